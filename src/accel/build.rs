@@ -1,0 +1,179 @@
+//! Binned SAH construction of the flat BVH.
+
+use glam::Vec3;
+
+use super::bvh::{Bvh, BvhNode};
+use crate::geometry::Aabb;
+use crate::geometry::float::{next_down, next_up};
+
+const BINS: usize = 16;
+/// Leaves never hold more primitives than this unless they are all coincident-and-unsplittable.
+const MAX_LEAF: usize = 8;
+/// Below this depth the SAH chooses splits; deeper nodes split at the median, which bounds the
+/// tree depth by `SAH_DEPTH + log2(n)` and so keeps it within the traversal stack.
+const SAH_DEPTH: usize = 32;
+/// Cost of visiting a node relative to intersecting one primitive.
+const TRAVERSAL_COST: f32 = 1.0;
+
+struct Task {
+    node: usize,
+    start: usize,
+    end: usize,
+    depth: usize,
+}
+
+pub(super) fn build(bounds: &[Aabb]) -> Bvh {
+    let n = bounds.len();
+    if n == 0 {
+        return Bvh::default();
+    }
+    let centroids: Vec<Vec3> = bounds.iter().map(Aabb::center).collect();
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    let mut nodes = Vec::with_capacity(2 * n.div_ceil(2).max(1));
+    nodes.push(leaf(Aabb::EMPTY, 0, 0));
+    let mut tasks = vec![Task { node: 0, start: 0, end: n, depth: 0 }];
+    while let Some(Task { node, start, end, depth }) = tasks.pop() {
+        let slice = &mut order[start..end];
+        let mut node_bounds = Aabb::EMPTY;
+        let mut centroid_bounds = Aabb::EMPTY;
+        for &i in slice.iter() {
+            node_bounds = node_bounds.union(bounds[i as usize]);
+            centroid_bounds = centroid_bounds.grow(centroids[i as usize]);
+        }
+        let count = end - start;
+        let split = if count <= 1 {
+            None
+        } else if depth < SAH_DEPTH {
+            sah_split(slice, bounds, &centroids, node_bounds, centroid_bounds)
+        } else {
+            Some(median_split(slice, &centroids, centroid_bounds))
+        };
+        let split = match split {
+            Some(mid) => Some(mid),
+            None if count > MAX_LEAF => Some(median_split(slice, &centroids, centroid_bounds)),
+            None => None,
+        };
+        match split {
+            Some(mid) => {
+                let left = nodes.len();
+                nodes.push(leaf(Aabb::EMPTY, 0, 0));
+                nodes.push(leaf(Aabb::EMPTY, 0, 0));
+                nodes[node] = interior(node_bounds, left);
+                tasks.push(Task { node: left + 1, start: start + mid, end, depth: depth + 1 });
+                tasks.push(Task { node: left, start, end: start + mid, depth: depth + 1 });
+            }
+            None => nodes[node] = leaf(node_bounds, start, count),
+        }
+    }
+    Bvh { nodes, order }
+}
+
+fn leaf(b: Aabb, first: usize, count: usize) -> BvhNode {
+    let (min, max) = padded(b);
+    BvhNode { min, index: first as u32, max, count: count as u32 }
+}
+
+fn interior(b: Aabb, first_child: usize) -> BvhNode {
+    let (min, max) = padded(b);
+    BvhNode { min, index: first_child as u32, max, count: 0 }
+}
+
+/// Node bounds grown by one ulp on every side, so every primitive point lies strictly inside its
+/// node's slabs: an axis-parallel ray sliding exactly along a primitive's bounding plane is then
+/// inside the slab instead of on its boundary, where `0·(1/d)` would be ambiguous.
+pub(super) fn padded(b: Aabb) -> ([f32; 3], [f32; 3]) {
+    if b.is_empty() {
+        return (b.min.to_array(), b.max.to_array());
+    }
+    (b.min.to_array().map(next_down), b.max.to_array().map(next_up))
+}
+
+/// Best SAH split of `slice` over all three axes; returns the size of the left part, or `None`
+/// when a leaf is cheaper (and allowed) or the centroids cannot be separated.
+fn sah_split(
+    slice: &mut [u32],
+    bounds: &[Aabb],
+    centroids: &[Vec3],
+    node_bounds: Aabb,
+    centroid_bounds: Aabb,
+) -> Option<usize> {
+    let extent = centroid_bounds.extent();
+    let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, bin boundary)
+    for axis in 0..3 {
+        if !(extent[axis] > 0.0) {
+            continue;
+        }
+        let scale = BINS as f32 / extent[axis];
+        let lo = centroid_bounds.min[axis];
+        let mut bin_bounds = [Aabb::EMPTY; BINS];
+        let mut bin_count = [0u32; BINS];
+        for &i in slice.iter() {
+            let b = bin_index(centroids[i as usize][axis], lo, scale);
+            bin_bounds[b] = bin_bounds[b].union(bounds[i as usize]);
+            bin_count[b] += 1;
+        }
+        // Sweep from the right to get suffix areas and counts.
+        let mut right_area = [0.0f32; BINS];
+        let mut right_count = [0u32; BINS];
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0u32);
+        for b in (1..BINS).rev() {
+            acc = acc.union(bin_bounds[b]);
+            cnt += bin_count[b];
+            right_area[b] = acc.half_area();
+            right_count[b] = cnt;
+        }
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0u32);
+        for b in 1..BINS {
+            acc = acc.union(bin_bounds[b - 1]);
+            cnt += bin_count[b - 1];
+            if cnt == 0 || right_count[b] == 0 {
+                continue;
+            }
+            let cost = acc.half_area() * cnt as f32 + right_area[b] * right_count[b] as f32;
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, axis, b));
+            }
+        }
+    }
+    let (cost, axis, boundary) = best?;
+    let node_area = node_bounds.half_area();
+    let split_cost = TRAVERSAL_COST + if node_area > 0.0 { cost / node_area } else { 0.0 };
+    let leaf_cost = slice.len() as f32;
+    if slice.len() <= MAX_LEAF && split_cost >= leaf_cost {
+        return None;
+    }
+    let lo = centroid_bounds.min[axis];
+    let scale = BINS as f32 / extent[axis];
+    let mid = partition(slice, |i| bin_index(centroids[i as usize][axis], lo, scale) < boundary);
+    (mid > 0 && mid < slice.len()).then_some(mid)
+}
+
+#[inline]
+fn bin_index(c: f32, lo: f32, scale: f32) -> usize {
+    (((c - lo) * scale) as usize).min(BINS - 1)
+}
+
+/// Splits at the median along the widest centroid axis (by index when all centroids coincide).
+fn median_split(slice: &mut [u32], centroids: &[Vec3], centroid_bounds: Aabb) -> usize {
+    let mid = slice.len() / 2;
+    let e = centroid_bounds.extent();
+    let axis = if e.x >= e.y && e.x >= e.z { 0 } else if e.y >= e.z { 1 } else { 2 };
+    if e[axis] > 0.0 {
+        slice.select_nth_unstable_by(mid, |&a, &b| {
+            centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis]).then(a.cmp(&b))
+        });
+    }
+    mid
+}
+
+/// In-place partition; returns the number of elements for which `pred` holds (now at the front).
+fn partition(slice: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
+    let mut first = 0;
+    for i in 0..slice.len() {
+        if pred(slice[i]) {
+            slice.swap(first, i);
+            first += 1;
+        }
+    }
+    first
+}
