@@ -8,3 +8,5 @@
 
 pub mod accel;
 pub mod geometry;
+pub mod bench;
+pub mod scene;

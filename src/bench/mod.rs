@@ -1,0 +1,3 @@
+//! Benchmark workloads shared by `cargo bench` and tests.
+
+pub mod blob;

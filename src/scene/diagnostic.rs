@@ -1,0 +1,200 @@
+//! Diagnostics: one problem in a scene file, with where it is and how to fix it, rendered like a
+//! compiler message (file:line:column, the offending line, a caret under the value).
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use super::locate::{Location, SourceIndex};
+
+/// How serious a diagnostic is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Severity {
+    /// The scene cannot be rendered.
+    Error,
+    /// The scene renders, but probably not as intended.
+    Warning,
+}
+
+/// One problem found in a scene, before or after parsing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagnostic {
+    /// Error or warning.
+    pub severity: Severity,
+    /// Field path such as `materials.water.ior` (empty when the problem is not tied to a field).
+    pub path: String,
+    /// What is wrong, including what was found and what is valid.
+    pub message: String,
+    /// An optional hint, such as a did-you-mean suggestion.
+    pub help: Option<String>,
+    /// Where in the file, when known.
+    pub location: Option<SourcePoint>,
+}
+
+/// A located excerpt of a source file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourcePoint {
+    /// The scene file.
+    pub file: PathBuf,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column (characters).
+    pub column: usize,
+    /// The text of that line.
+    pub line_text: String,
+    /// How many characters the caret underlines.
+    pub width: usize,
+}
+
+impl Diagnostic {
+    /// An error at `path`.
+    #[must_use]
+    pub fn error(path: impl Into<String>, message: impl Into<String>) -> Self {
+        Self { severity: Severity::Error, path: path.into(), message: message.into(), help: None, location: None }
+    }
+
+    /// A warning at `path`.
+    #[must_use]
+    pub fn warning(path: impl Into<String>, message: impl Into<String>) -> Self {
+        Self { severity: Severity::Warning, ..Self::error(path, message) }
+    }
+
+    /// Adds a hint.
+    #[must_use]
+    pub fn with_help(mut self, help: impl Into<String>) -> Self {
+        self.help = Some(help.into());
+        self
+    }
+
+    /// True for errors.
+    #[must_use]
+    pub fn is_error(&self) -> bool {
+        self.severity == Severity::Error
+    }
+
+    /// Attaches the file position of `self.path`, found with `index` in `text`.
+    #[must_use]
+    pub fn located(mut self, file: &Path, text: &str, index: &SourceIndex) -> Self {
+        if self.location.is_none() && !self.path.is_empty() {
+            if let Some(loc) = index.locate(&self.path) {
+                self.location = Some(SourcePoint::at(file, text, loc));
+            }
+        }
+        self
+    }
+}
+
+impl SourcePoint {
+    /// The excerpt at `loc` in `text`, underlining the token that starts there.
+    #[must_use]
+    pub fn at(file: &Path, text: &str, loc: Location) -> Self {
+        let line_text = text.lines().nth(loc.line.saturating_sub(1)).unwrap_or("").trim_end_matches('\r').to_string();
+        let rest: String = line_text.chars().skip(loc.column.saturating_sub(1)).collect();
+        Self { file: file.to_path_buf(), line: loc.line, column: loc.column, width: token_width(&rest), line_text }
+    }
+}
+
+/// Width of the value token at the start of `rest`: a bracketed group on one line, a string, or
+/// a run of characters up to a delimiter.
+fn token_width(rest: &str) -> usize {
+    let mut chars = rest.chars();
+    match chars.next() {
+        None => 1,
+        Some('"') => {
+            let mut n = 1;
+            let mut escaped = false;
+            for c in chars {
+                n += 1;
+                if c == '"' && !escaped {
+                    return n;
+                }
+                escaped = c == '\\' && !escaped;
+            }
+            n
+        }
+        Some(open @ ('(' | '[' | '{')) => {
+            let close = match open {
+                '(' => ')',
+                '[' => ']',
+                _ => '}',
+            };
+            let mut depth = 0usize;
+            for (i, c) in rest.chars().enumerate() {
+                if c == open {
+                    depth += 1;
+                } else if c == close {
+                    depth -= 1;
+                    if depth == 0 {
+                        return i + 1;
+                    }
+                }
+            }
+            1
+        }
+        Some(_) => rest.chars().take_while(|c| !matches!(c, ',' | ')' | ']' | '}' | '(' | '[' | '{') && !c.is_whitespace()).count().max(1),
+    }
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let label = match self.severity {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        };
+        if self.path.is_empty() {
+            writeln!(f, "{label}: {}", self.message)?;
+        } else {
+            writeln!(f, "{label}: {}: {}", self.path, self.message)?;
+        }
+        if let Some(p) = &self.location {
+            let num = p.line.to_string();
+            let pad = " ".repeat(num.len());
+            writeln!(f, "{pad}--> {}:{}:{}", p.file.display(), p.line, p.column)?;
+            writeln!(f, "{pad} |")?;
+            writeln!(f, "{num} | {}", p.line_text)?;
+            let lead: String =
+                p.line_text.chars().take(p.column.saturating_sub(1)).map(|c| if c == '\t' { '\t' } else { ' ' }).collect();
+            writeln!(f, "{pad} | {lead}{}", "^".repeat(p.width))?;
+        }
+        if let Some(help) = &self.help {
+            writeln!(f, "  = help: {help}")?;
+        }
+        Ok(())
+    }
+}
+
+/// The closest of `candidates` to `found` by edit distance, if it is close enough to be a likely typo.
+#[must_use]
+pub fn did_you_mean<'a>(found: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    candidates
+        .into_iter()
+        .map(|c| (strsim::jaro_winkler(found, c), c))
+        .filter(|(score, _)| *score > 0.8)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, c)| c)
+}
+
+/// Formats a list of names as `` `a`, `b`, `c` ``.
+#[must_use]
+pub fn quoted_list<'a>(names: impl IntoIterator<Item = &'a str>) -> String {
+    names.into_iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn suggestions_pick_close_names_only() {
+        assert_eq!(did_you_mean("albdo", ["color", "albedo", "ior"]), Some("albedo"));
+        assert_eq!(did_you_mean("glas", ["glass", "mirror"]), Some("glass"));
+        assert_eq!(did_you_mean("zzz", ["glass", "mirror"]), None);
+    }
+
+    #[test]
+    fn token_widths() {
+        assert_eq!(token_width("-1.33),"), 5);
+        assert_eq!(token_width("\"wat\\\"r\", x"), 8);
+        assert_eq!(token_width("(1, (2), 3) x"), 11);
+        assert_eq!(token_width(""), 1);
+    }
+}

@@ -1,0 +1,295 @@
+//! Semantic checks of a parsed scene: every problem is reported, not just the first.
+
+use std::collections::BTreeSet;
+
+use super::diagnostic::{Diagnostic, did_you_mean, quoted_list};
+use super::schema::{CameraSpec, LightSpec, MaterialSpec, NodeSpec, RenderSettings, ScaleSpec, SceneFile, TransformStep};
+
+/// Largest accepted image side, in pixels.
+pub const MAX_IMAGE_SIDE: u32 = 32_768;
+/// Largest accepted image area, in pixels (the film needs 12 bytes per pixel).
+pub const MAX_IMAGE_PIXELS: u64 = 100_000_000;
+/// Largest accepted samples per pixel.
+pub const MAX_SAMPLES_PER_PIXEL: u32 = 1 << 20;
+/// Largest accepted recursion depth.
+pub const MAX_DEPTH: u32 = 1024;
+/// Deepest accepted group nesting.
+pub const MAX_NESTING: usize = 64;
+
+/// Checks a scene and returns all errors and warnings (errors first keep the file order).
+#[must_use]
+pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
+    let mut v = Validator { out: Vec::new(), used: BTreeSet::new(), scene };
+    v.render(&scene.render);
+    v.camera(&scene.camera);
+    for (name, m) in &scene.materials {
+        v.material(&format!("materials.{name}"), m);
+    }
+    if scene.lights.is_empty() {
+        v.out.push(
+            Diagnostic::warning("lights", "the scene has no lights, so only the background will be visible")
+                .with_help("add e.g. `Point(position: (0, 5, 0), power: (100, 100, 100))`"),
+        );
+    }
+    for (i, l) in scene.lights.iter().enumerate() {
+        v.light(&format!("lights[{i}]"), l);
+    }
+    if scene.nodes.is_empty() {
+        v.out.push(Diagnostic::error("nodes", "the scene has no nodes, so there is nothing to render"));
+    }
+    for (i, n) in scene.nodes.iter().enumerate() {
+        v.node(&format!("nodes[{i}]"), n, 1);
+    }
+    for name in scene.materials.keys() {
+        if !v.used.contains(name.as_str()) {
+            v.out.push(Diagnostic::warning(format!("materials.{name}"), format!("material `{name}` is never used")));
+        }
+    }
+    v.out
+}
+
+struct Validator<'a> {
+    out: Vec<Diagnostic>,
+    used: BTreeSet<&'a str>,
+    scene: &'a SceneFile,
+}
+
+impl<'a> Validator<'a> {
+    fn err(&mut self, path: &str, msg: String) {
+        self.out.push(Diagnostic::error(path, msg));
+    }
+
+    fn finite(&mut self, path: &str, v: f32) -> bool {
+        if v.is_finite() {
+            return true;
+        }
+        self.err(path, format!("must be a finite number, found {v}"));
+        false
+    }
+
+    fn finite3(&mut self, path: &str, v: [f32; 3]) -> bool {
+        if v.iter().all(|x| x.is_finite()) {
+            return true;
+        }
+        self.err(path, format!("must have finite components, found {}", fmt3(v)));
+        false
+    }
+
+    fn positive(&mut self, path: &str, v: f32, what: &str) {
+        if self.finite(path, v) && v <= 0.0 {
+            self.err(path, format!("{what} must be greater than 0, found {v}"));
+        }
+    }
+
+    fn range(&mut self, path: &str, v: f32, lo: f32, hi: f32) {
+        if self.finite(path, v) && !(lo..=hi).contains(&v) {
+            self.err(path, format!("must be within [{lo}, {hi}], found {v}"));
+        }
+    }
+
+    fn unit_rgb(&mut self, path: &str, v: [f32; 3], what: &str) {
+        if self.finite3(path, v) && v.iter().any(|c| !(0.0..=1.0).contains(c)) {
+            self.out.push(
+                Diagnostic::error(path, format!("{what} components must be within [0, 1], found {}", fmt3(v)))
+                    .with_help("a reflectance above 1 would create energy; scale the light's power instead"),
+            );
+        }
+    }
+
+    fn render(&mut self, r: &RenderSettings) {
+        for (field, v) in [("width", r.width), ("height", r.height)] {
+            let path = format!("render.{field}");
+            if v == 0 {
+                self.err(&path, "must be at least 1 pixel, found 0".into());
+            } else if v > MAX_IMAGE_SIDE {
+                self.err(&path, format!("must be at most {MAX_IMAGE_SIDE} pixels, found {v}"));
+            }
+        }
+        let pixels = u64::from(r.width) * u64::from(r.height);
+        if r.width <= MAX_IMAGE_SIDE && r.height <= MAX_IMAGE_SIDE && pixels > MAX_IMAGE_PIXELS {
+            self.err(
+                "render.width",
+                format!(
+                    "{}×{} = {pixels} pixels exceeds the limit of {MAX_IMAGE_PIXELS} pixels (the film alone would need {:.1} GB)",
+                    r.width,
+                    r.height,
+                    pixels as f64 * 12.0 / 1e9
+                ),
+            );
+        }
+        if r.samples_per_pixel == 0 || r.samples_per_pixel > MAX_SAMPLES_PER_PIXEL {
+            self.err(
+                "render.samples_per_pixel",
+                format!("must be within [1, {MAX_SAMPLES_PER_PIXEL}], found {}", r.samples_per_pixel),
+            );
+        }
+        if r.max_depth > MAX_DEPTH {
+            self.err("render.max_depth", format!("must be at most {MAX_DEPTH}, found {}", r.max_depth));
+        }
+        if r.light_samples == 0 || r.light_samples > 1024 {
+            self.err("render.light_samples", format!("must be within [1, 1024], found {}", r.light_samples));
+        }
+        self.range("render.min_contribution", r.min_contribution, 0.0, 1.0);
+        if self.finite3("render.background", r.background) && r.background.iter().any(|c| *c < 0.0) {
+            self.err("render.background", format!("must not be negative, found {}", fmt3(r.background)));
+        }
+        self.positive("render.exposure", r.exposure, "exposure");
+    }
+
+    fn camera(&mut self, c: &CameraSpec) {
+        let CameraSpec::Pinhole { eye, look_at, up, fov_y } = c;
+        let ok = self.finite3("camera.eye", *eye) & self.finite3("camera.look_at", *look_at) & self.finite3("camera.up", *up);
+        if self.finite("camera.fov_y", *fov_y) && !(*fov_y > 0.0 && *fov_y < 180.0) {
+            self.err("camera.fov_y", format!("must be within (0, 180) degrees, found {fov_y}"));
+        }
+        if !ok {
+            return;
+        }
+        let forward = glam::Vec3::from(*look_at) - glam::Vec3::from(*eye);
+        if !(forward.length_squared() > 0.0) {
+            self.err("camera.look_at", format!("must differ from `eye`, both are {}", fmt3(*eye)));
+        } else if !(forward.normalize().cross(glam::Vec3::from(*up)).length_squared() > 1e-12) {
+            self.err("camera.up", format!("must not be parallel to the view direction, found {}", fmt3(*up)));
+        }
+    }
+
+    fn material(&mut self, path: &str, m: &MaterialSpec) {
+        self.unit_rgb(&format!("{path}.color"), m.color, "color");
+        self.unit_rgb(&format!("{path}.specular"), m.specular, "specular");
+        if self.finite(&format!("{path}.shininess"), m.shininess) && m.shininess < 0.0 {
+            self.err(&format!("{path}.shininess"), format!("must not be negative, found {}", m.shininess));
+        }
+        let weights = [("diffuse", m.diffuse), ("reflect", m.reflect), ("transmit", m.transmit)];
+        let mut all_ok = true;
+        for (field, w) in weights {
+            let Some(w) = w else { continue };
+            let p = format!("{path}.{field}");
+            if !self.finite(&p, w) {
+                all_ok = false;
+            } else if w < 0.0 {
+                all_ok = false;
+                self.err(&p, format!("weights must not be negative, found {w}"));
+            }
+        }
+        let any_given = weights.iter().any(|(_, w)| w.is_some());
+        let sum: f32 = weights.iter().filter_map(|(_, w)| *w).sum();
+        if all_ok && any_given && sum <= 0.0 {
+            self.out.push(
+                Diagnostic::error(path, "`diffuse`, `reflect` and `transmit` are all zero, so the surface would be black")
+                    .with_help("give at least one weight a positive value; weights are normalised to sum to 1"),
+            );
+        }
+        let p = format!("{path}.ior");
+        if self.finite(&p, m.ior) && m.ior <= 0.0 {
+            self.out.push(
+                Diagnostic::error(&p, format!("index of refraction must be greater than 0, found {}", m.ior))
+                    .with_help("typical values: 1.0 air, 1.33 water, 1.5 glass, 2.42 diamond"),
+            );
+        }
+        let gains = (0..3).any(|i| m.color[i] + m.specular[i] > 1.0 + 1e-6);
+        if m.diffuse.unwrap_or(if any_given { 0.0 } else { 1.0 }) > 0.0 && gains && m.color.iter().all(|c| c.is_finite()) {
+            self.out.push(Diagnostic::warning(
+                format!("{path}.specular"),
+                format!("color + specular exceeds 1 ({} + {}), so the surface reflects more light than it receives", fmt3(m.color), fmt3(m.specular)),
+            ));
+        }
+    }
+
+    fn light(&mut self, path: &str, l: &LightSpec) {
+        let (power, power_path) = match l {
+            LightSpec::Point { position, power } => {
+                self.finite3(&format!("{path}.position"), *position);
+                (power, format!("{path}.power"))
+            }
+            LightSpec::Sphere { center, radius, power } => {
+                self.finite3(&format!("{path}.center"), *center);
+                self.positive(&format!("{path}.radius"), *radius, "radius");
+                (power, format!("{path}.power"))
+            }
+        };
+        if self.finite3(&power_path, *power) && power.iter().any(|c| *c < 0.0) {
+            self.err(&power_path, format!("must not be negative, found {}", fmt3(*power)));
+        }
+    }
+
+    fn node(&mut self, path: &str, n: &'a NodeSpec, depth: usize) {
+        if depth > MAX_NESTING {
+            self.err(path, format!("groups are nested more than {MAX_NESTING} levels deep"));
+            return;
+        }
+        for (i, step) in n.transform().iter().enumerate() {
+            self.transform_step(&format!("{path}.transform[{i}]"), step);
+        }
+        if let Some(material) = n.material() {
+            self.material_ref(&format!("{path}.material"), material);
+        }
+        match n {
+            NodeSpec::Group { children, .. } => {
+                for (i, c) in children.iter().enumerate() {
+                    self.node(&format!("{path}.children[{i}]"), c, depth + 1);
+                }
+            }
+            NodeSpec::Sphere { center, radius, .. } => {
+                self.finite3(&format!("{path}.center"), *center);
+                self.positive(&format!("{path}.radius"), *radius, "radius");
+            }
+            NodeSpec::Cube { size, .. } => self.positive(&format!("{path}.size"), *size, "size"),
+            NodeSpec::Quad { size, .. } => {
+                for (i, s) in size.iter().enumerate() {
+                    self.positive(&format!("{path}.size[{i}]"), *s, "size");
+                }
+            }
+            NodeSpec::Mesh { file, .. } => {
+                if file.trim().is_empty() {
+                    self.err(&format!("{path}.file"), "must name an OBJ file, found an empty string".into());
+                }
+            }
+        }
+    }
+
+    fn material_ref(&mut self, path: &str, name: &'a str) {
+        if self.scene.materials.contains_key(name) {
+            self.used.insert(name);
+            return;
+        }
+        let names = self.scene.materials.keys().map(String::as_str);
+        let list = quoted_list(names.clone());
+        let mut d = Diagnostic::error(
+            path,
+            format!("unknown material `{name}`; defined materials: {}", if list.is_empty() { "none" } else { &list }),
+        );
+        if let Some(s) = did_you_mean(name, names) {
+            d = d.with_help(format!("did you mean `{s}`?"));
+        }
+        self.out.push(d);
+    }
+
+    fn transform_step(&mut self, path: &str, step: &TransformStep) {
+        match step {
+            TransformStep::Translate(x, y, z) => {
+                self.finite3(path, [*x, *y, *z]);
+            }
+            TransformStep::RotateX(a) | TransformStep::RotateY(a) | TransformStep::RotateZ(a) => {
+                self.finite(path, *a);
+            }
+            TransformStep::Scale(s) => {
+                let v = match s {
+                    ScaleSpec::Uniform(u) => [*u; 3],
+                    ScaleSpec::PerAxis(v) => *v,
+                };
+                if self.finite3(path, v) && v.iter().any(|c| *c == 0.0) {
+                    self.out.push(
+                        Diagnostic::error(path, format!("scale {} is singular (a zero factor flattens the object)", fmt3(v)))
+                            .with_help("use a small positive factor, or remove the node"),
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Formats a triple as `(x, y, z)`.
+#[must_use]
+pub fn fmt3(v: [f32; 3]) -> String {
+    format!("({}, {}, {})", v[0], v[1], v[2])
+}
