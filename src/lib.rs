@@ -7,6 +7,15 @@
 #![warn(missing_docs)]
 
 pub mod accel;
-pub mod geometry;
 pub mod bench;
+pub mod compile;
+pub mod error;
+pub mod geometry;
+pub mod pipeline;
+pub mod render;
+pub mod render_scene;
+pub mod sampling;
 pub mod scene;
+pub mod shading;
+
+pub use error::Error;

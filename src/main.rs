@@ -1,1 +1,261 @@
-fn main() {}
+//! The `caustic` command line: render, check, schema, debug-pixel.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+
+use caustic::Error;
+use caustic::pipeline::{SceneOverrides, prepare};
+use caustic::render::output::{OutputFormat, write_image};
+use caustic::render::{Region, RenderOptions, render, trace_pixel};
+use caustic::scene::Diagnostic;
+
+/// caustic: a ray tracer driven by RON/TOML scene files.
+#[derive(Parser)]
+#[command(name = "caustic", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to PNG (sRGB) or EXR (linear float), chosen by the output's extension.
+    Render(RenderArgs),
+    /// Parse and validate a scene (and its assets) without rendering; reports every error.
+    Check(SceneArgs),
+    /// Print the JSON Schema of the scene format.
+    Schema,
+    /// Trace one sample of one pixel and print its ray tree.
+    DebugPixel(DebugPixelArgs),
+}
+
+#[derive(Args)]
+struct SceneArgs {
+    /// Scene file (.ron or .toml).
+    scene: PathBuf,
+    /// Override a scene value, e.g. `--set camera.fov_y=35` (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    sets: Vec<String>,
+    /// Image width in pixels.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Samples per pixel.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Maximum specular recursion depth.
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Seed of the random streams.
+    #[arg(long)]
+    seed: Option<u64>,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output image (.png or .exr); default: the scene's name with .png in the current directory.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Render only the crop X,Y,W,H (pixels from the top-left); its pixels equal the full render's.
+    #[arg(long, value_name = "X,Y,W,H")]
+    region: Option<String>,
+    /// No progress bar and no warnings.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Print scene and BVH statistics.
+    #[arg(long)]
+    stats: bool,
+}
+
+#[derive(Args)]
+struct DebugPixelArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Pixel column.
+    x: u32,
+    /// Pixel row (from the top).
+    y: u32,
+    /// Which of the pixel's samples to trace.
+    #[arg(long, default_value_t = 0)]
+    sample: u32,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+impl SceneArgs {
+    fn overrides(&self) -> SceneOverrides {
+        SceneOverrides {
+            sets: self.sets.clone(),
+            width: self.width,
+            height: self.height,
+            samples_per_pixel: self.spp,
+            max_depth: self.max_depth,
+            seed: self.seed,
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => cmd_render(&args),
+        Command::Check(args) => cmd_check(&args),
+        Command::Schema => {
+            print!("{}", caustic::scene::schema::json_schema());
+            Ok(())
+        }
+        Command::DebugPixel(args) => cmd_debug_pixel(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{e}");
+            ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}
+
+fn print_warnings(warnings: &[Diagnostic]) {
+    for w in warnings {
+        eprint!("{w}");
+    }
+}
+
+fn cmd_check(args: &SceneArgs) -> Result<(), Error> {
+    let prepared = prepare(&args.scene, &args.overrides())?;
+    print_warnings(&prepared.warnings);
+    let s = &prepared.stats;
+    println!(
+        "{}: ok ({} triangles, {} spheres, {} ellipsoids, {} materials, {} lights; {} warning{})",
+        args.scene.display(),
+        s.triangles,
+        s.spheres,
+        s.ellipsoids,
+        s.materials,
+        s.lights,
+        prepared.warnings.len(),
+        if prepared.warnings.len() == 1 {
+            ""
+        } else {
+            "s"
+        }
+    );
+    Ok(())
+}
+
+fn parse_region(text: &str) -> Result<Region, Error> {
+    let parts: Vec<Result<u32, _>> = text.split(',').map(|p| p.trim().parse::<u32>()).collect();
+    match parts.as_slice() {
+        [Ok(x), Ok(y), Ok(w), Ok(h)] => Ok(Region {
+            x: *x,
+            y: *y,
+            width: *w,
+            height: *h,
+        }),
+        _ => Err(Error::Usage(format!(
+            "error: --region `{text}`: expected four non-negative integers X,Y,W,H, e.g. `--region 64,64,128,128`"
+        ))),
+    }
+}
+
+fn default_output(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from(format!("{stem}.png"))
+}
+
+fn cmd_render(args: &RenderArgs) -> Result<(), Error> {
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&args.scene.scene));
+    // Refuse a bad output name before doing any work.
+    OutputFormat::for_path(&output)?;
+    let region = args.region.as_deref().map(parse_region).transpose()?;
+    if args.threads == Some(0) {
+        return Err(Error::Usage("error: --threads must be at least 1".into()));
+    }
+    let prepared = prepare(&args.scene.scene, &args.scene.overrides())?;
+    if !args.quiet {
+        print_warnings(&prepared.warnings);
+    }
+    let s = &prepared.stats;
+    if args.stats {
+        eprintln!(
+            "scene: {} triangles ({} degenerate dropped), {} spheres, {} ellipsoids, {} materials, {} lights, {} OBJ files",
+            s.triangles,
+            s.degenerate_triangles,
+            s.spheres,
+            s.ellipsoids,
+            s.materials,
+            s.lights,
+            s.meshes_loaded
+        );
+        eprintln!(
+            "bvh: {} nodes, {} leaves, depth {}, max leaf {}, SAH cost {:.2}; flatten {:.3} s, build {:.3} s",
+            s.bvh.nodes,
+            s.bvh.leaves,
+            s.bvh.max_depth,
+            s.bvh.max_leaf_size,
+            s.bvh.sah_cost,
+            s.flatten_time.as_secs_f64(),
+            s.bvh_time.as_secs_f64()
+        );
+    }
+    let options = RenderOptions {
+        threads: args.threads,
+        region,
+        progress: !args.quiet && std::io::stderr().is_terminal(),
+    };
+    let out = render(&prepared.render_scene, &options)?;
+    write_image(&out.film, &output, prepared.render_scene.params.exposure)?;
+    let st = &out.stats;
+    let secs = st.elapsed.as_secs_f64();
+    println!(
+        "{}: {}×{}, {} spp, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
+        output.display(),
+        out.film.width,
+        out.film.height,
+        prepared.render_scene.params.samples_per_pixel,
+        st.rays,
+        secs,
+        st.rays as f64 / secs.max(1e-9) / 1e6,
+        st.threads,
+        if st.threads == 1 { "" } else { "s" }
+    );
+    if st.nan_samples > 0 {
+        eprintln!(
+            "warning: {} samples were NaN or infinite and were dropped",
+            st.nan_samples
+        );
+    }
+    Ok(())
+}
+
+fn cmd_debug_pixel(args: &DebugPixelArgs) -> Result<(), Error> {
+    let prepared = prepare(&args.scene.scene, &args.scene.overrides())?;
+    let (log, l) = trace_pixel(&prepared.render_scene, args.x, args.y, args.sample)?;
+    if args.json {
+        let mut v = log.to_json();
+        v["pixel"] = serde_json::json!([args.x, args.y]);
+        v["sample"] = serde_json::json!(args.sample);
+        v["radiance"] = serde_json::json!([l.x, l.y, l.z]);
+        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+    } else {
+        println!("pixel ({}, {}) sample {}:", args.x, args.y, args.sample);
+        print!("{}", log.to_text());
+    }
+    Ok(())
+}

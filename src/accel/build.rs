@@ -31,8 +31,19 @@ pub(super) fn build(bounds: &[Aabb]) -> Bvh {
     let mut order: Vec<u32> = (0..n as u32).collect();
     let mut nodes = Vec::with_capacity(2 * n.div_ceil(2).max(1));
     nodes.push(leaf(Aabb::EMPTY, 0, 0));
-    let mut tasks = vec![Task { node: 0, start: 0, end: n, depth: 0 }];
-    while let Some(Task { node, start, end, depth }) = tasks.pop() {
+    let mut tasks = vec![Task {
+        node: 0,
+        start: 0,
+        end: n,
+        depth: 0,
+    }];
+    while let Some(Task {
+        node,
+        start,
+        end,
+        depth,
+    }) = tasks.pop()
+    {
         let slice = &mut order[start..end];
         let mut node_bounds = Aabb::EMPTY;
         let mut centroid_bounds = Aabb::EMPTY;
@@ -59,8 +70,18 @@ pub(super) fn build(bounds: &[Aabb]) -> Bvh {
                 nodes.push(leaf(Aabb::EMPTY, 0, 0));
                 nodes.push(leaf(Aabb::EMPTY, 0, 0));
                 nodes[node] = interior(node_bounds, left);
-                tasks.push(Task { node: left + 1, start: start + mid, end, depth: depth + 1 });
-                tasks.push(Task { node: left, start, end: start + mid, depth: depth + 1 });
+                tasks.push(Task {
+                    node: left + 1,
+                    start: start + mid,
+                    end,
+                    depth: depth + 1,
+                });
+                tasks.push(Task {
+                    node: left,
+                    start,
+                    end: start + mid,
+                    depth: depth + 1,
+                });
             }
             None => nodes[node] = leaf(node_bounds, start, count),
         }
@@ -70,12 +91,22 @@ pub(super) fn build(bounds: &[Aabb]) -> Bvh {
 
 fn leaf(b: Aabb, first: usize, count: usize) -> BvhNode {
     let (min, max) = padded(b);
-    BvhNode { min, index: first as u32, max, count: count as u32 }
+    BvhNode {
+        min,
+        index: first as u32,
+        max,
+        count: count as u32,
+    }
 }
 
 fn interior(b: Aabb, first_child: usize) -> BvhNode {
     let (min, max) = padded(b);
-    BvhNode { min, index: first_child as u32, max, count: 0 }
+    BvhNode {
+        min,
+        index: first_child as u32,
+        max,
+        count: 0,
+    }
 }
 
 /// Node bounds grown by one ulp on every side, so every primitive point lies strictly inside its
@@ -85,7 +116,10 @@ pub(super) fn padded(b: Aabb) -> ([f32; 3], [f32; 3]) {
     if b.is_empty() {
         return (b.min.to_array(), b.max.to_array());
     }
-    (b.min.to_array().map(next_down), b.max.to_array().map(next_up))
+    (
+        b.min.to_array().map(next_down),
+        b.max.to_array().map(next_up),
+    )
 }
 
 /// Best SAH split of `slice` over all three axes; returns the size of the left part, or `None`
@@ -137,14 +171,21 @@ fn sah_split(
     }
     let (cost, axis, boundary) = best?;
     let node_area = node_bounds.half_area();
-    let split_cost = TRAVERSAL_COST + if node_area > 0.0 { cost / node_area } else { 0.0 };
+    let split_cost = TRAVERSAL_COST
+        + if node_area > 0.0 {
+            cost / node_area
+        } else {
+            0.0
+        };
     let leaf_cost = slice.len() as f32;
     if slice.len() <= MAX_LEAF && split_cost >= leaf_cost {
         return None;
     }
     let lo = centroid_bounds.min[axis];
     let scale = BINS as f32 / extent[axis];
-    let mid = partition(slice, |i| bin_index(centroids[i as usize][axis], lo, scale) < boundary);
+    let mid = partition(slice, |i| {
+        bin_index(centroids[i as usize][axis], lo, scale) < boundary
+    });
     (mid > 0 && mid < slice.len()).then_some(mid)
 }
 
@@ -157,10 +198,18 @@ fn bin_index(c: f32, lo: f32, scale: f32) -> usize {
 fn median_split(slice: &mut [u32], centroids: &[Vec3], centroid_bounds: Aabb) -> usize {
     let mid = slice.len() / 2;
     let e = centroid_bounds.extent();
-    let axis = if e.x >= e.y && e.x >= e.z { 0 } else if e.y >= e.z { 1 } else { 2 };
+    let axis = if e.x >= e.y && e.x >= e.z {
+        0
+    } else if e.y >= e.z {
+        1
+    } else {
+        2
+    };
     if e[axis] > 0.0 {
         slice.select_nth_unstable_by(mid, |&a, &b| {
-            centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis]).then(a.cmp(&b))
+            centroids[a as usize][axis]
+                .total_cmp(&centroids[b as usize][axis])
+                .then(a.cmp(&b))
         });
     }
     mid

@@ -46,7 +46,10 @@ impl BvhNode {
     #[inline]
     #[must_use]
     pub fn bounds(&self) -> Aabb {
-        Aabb { min: self.min.into(), max: self.max.into() }
+        Aabb {
+            min: self.min.into(),
+            max: self.max.into(),
+        }
     }
 
     /// True for leaves.
@@ -67,7 +70,10 @@ impl Bvh {
     /// Shape figures of this tree.
     #[must_use]
     pub fn stats(&self) -> BvhStats {
-        let mut s = BvhStats { nodes: self.nodes.len(), ..Default::default() };
+        let mut s = BvhStats {
+            nodes: self.nodes.len(),
+            ..Default::default()
+        };
         if self.nodes.is_empty() {
             return s;
         }

@@ -1,7 +1,7 @@
 //! Acceleration structures over primitive bounds.
 
-pub mod bvh;
 pub(crate) mod build;
+pub mod bvh;
 mod traverse;
 
 pub use bvh::{Bvh, BvhNode, BvhStats};

@@ -27,9 +27,16 @@ impl RayBoxTest {
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
         let inv = |d: f32| {
             let r = 1.0 / d;
-            if r.is_finite() { r } else { HUGE_RECIPROCAL.copysign(d) }
+            if r.is_finite() {
+                r
+            } else {
+                HUGE_RECIPROCAL.copysign(d)
+            }
         };
-        Self { origin: origin.into(), inv_dir: Vec3A::new(inv(dir.x), inv(dir.y), inv(dir.z)) }
+        Self {
+            origin: origin.into(),
+            inv_dir: Vec3A::new(inv(dir.x), inv(dir.y), inv(dir.z)),
+        }
     }
 
     /// Entry distance of the ray into `node` if it overlaps `[0, t_max]`, else +∞.
@@ -41,7 +48,11 @@ impl RayBoxTest {
         let t_near = lo.min(hi).max_element().max(0.0);
         // Widen the far distance by the slab computation's rounding error (pbrt's 1 + 2γ₃).
         let t_far = (lo.max(hi).min_element() * (1.0 + 2.0 * gamma(3))).min(t_max);
-        if t_near <= t_far { t_near } else { f32::INFINITY }
+        if t_near <= t_far {
+            t_near
+        } else {
+            f32::INFINITY
+        }
     }
 }
 
@@ -50,9 +61,16 @@ impl Bvh {
     /// `test(slot, t_max)` intersects the primitive in `slot` and returns a closer distance on a
     /// hit, which then shrinks the search. Returns the final `t_max`.
     #[inline]
-    pub fn closest(&self, ray: &RayBoxTest, mut t_max: f32, mut test: impl FnMut(u32, f32) -> Option<f32>) -> f32 {
+    pub fn closest(
+        &self,
+        ray: &RayBoxTest,
+        mut t_max: f32,
+        mut test: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> f32 {
         let nodes = &self.nodes[..];
-        let Some(root) = nodes.first() else { return t_max };
+        let Some(root) = nodes.first() else {
+            return t_max;
+        };
         if ray.entry(root, t_max) == f32::INFINITY {
             return t_max;
         }
@@ -69,10 +87,18 @@ impl Bvh {
             } else {
                 let (a, b) = (&nodes[node.index as usize], &nodes[node.index as usize + 1]);
                 let (ta, tb) = (ray.entry(a, t_max), ray.entry(b, t_max));
-                let (near, far, t_near, t_far) = if ta <= tb { (a, b, ta, tb) } else { (b, a, tb, ta) };
+                let (near, far, t_near, t_far) = if ta <= tb {
+                    (a, b, ta, tb)
+                } else {
+                    (b, a, tb, ta)
+                };
                 if t_near != f32::INFINITY {
                     if t_far != f32::INFINITY {
-                        let far_index = if std::ptr::eq(far, a) { node.index } else { node.index + 1 };
+                        let far_index = if std::ptr::eq(far, a) {
+                            node.index
+                        } else {
+                            node.index + 1
+                        };
                         stack[sp] = (far_index, t_far);
                         sp += 1;
                     }
@@ -97,9 +123,16 @@ impl Bvh {
 
     /// True as soon as `test(slot, t_max)` reports any hit in a node the ray enters before `t_max`.
     #[inline]
-    pub fn any(&self, ray: &RayBoxTest, t_max: f32, mut test: impl FnMut(u32, f32) -> bool) -> bool {
+    pub fn any(
+        &self,
+        ray: &RayBoxTest,
+        t_max: f32,
+        mut test: impl FnMut(u32, f32) -> bool,
+    ) -> bool {
         let nodes = &self.nodes[..];
-        let Some(root) = nodes.first() else { return false };
+        let Some(root) = nodes.first() else {
+            return false;
+        };
         if ray.entry(root, t_max) == f32::INFINITY {
             return false;
         }
@@ -116,7 +149,10 @@ impl Bvh {
             } else {
                 let i = node.index;
                 let (a, b) = (&nodes[i as usize], &nodes[i as usize + 1]);
-                let (ha, hb) = (ray.entry(a, t_max) != f32::INFINITY, ray.entry(b, t_max) != f32::INFINITY);
+                let (ha, hb) = (
+                    ray.entry(a, t_max) != f32::INFINITY,
+                    ray.entry(b, t_max) != f32::INFINITY,
+                );
                 match (ha, hb) {
                     (true, true) => {
                         stack[sp] = i + 1;
@@ -151,11 +187,19 @@ mod tests {
 
     fn node_of(b: Aabb) -> BvhNode {
         let (min, max) = crate::accel::build::padded(b);
-        BvhNode { min, index: 0, max, count: 1 }
+        BvhNode {
+            min,
+            index: 0,
+            max,
+            count: 1,
+        }
     }
 
     fn unit_box() -> BvhNode {
-        node_of(Aabb { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) })
+        node_of(Aabb {
+            min: Vec3::splat(-1.0),
+            max: Vec3::splat(1.0),
+        })
     }
 
     fn slab(o: Vec3, d: Vec3) -> Option<(f32, f32)> {
@@ -172,13 +216,22 @@ mod tests {
         assert!((t - 4.0).abs() <= 4.0 * f32::EPSILON, "{t}");
         assert!(slab(Vec3::new(-2.0, 0.0, 0.0), Vec3::Y).is_none());
         for d in [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z] {
-            assert!(slab(Vec3::splat(-1.0), d).is_some(), "corner (-1,-1,-1) along {d:?}");
-            assert!(slab(Vec3::splat(1.0), d).is_some(), "corner (1,1,1) along {d:?}");
+            assert!(
+                slab(Vec3::splat(-1.0), d).is_some(),
+                "corner (-1,-1,-1) along {d:?}"
+            );
+            assert!(
+                slab(Vec3::splat(1.0), d).is_some(),
+                "corner (1,1,1) along {d:?}"
+            );
         }
         // Negative zero and tiny components.
         assert!(slab(Vec3::new(0.0, 0.0, -5.0), Vec3::new(-0.0, 0.0, 1.0)).is_some());
         assert!(slab(Vec3::new(0.0, 0.0, -5.0), Vec3::new(1e-30, -1e-30, 1.0)).is_some());
-        assert!(slab(Vec3::new(1.0, 1.0, -5.0), Vec3::new(-0.0, 0.0, 1.0)).is_some(), "on two slab planes");
+        assert!(
+            slab(Vec3::new(1.0, 1.0, -5.0), Vec3::new(-0.0, 0.0, 1.0)).is_some(),
+            "on two slab planes"
+        );
     }
 
     fn brute_closest(boxes: &[Aabb], o: Vec3, d: Vec3) -> Option<u32> {
@@ -235,7 +288,13 @@ mod tests {
 
     #[test]
     fn coincident_primitives_build_a_shallow_tree() {
-        let boxes = vec![Aabb { min: Vec3::ZERO, max: Vec3::ONE }; 100_000];
+        let boxes = vec![
+            Aabb {
+                min: Vec3::ZERO,
+                max: Vec3::ONE
+            };
+            100_000
+        ];
         let t0 = std::time::Instant::now();
         let bvh = Bvh::build(&boxes);
         let s = bvh.stats();

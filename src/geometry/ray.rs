@@ -18,7 +18,11 @@ impl Ray {
     #[inline]
     #[must_use]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        Self { origin, dir, t_max: f32::INFINITY }
+        Self {
+            origin,
+            dir,
+            t_max: f32::INFINITY,
+        }
     }
 
     /// The point at parameter `t`.
@@ -32,6 +36,9 @@ impl Ray {
     #[inline]
     #[must_use]
     pub fn is_valid(&self) -> bool {
-        self.origin.is_finite() && self.dir.is_finite() && self.dir != Vec3::ZERO && !self.t_max.is_nan()
+        self.origin.is_finite()
+            && self.dir.is_finite()
+            && self.dir != Vec3::ZERO
+            && !self.t_max.is_nan()
     }
 }

@@ -9,7 +9,12 @@ use super::Ray;
 #[inline]
 #[must_use]
 pub fn intersect_sphere(center: Vec3, radius: f32, ray: &Ray) -> Option<f32> {
-    intersect_unit_quadric(ray.origin.as_dvec3() - center.as_dvec3(), ray.dir.as_dvec3(), f64::from(radius), ray.t_max)
+    intersect_unit_quadric(
+        ray.origin.as_dvec3() - center.as_dvec3(),
+        ray.dir.as_dvec3(),
+        f64::from(radius),
+        ray.t_max,
+    )
 }
 
 /// Nearest `t` in `(0, t_max)` for a ray from `o` (relative to the centre) along `d` against a
@@ -31,7 +36,11 @@ pub fn intersect_unit_quadric(o: DVec3, d: DVec3, r: f64, t_max: f32) -> Option<
         return None;
     }
     let root = disc.sqrt();
-    let q = if b < 0.0 { -0.5 * (b - root) } else { -0.5 * (b + root) };
+    let q = if b < 0.0 {
+        -0.5 * (b - root)
+    } else {
+        -0.5 * (b + root)
+    };
     if q == 0.0 {
         return None;
     }
@@ -50,7 +59,11 @@ pub fn intersect_unit_quadric(o: DVec3, d: DVec3, r: f64, t_max: f32) -> Option<
 pub fn reproject_to_sphere(center: DVec3, radius: f64, p: DVec3) -> DVec3 {
     let rel = p - center;
     let len = rel.length();
-    if len == 0.0 { center + DVec3::new(radius, 0.0, 0.0) } else { center + rel * (radius / len) }
+    if len == 0.0 {
+        center + DVec3::new(radius, 0.0, 0.0)
+    } else {
+        center + rel * (radius / len)
+    }
 }
 
 #[cfg(test)]
@@ -63,13 +76,18 @@ mod tests {
 
     #[test]
     fn hits_from_outside_and_inside() {
-        let t = intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.0, 0.0, -5.0), Vec3::Z)).unwrap();
+        let t =
+            intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.0, 0.0, -5.0), Vec3::Z)).unwrap();
         assert!((t - 4.0).abs() < 1e-6);
         let t = intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::ZERO, Vec3::Y)).unwrap();
         assert!((t - 1.0).abs() < 1e-6, "from the centre");
-        let t = intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.5, 0.0, 0.0), -Vec3::X)).unwrap();
+        let t =
+            intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.5, 0.0, 0.0), -Vec3::X)).unwrap();
         assert!((t - 1.5).abs() < 1e-6, "from inside, off centre");
-        assert!(intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.0, 0.0, 5.0), Vec3::Z)).is_none(), "behind");
+        assert!(
+            intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.0, 0.0, 5.0), Vec3::Z)).is_none(),
+            "behind"
+        );
     }
 
     #[test]
@@ -92,10 +110,20 @@ mod tests {
     fn ray_starting_on_the_surface_going_out_does_not_rehit() {
         let p = Vec3::new(0.6, 0.8, 0.0);
         let n = p;
-        let o = super::super::offset::offset_ray_origin(p, p.abs() * super::super::float::gamma(2), n, n);
+        let o = super::super::offset::offset_ray_origin(
+            p,
+            p.abs() * super::super::float::gamma(2),
+            n,
+            n,
+        );
         assert!(intersect_sphere(Vec3::ZERO, 1.0, &ray(o, n)).is_none());
         // Going in, it reaches the far side at distance 2.
-        let o = super::super::offset::offset_ray_origin(p, p.abs() * super::super::float::gamma(2), n, -n);
+        let o = super::super::offset::offset_ray_origin(
+            p,
+            p.abs() * super::super::float::gamma(2),
+            n,
+            -n,
+        );
         let t = intersect_sphere(Vec3::ZERO, 1.0, &ray(o, -n)).unwrap();
         assert!((t - 2.0).abs() < 1e-5);
     }
@@ -124,7 +152,12 @@ mod tests {
             let t = intersect_sphere(Vec3::ZERO, 2.0, &ray(-d * 10.0, d)).unwrap();
             assert!((t - 8.0).abs() < 1e-5);
         }
-        assert!(intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.0, 0.0, -5.0), Vec3::ZERO)).is_none());
-        assert!(intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.0, 0.0, -5.0), Vec3::NAN)).is_none());
+        assert!(
+            intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.0, 0.0, -5.0), Vec3::ZERO))
+                .is_none()
+        );
+        assert!(
+            intersect_sphere(Vec3::ZERO, 1.0, &ray(Vec3::new(0.0, 0.0, -5.0), Vec3::NAN)).is_none()
+        );
     }
 }

@@ -38,11 +38,25 @@ impl TriRay {
     pub fn new(ray: &Ray) -> Self {
         let d = ray.dir.to_array();
         let a = ray.dir.abs();
-        let kz = if a.x > a.y { if a.x > a.z { 0 } else { 2 } } else if a.y > a.z { 1 } else { 2 };
+        let kz = if a.x > a.y {
+            if a.x > a.z { 0 } else { 2 }
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
         let kx = (kz + 1) % 3;
         let ky = (kx + 1) % 3;
         let dz = d[kz];
-        Self { origin: ray.origin.to_array(), kx, ky, kz, sx: -d[kx] / dz, sy: -d[ky] / dz, sz: 1.0 / dz }
+        Self {
+            origin: ray.origin.to_array(),
+            kx,
+            ky,
+            kz,
+            sx: -d[kx] / dz,
+            sy: -d[ky] / dz,
+            sz: 1.0 / dz,
+        }
     }
 }
 
@@ -69,8 +83,14 @@ pub fn intersect_triangle(r: &TriRay, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) 
     let mut e2 = p0x * p1y - p0y * p1x;
     if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
         // Exactly on an edge in f32: decide in f64 so neighbours agree.
-        let (p0x, p0y, p1x, p1y, p2x, p2y) =
-            (f64::from(p0x), f64::from(p0y), f64::from(p1x), f64::from(p1y), f64::from(p2x), f64::from(p2y));
+        let (p0x, p0y, p1x, p1y, p2x, p2y) = (
+            f64::from(p0x),
+            f64::from(p0y),
+            f64::from(p1x),
+            f64::from(p1y),
+            f64::from(p2x),
+            f64::from(p2y),
+        );
         e0 = (p1x * p2y - p1y * p2x) as f32;
         e1 = (p2x * p0y - p2y * p0x) as f32;
         e2 = (p0x * p1y - p0y * p1x) as f32;
@@ -101,11 +121,17 @@ pub fn intersect_triangle(r: &TriRay, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) 
     let delta_y = gamma(5) * (max_yt + max_zt);
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-    let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    let delta_t =
+        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
     if t <= delta_t {
         return None;
     }
-    Some(TriHit { t, b0: e0 * inv_det, b1: e1 * inv_det, b2: e2 * inv_det })
+    Some(TriHit {
+        t,
+        b0: e0 * inv_det,
+        b1: e1 * inv_det,
+        b2: e2 * inv_det,
+    })
 }
 
 /// Absolute error bound of the interpolated hit point `b0·p0 + b1·p1 + b2·p2`.
@@ -138,7 +164,9 @@ mod tests {
     fn hit_distance_and_barycentrics_are_exact_for_simple_case() {
         let h = hit(Vec3::new(0.25, 0.25, -1.0), Vec3::Z, TRI).unwrap();
         assert_eq!(h.t, 1.0);
-        assert!((h.b1 - 0.25).abs() < 1e-7 && (h.b2 - 0.25).abs() < 1e-7 && (h.b0 - 0.5).abs() < 1e-7);
+        assert!(
+            (h.b1 - 0.25).abs() < 1e-7 && (h.b2 - 0.25).abs() < 1e-7 && (h.b0 - 0.5).abs() < 1e-7
+        );
         // Two-sided.
         assert!(hit(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, TRI).is_some());
         // Behind the origin.
@@ -154,7 +182,10 @@ mod tests {
                 let target = Vec3::new(u, v, 0.0);
                 let o = Vec3::new(0.0, 0.0, -1.0);
                 let h = hit(o, target - o, TRI).unwrap();
-                worst = worst.max((h.t - 1.0).abs()).max((h.b1 - u).abs()).max((h.b2 - v).abs());
+                worst = worst
+                    .max((h.t - 1.0).abs())
+                    .max((h.b1 - u).abs())
+                    .max((h.b2 - v).abs());
             }
         }
         assert!(worst <= 16.0 * f32::EPSILON, "worst error {worst}");

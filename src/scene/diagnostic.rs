@@ -49,13 +49,22 @@ impl Diagnostic {
     /// An error at `path`.
     #[must_use]
     pub fn error(path: impl Into<String>, message: impl Into<String>) -> Self {
-        Self { severity: Severity::Error, path: path.into(), message: message.into(), help: None, location: None }
+        Self {
+            severity: Severity::Error,
+            path: path.into(),
+            message: message.into(),
+            help: None,
+            location: None,
+        }
     }
 
     /// A warning at `path`.
     #[must_use]
     pub fn warning(path: impl Into<String>, message: impl Into<String>) -> Self {
-        Self { severity: Severity::Warning, ..Self::error(path, message) }
+        Self {
+            severity: Severity::Warning,
+            ..Self::error(path, message)
+        }
     }
 
     /// Adds a hint.
@@ -87,9 +96,23 @@ impl SourcePoint {
     /// The excerpt at `loc` in `text`, underlining the token that starts there.
     #[must_use]
     pub fn at(file: &Path, text: &str, loc: Location) -> Self {
-        let line_text = text.lines().nth(loc.line.saturating_sub(1)).unwrap_or("").trim_end_matches('\r').to_string();
-        let rest: String = line_text.chars().skip(loc.column.saturating_sub(1)).collect();
-        Self { file: file.to_path_buf(), line: loc.line, column: loc.column, width: token_width(&rest), line_text }
+        let line_text = text
+            .lines()
+            .nth(loc.line.saturating_sub(1))
+            .unwrap_or("")
+            .trim_end_matches('\r')
+            .to_string();
+        let rest: String = line_text
+            .chars()
+            .skip(loc.column.saturating_sub(1))
+            .collect();
+        Self {
+            file: file.to_path_buf(),
+            line: loc.line,
+            column: loc.column,
+            width: token_width(&rest),
+            line_text,
+        }
     }
 }
 
@@ -130,7 +153,13 @@ fn token_width(rest: &str) -> usize {
             }
             1
         }
-        Some(_) => rest.chars().take_while(|c| !matches!(c, ',' | ')' | ']' | '}' | '(' | '[' | '{') && !c.is_whitespace()).count().max(1),
+        Some(_) => rest
+            .chars()
+            .take_while(|c| {
+                !matches!(c, ',' | ')' | ']' | '}' | '(' | '[' | '{') && !c.is_whitespace()
+            })
+            .count()
+            .max(1),
     }
 }
 
@@ -151,8 +180,12 @@ impl fmt::Display for Diagnostic {
             writeln!(f, "{pad}--> {}:{}:{}", p.file.display(), p.line, p.column)?;
             writeln!(f, "{pad} |")?;
             writeln!(f, "{num} | {}", p.line_text)?;
-            let lead: String =
-                p.line_text.chars().take(p.column.saturating_sub(1)).map(|c| if c == '\t' { '\t' } else { ' ' }).collect();
+            let lead: String = p
+                .line_text
+                .chars()
+                .take(p.column.saturating_sub(1))
+                .map(|c| if c == '\t' { '\t' } else { ' ' })
+                .collect();
             writeln!(f, "{pad} | {lead}{}", "^".repeat(p.width))?;
         }
         if let Some(help) = &self.help {
@@ -164,7 +197,10 @@ impl fmt::Display for Diagnostic {
 
 /// The closest of `candidates` to `found` by edit distance, if it is close enough to be a likely typo.
 #[must_use]
-pub fn did_you_mean<'a>(found: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+pub fn did_you_mean<'a>(
+    found: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
     candidates
         .into_iter()
         .map(|c| (strsim::jaro_winkler(found, c), c))
@@ -176,7 +212,11 @@ pub fn did_you_mean<'a>(found: &str, candidates: impl IntoIterator<Item = &'a st
 /// Formats a list of names as `` `a`, `b`, `c` ``.
 #[must_use]
 pub fn quoted_list<'a>(names: impl IntoIterator<Item = &'a str>) -> String {
-    names.into_iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+    names
+        .into_iter()
+        .map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 #[cfg(test)]
@@ -185,7 +225,10 @@ mod tests {
 
     #[test]
     fn suggestions_pick_close_names_only() {
-        assert_eq!(did_you_mean("albdo", ["color", "albedo", "ior"]), Some("albedo"));
+        assert_eq!(
+            did_you_mean("albdo", ["color", "albedo", "ior"]),
+            Some("albedo")
+        );
         assert_eq!(did_you_mean("glas", ["glass", "mirror"]), Some("glass"));
         assert_eq!(did_you_mean("zzz", ["glass", "mirror"]), None);
     }

@@ -60,46 +60,76 @@ pub enum SceneError {
 fn render_all(diags: &[Diagnostic]) -> String {
     let errors = diags.iter().filter(|d| d.is_error()).count();
     let mut s: String = diags.iter().map(|d| format!("{d}\n")).collect();
-    s.push_str(&format!("{errors} error{} found", if errors == 1 { "" } else { "s" }));
+    s.push_str(&format!(
+        "{errors} error{} found",
+        if errors == 1 { "" } else { "s" }
+    ));
     s
 }
 
 impl SourceFile {
     /// Wraps already-read text; the format comes from the path's extension.
     pub fn new(path: &Path, text: String) -> Result<Self, SceneError> {
-        let format = match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        let format = match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
             Some("ron") => SourceFormat::Ron,
             Some("toml") => SourceFormat::Toml,
-            _ => return Err(SceneError::UnknownFormat { path: path.to_path_buf() }),
+            _ => {
+                return Err(SceneError::UnknownFormat {
+                    path: path.to_path_buf(),
+                });
+            }
         };
-        Ok(Self { path: path.to_path_buf(), text, format, index: OnceCell::new() })
+        Ok(Self {
+            path: path.to_path_buf(),
+            text,
+            format,
+            index: OnceCell::new(),
+        })
     }
 
     /// Reads a file from disk.
     pub fn read(path: &Path) -> Result<Self, SceneError> {
-        let bytes = std::fs::read(path).map_err(|source| SceneError::Read { path: path.to_path_buf(), source })?;
+        let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
         let text = String::from_utf8(bytes).map_err(|e| SceneError::Read {
             path: path.to_path_buf(),
-            source: std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 text ({e})")),
+            source: std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("not UTF-8 text ({e})"),
+            ),
         })?;
         Self::new(path, text)
     }
 
     /// The path-to-position index of this text (built on first use).
     pub fn index(&self) -> &SourceIndex {
-        self.index.get_or_init(|| SourceIndex::build(&self.text, self.format))
+        self.index
+            .get_or_init(|| SourceIndex::build(&self.text, self.format))
     }
 
     /// Attaches file positions to diagnostics that have a field path.
     #[must_use]
     pub fn locate(&self, diags: Vec<Diagnostic>) -> Vec<Diagnostic> {
-        diags.into_iter().map(|d| d.located(&self.path, &self.text, self.index())).collect()
+        diags
+            .into_iter()
+            .map(|d| d.located(&self.path, &self.text, self.index()))
+            .collect()
     }
 
     /// The directory asset paths are relative to.
     #[must_use]
     pub fn base_dir(&self) -> PathBuf {
-        self.path.parent().map(Path::to_path_buf).unwrap_or_default()
+        self.path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default()
     }
 
     /// Deserialises the text into the schema.
@@ -113,16 +143,27 @@ impl SourceFile {
 
     fn parse_ron(&self) -> Result<SceneFile, Box<Diagnostic>> {
         use ron::extensions::Extensions;
-        let options = ron::Options::default()
-            .with_default_extension(Extensions::IMPLICIT_SOME | Extensions::UNWRAP_VARIANT_NEWTYPES);
-        let mut de = ron::Deserializer::from_str_with_options(&self.text, &options)
-            .map_err(|e| Box::new(self.syntax_error(e.span.start.line, e.span.start.col, &e.code.to_string())))?;
+        let options = ron::Options::default().with_default_extension(
+            Extensions::IMPLICIT_SOME | Extensions::UNWRAP_VARIANT_NEWTYPES,
+        );
+        let mut de =
+            ron::Deserializer::from_str_with_options(&self.text, &options).map_err(|e| {
+                Box::new(self.syntax_error(
+                    e.span.start.line,
+                    e.span.start.col,
+                    &e.code.to_string(),
+                ))
+            })?;
         match serde_path_to_error::deserialize::<_, SceneFile>(&mut de) {
             Ok(scene) => match de.end() {
                 Ok(()) => Ok(scene),
                 Err(code) => {
                     let e = de.span_error(code);
-                    Err(Box::new(self.syntax_error(e.span.start.line, e.span.start.col, &e.code.to_string())))
+                    Err(Box::new(self.syntax_error(
+                        e.span.start.line,
+                        e.span.start.col,
+                        &e.code.to_string(),
+                    )))
                 }
             },
             Err(err) => {
@@ -130,21 +171,29 @@ impl SourceFile {
                 let code = err.into_inner();
                 let spanned = de.span_error(code.clone());
                 let diag = match &code {
-                    ron::Error::NoSuchStructField { expected, found, .. } => unknown_name("field", found, expected),
-                    ron::Error::NoSuchEnumVariant { expected, found, .. } => unknown_name("variant", found, expected),
+                    ron::Error::NoSuchStructField {
+                        expected, found, ..
+                    } => unknown_name("field", found, expected),
+                    ron::Error::NoSuchEnumVariant {
+                        expected, found, ..
+                    } => unknown_name("variant", found, expected),
                     ron::Error::MissingStructField { field, .. } => {
                         Diagnostic::error(&path, format!("missing required field `{field}`"))
                     }
                     other => Diagnostic::error(&path, other.to_string()),
                 };
                 let diag = Diagnostic { path, ..diag };
-                Err(Box::new(self.place(diag, Some((spanned.span.start.line, spanned.span.start.col)))))
+                Err(Box::new(self.place(
+                    diag,
+                    Some((spanned.span.start.line, spanned.span.start.col)),
+                )))
             }
         }
     }
 
     fn parse_toml(&self) -> Result<SceneFile, Box<Diagnostic>> {
-        let de = toml::Deserializer::parse(&self.text).map_err(|e| Box::new(self.toml_error(&e, String::new())))?;
+        let de = toml::Deserializer::parse(&self.text)
+            .map_err(|e| Box::new(self.toml_error(&e, String::new())))?;
         serde_path_to_error::deserialize::<_, SceneFile>(de).map_err(|err| {
             let path = user_path(&err.path().to_string());
             Box::new(self.toml_error(err.inner(), path))
@@ -155,12 +204,18 @@ impl SourceFile {
         let msg = e.message().trim().to_string();
         let diag = parse_unknown_name(&msg).unwrap_or_else(|| Diagnostic::error("", msg));
         let diag = Diagnostic { path, ..diag };
-        let at = e.span().map(|s| self.index().location_of_offset(s.start)).map(|l| (l.line, l.column));
+        let at = e
+            .span()
+            .map(|s| self.index().location_of_offset(s.start))
+            .map(|l| (l.line, l.column));
         self.place(diag, at)
     }
 
     fn syntax_error(&self, line: usize, col: usize, msg: &str) -> Diagnostic {
-        self.place(Diagnostic::error("", format!("syntax error: {msg}")), Some((line, col)))
+        self.place(
+            Diagnostic::error("", format!("syntax error: {msg}")),
+            Some((line, col)),
+        )
     }
 
     /// Positions a parse diagnostic: at the parser's position when it has one, else at the path.
@@ -168,8 +223,15 @@ impl SourceFile {
         match at {
             Some((line, column)) if line > 0 => {
                 let offset = 0;
-                let loc = super::locate::Location { line, column: column.max(1), offset };
-                Diagnostic { location: Some(SourcePoint::at(&self.path, &self.text, loc)), ..diag }
+                let loc = super::locate::Location {
+                    line,
+                    column: column.max(1),
+                    offset,
+                };
+                Diagnostic {
+                    location: Some(SourcePoint::at(&self.path, &self.text, loc)),
+                    ..diag
+                }
             }
             _ => diag.located(&self.path, &self.text, self.index()),
         }
@@ -191,8 +253,15 @@ fn parse_unknown_name(msg: &str) -> Option<Diagnostic> {
 }
 
 fn unknown_name(kind: &str, found: &str, expected: &[&str]) -> Diagnostic {
-    let list = if expected.is_empty() { "none".to_string() } else { quoted_list(expected.iter().copied()) };
-    let diag = Diagnostic::error("", format!("unknown {kind} `{found}`; valid {kind}s here: {list}"));
+    let list = if expected.is_empty() {
+        "none".to_string()
+    } else {
+        quoted_list(expected.iter().copied())
+    };
+    let diag = Diagnostic::error(
+        "",
+        format!("unknown {kind} `{found}`; valid {kind}s here: {list}"),
+    );
     match did_you_mean(found, expected.iter().copied()) {
         Some(s) => diag.with_help(format!("did you mean `{s}`?")),
         None => diag,
@@ -205,8 +274,20 @@ fn user_path(raw: &str) -> String {
     if raw == "." {
         return String::new();
     }
-    const VARIANTS: [&str; 12] =
-        ["Pinhole", "Point", "Sphere", "Group", "Cube", "Quad", "Mesh", "Translate", "RotateX", "RotateY", "RotateZ", "Scale"];
+    const VARIANTS: [&str; 12] = [
+        "Pinhole",
+        "Point",
+        "Sphere",
+        "Group",
+        "Cube",
+        "Quad",
+        "Mesh",
+        "Translate",
+        "RotateX",
+        "RotateY",
+        "RotateZ",
+        "Scale",
+    ];
     let mut out: Vec<&str> = Vec::new();
     for seg in raw.split('.') {
         let is_map_key = out.last().is_some_and(|prev| *prev == "materials");
@@ -239,7 +320,8 @@ mod tests {
 
     #[test]
     fn unknown_field_messages_are_parsed() {
-        let d = parse_unknown_name("unknown field `albdo`, expected one of `color`, `albedo`").unwrap();
+        let d =
+            parse_unknown_name("unknown field `albdo`, expected one of `color`, `albedo`").unwrap();
         assert!(d.message.contains("`albdo`"));
         assert_eq!(d.help.as_deref(), Some("did you mean `albedo`?"));
     }

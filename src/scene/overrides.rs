@@ -25,7 +25,10 @@ pub fn apply_overrides(scene: &SceneFile, sets: &[String]) -> Result<SceneFile, 
     }
     serde_path_to_error::deserialize::<_, SceneFile>(tree).map_err(|e| {
         let path = e.path().to_string();
-        invalid(&format!("--set {path}"), format!("{} (the override does not fit the schema)", e.inner()))
+        invalid(
+            &format!("--set {path}"),
+            format!("{} (the override does not fit the schema)", e.inner()),
+        )
     })
 }
 
@@ -42,13 +45,20 @@ fn apply_one(tree: &mut Value, set: &str) -> Result<(), Box<Diagnostic>> {
     };
     let (path, text) = (path.trim(), text.trim());
     let segments = split_path(path).ok_or_else(|| {
-        Box::new(Diagnostic::error(format!("--set {path}"), "malformed path; write e.g. `lights[0].power`"))
+        Box::new(Diagnostic::error(
+            format!("--set {path}"),
+            "malformed path; write e.g. `lights[0].power`",
+        ))
     })?;
     let mut node = tree;
     let mut walked = String::new();
     for seg in &segments {
         node = step(node, seg, &walked, path)?;
-        walked = if walked.is_empty() || seg.starts_with('[') { format!("{walked}{seg}") } else { format!("{walked}.{seg}") };
+        walked = if walked.is_empty() || seg.starts_with('[') {
+            format!("{walked}{seg}")
+        } else {
+            format!("{walked}.{seg}")
+        };
     }
     *node = parse_value(text);
     Ok(())
@@ -78,8 +88,17 @@ fn split_path(path: &str) -> Option<Vec<String>> {
     (!out.is_empty()).then_some(out)
 }
 
-fn step<'v>(node: &'v mut Value, seg: &str, walked: &str, full: &str) -> Result<&'v mut Value, Box<Diagnostic>> {
-    let here = if walked.is_empty() { "the scene".to_string() } else { format!("`{walked}`") };
+fn step<'v>(
+    node: &'v mut Value,
+    seg: &str,
+    walked: &str,
+    full: &str,
+) -> Result<&'v mut Value, Box<Diagnostic>> {
+    let here = if walked.is_empty() {
+        "the scene".to_string()
+    } else {
+        format!("`{walked}`")
+    };
     if let Some(index) = seg.strip_prefix('[').and_then(|s| s.strip_suffix(']')) {
         let index: usize = index.parse().unwrap_or(usize::MAX);
         let node = unwrap_variant(node, None);
@@ -88,26 +107,41 @@ fn step<'v>(node: &'v mut Value, seg: &str, walked: &str, full: &str) -> Result<
             (Some(items), Some(len)) if index < len => Ok(&mut items[index]),
             (Some(_), Some(len)) => Err(Box::new(Diagnostic::error(
                 format!("--set {full}"),
-                format!("index {index} is out of range: {here} has {len} element{}", if len == 1 { "" } else { "s" }),
+                format!(
+                    "index {index} is out of range: {here} has {len} element{}",
+                    if len == 1 { "" } else { "s" }
+                ),
             ))),
-            _ => Err(Box::new(Diagnostic::error(format!("--set {full}"), format!("{here} is not a list")))),
+            _ => Err(Box::new(Diagnostic::error(
+                format!("--set {full}"),
+                format!("{here} is not a list"),
+            ))),
         };
     }
     let node = unwrap_variant(node, Some(seg));
-    let keys: Vec<String> = node.as_object().map(|m| m.keys().cloned().collect()).unwrap_or_default();
+    let keys: Vec<String> = node
+        .as_object()
+        .map(|m| m.keys().cloned().collect())
+        .unwrap_or_default();
     match node.as_object_mut() {
         Some(map) if map.contains_key(seg) => Ok(&mut map[seg]),
         Some(_) => {
             let mut d = Diagnostic::error(
                 format!("--set {full}"),
-                format!("{here} has no field `{seg}`; its fields are {}", quoted_list(keys.iter().map(String::as_str))),
+                format!(
+                    "{here} has no field `{seg}`; its fields are {}",
+                    quoted_list(keys.iter().map(String::as_str))
+                ),
             );
             if let Some(s) = did_you_mean(seg, keys.iter().map(String::as_str)) {
                 d = d.with_help(format!("did you mean `{s}`?"));
             }
             Err(Box::new(d))
         }
-        None => Err(Box::new(Diagnostic::error(format!("--set {full}"), format!("{here} has no fields")))),
+        None => Err(Box::new(Diagnostic::error(
+            format!("--set {full}"),
+            format!("{here} has no fields"),
+        ))),
     }
 }
 
@@ -115,7 +149,8 @@ fn step<'v>(node: &'v mut Value, seg: &str, walked: &str, full: &str) -> Result<
 fn unwrap_variant<'v>(node: &'v mut Value, seg: Option<&str>) -> &'v mut Value {
     let variant = node.as_object().and_then(|m| {
         let k = m.keys().next()?;
-        (m.len() == 1 && k.starts_with(|c: char| c.is_ascii_uppercase()) && Some(k.as_str()) != seg).then(|| k.clone())
+        (m.len() == 1 && k.starts_with(|c: char| c.is_ascii_uppercase()) && Some(k.as_str()) != seg)
+            .then(|| k.clone())
     });
     match variant {
         Some(k) => &mut node[k.as_str()],

@@ -16,7 +16,7 @@ pub type Rgb = [f32; 3];
 
 /// A whole scene file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Scene")]
 pub struct SceneFile {
     /// Image size, sampling and recursion limits.
     #[serde(default)]
@@ -271,7 +271,10 @@ pub enum TransformStep {
 
 /// A uniform or per-axis scale factor.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(untagged, expecting = "a scale factor `s` or a per-axis triple `(x, y, z)`")]
+#[serde(
+    untagged,
+    expecting = "a scale factor `s` or a per-axis triple `(x, y, z)`"
+)]
 pub enum ScaleSpec {
     /// The same factor on every axis.
     Uniform(f32),

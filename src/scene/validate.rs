@@ -3,7 +3,10 @@
 use std::collections::BTreeSet;
 
 use super::diagnostic::{Diagnostic, did_you_mean, quoted_list};
-use super::schema::{CameraSpec, LightSpec, MaterialSpec, NodeSpec, RenderSettings, ScaleSpec, SceneFile, TransformStep};
+use super::schema::{
+    CameraSpec, LightSpec, MaterialSpec, NodeSpec, RenderSettings, ScaleSpec, SceneFile,
+    TransformStep,
+};
 
 /// Largest accepted image side, in pixels.
 pub const MAX_IMAGE_SIDE: u32 = 32_768;
@@ -19,7 +22,11 @@ pub const MAX_NESTING: usize = 64;
 /// Checks a scene and returns all errors and warnings (errors first keep the file order).
 #[must_use]
 pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
-    let mut v = Validator { out: Vec::new(), used: BTreeSet::new(), scene };
+    let mut v = Validator {
+        out: Vec::new(),
+        used: BTreeSet::new(),
+        scene,
+    };
     v.render(&scene.render);
     v.camera(&scene.camera);
     for (name, m) in &scene.materials {
@@ -27,22 +34,31 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
     }
     if scene.lights.is_empty() {
         v.out.push(
-            Diagnostic::warning("lights", "the scene has no lights, so only the background will be visible")
-                .with_help("add e.g. `Point(position: (0, 5, 0), power: (100, 100, 100))`"),
+            Diagnostic::warning(
+                "lights",
+                "the scene has no lights, so only the background will be visible",
+            )
+            .with_help("add e.g. `Point(position: (0, 5, 0), power: (100, 100, 100))`"),
         );
     }
     for (i, l) in scene.lights.iter().enumerate() {
         v.light(&format!("lights[{i}]"), l);
     }
     if scene.nodes.is_empty() {
-        v.out.push(Diagnostic::error("nodes", "the scene has no nodes, so there is nothing to render"));
+        v.out.push(Diagnostic::error(
+            "nodes",
+            "the scene has no nodes, so there is nothing to render",
+        ));
     }
     for (i, n) in scene.nodes.iter().enumerate() {
         v.node(&format!("nodes[{i}]"), n, 1);
     }
     for name in scene.materials.keys() {
         if !v.used.contains(name.as_str()) {
-            v.out.push(Diagnostic::warning(format!("materials.{name}"), format!("material `{name}` is never used")));
+            v.out.push(Diagnostic::warning(
+                format!("materials.{name}"),
+                format!("material `{name}` is never used"),
+            ));
         }
     }
     v.out
@@ -71,7 +87,10 @@ impl<'a> Validator<'a> {
         if v.iter().all(|x| x.is_finite()) {
             return true;
         }
-        self.err(path, format!("must have finite components, found {}", fmt3(v)));
+        self.err(
+            path,
+            format!("must have finite components, found {}", fmt3(v)),
+        );
         false
     }
 
@@ -90,8 +109,13 @@ impl<'a> Validator<'a> {
     fn unit_rgb(&mut self, path: &str, v: [f32; 3], what: &str) {
         if self.finite3(path, v) && v.iter().any(|c| !(0.0..=1.0).contains(c)) {
             self.out.push(
-                Diagnostic::error(path, format!("{what} components must be within [0, 1], found {}", fmt3(v)))
-                    .with_help("a reflectance above 1 would create energy; scale the light's power instead"),
+                Diagnostic::error(
+                    path,
+                    format!("{what} components must be within [0, 1], found {}", fmt3(v)),
+                )
+                .with_help(
+                    "a reflectance above 1 would create energy; scale the light's power instead",
+                ),
             );
         }
     }
@@ -102,7 +126,10 @@ impl<'a> Validator<'a> {
             if v == 0 {
                 self.err(&path, "must be at least 1 pixel, found 0".into());
             } else if v > MAX_IMAGE_SIDE {
-                self.err(&path, format!("must be at most {MAX_IMAGE_SIDE} pixels, found {v}"));
+                self.err(
+                    &path,
+                    format!("must be at most {MAX_IMAGE_SIDE} pixels, found {v}"),
+                );
             }
         }
         let pixels = u64::from(r.width) * u64::from(r.height);
@@ -120,36 +147,73 @@ impl<'a> Validator<'a> {
         if r.samples_per_pixel == 0 || r.samples_per_pixel > MAX_SAMPLES_PER_PIXEL {
             self.err(
                 "render.samples_per_pixel",
-                format!("must be within [1, {MAX_SAMPLES_PER_PIXEL}], found {}", r.samples_per_pixel),
+                format!(
+                    "must be within [1, {MAX_SAMPLES_PER_PIXEL}], found {}",
+                    r.samples_per_pixel
+                ),
             );
         }
         if r.max_depth > MAX_DEPTH {
-            self.err("render.max_depth", format!("must be at most {MAX_DEPTH}, found {}", r.max_depth));
+            self.err(
+                "render.max_depth",
+                format!("must be at most {MAX_DEPTH}, found {}", r.max_depth),
+            );
         }
         if r.light_samples == 0 || r.light_samples > 1024 {
-            self.err("render.light_samples", format!("must be within [1, 1024], found {}", r.light_samples));
+            self.err(
+                "render.light_samples",
+                format!("must be within [1, 1024], found {}", r.light_samples),
+            );
         }
         self.range("render.min_contribution", r.min_contribution, 0.0, 1.0);
-        if self.finite3("render.background", r.background) && r.background.iter().any(|c| *c < 0.0) {
-            self.err("render.background", format!("must not be negative, found {}", fmt3(r.background)));
+        if self.finite3("render.background", r.background) && r.background.iter().any(|c| *c < 0.0)
+        {
+            self.err(
+                "render.background",
+                format!("must not be negative, found {}", fmt3(r.background)),
+            );
         }
         self.positive("render.exposure", r.exposure, "exposure");
     }
 
     fn camera(&mut self, c: &CameraSpec) {
-        let CameraSpec::Pinhole { eye, look_at, up, fov_y } = c;
-        let ok = self.finite3("camera.eye", *eye) & self.finite3("camera.look_at", *look_at) & self.finite3("camera.up", *up);
+        let CameraSpec::Pinhole {
+            eye,
+            look_at,
+            up,
+            fov_y,
+        } = c;
+        let ok = self.finite3("camera.eye", *eye)
+            & self.finite3("camera.look_at", *look_at)
+            & self.finite3("camera.up", *up);
         if self.finite("camera.fov_y", *fov_y) && !(*fov_y > 0.0 && *fov_y < 180.0) {
-            self.err("camera.fov_y", format!("must be within (0, 180) degrees, found {fov_y}"));
+            self.err(
+                "camera.fov_y",
+                format!("must be within (0, 180) degrees, found {fov_y}"),
+            );
         }
         if !ok {
             return;
         }
         let forward = glam::Vec3::from(*look_at) - glam::Vec3::from(*eye);
         if !(forward.length_squared() > 0.0) {
-            self.err("camera.look_at", format!("must differ from `eye`, both are {}", fmt3(*eye)));
-        } else if !(forward.normalize().cross(glam::Vec3::from(*up)).length_squared() > 1e-12) {
-            self.err("camera.up", format!("must not be parallel to the view direction, found {}", fmt3(*up)));
+            self.err(
+                "camera.look_at",
+                format!("must differ from `eye`, both are {}", fmt3(*eye)),
+            );
+        } else if !(forward
+            .normalize()
+            .cross(glam::Vec3::from(*up))
+            .length_squared()
+            > 1e-12)
+        {
+            self.err(
+                "camera.up",
+                format!(
+                    "must not be parallel to the view direction, found {}",
+                    fmt3(*up)
+                ),
+            );
         }
     }
 
@@ -157,9 +221,16 @@ impl<'a> Validator<'a> {
         self.unit_rgb(&format!("{path}.color"), m.color, "color");
         self.unit_rgb(&format!("{path}.specular"), m.specular, "specular");
         if self.finite(&format!("{path}.shininess"), m.shininess) && m.shininess < 0.0 {
-            self.err(&format!("{path}.shininess"), format!("must not be negative, found {}", m.shininess));
+            self.err(
+                &format!("{path}.shininess"),
+                format!("must not be negative, found {}", m.shininess),
+            );
         }
-        let weights = [("diffuse", m.diffuse), ("reflect", m.reflect), ("transmit", m.transmit)];
+        let weights = [
+            ("diffuse", m.diffuse),
+            ("reflect", m.reflect),
+            ("transmit", m.transmit),
+        ];
         let mut all_ok = true;
         for (field, w) in weights {
             let Some(w) = w else { continue };
@@ -182,12 +253,21 @@ impl<'a> Validator<'a> {
         let p = format!("{path}.ior");
         if self.finite(&p, m.ior) && m.ior <= 0.0 {
             self.out.push(
-                Diagnostic::error(&p, format!("index of refraction must be greater than 0, found {}", m.ior))
-                    .with_help("typical values: 1.0 air, 1.33 water, 1.5 glass, 2.42 diamond"),
+                Diagnostic::error(
+                    &p,
+                    format!(
+                        "index of refraction must be greater than 0, found {}",
+                        m.ior
+                    ),
+                )
+                .with_help("typical values: 1.0 air, 1.33 water, 1.5 glass, 2.42 diamond"),
             );
         }
         let gains = (0..3).any(|i| m.color[i] + m.specular[i] > 1.0 + 1e-6);
-        if m.diffuse.unwrap_or(if any_given { 0.0 } else { 1.0 }) > 0.0 && gains && m.color.iter().all(|c| c.is_finite()) {
+        if m.diffuse.unwrap_or(if any_given { 0.0 } else { 1.0 }) > 0.0
+            && gains
+            && m.color.iter().all(|c| c.is_finite())
+        {
             self.out.push(Diagnostic::warning(
                 format!("{path}.specular"),
                 format!("color + specular exceeds 1 ({} + {}), so the surface reflects more light than it receives", fmt3(m.color), fmt3(m.specular)),
@@ -201,20 +281,30 @@ impl<'a> Validator<'a> {
                 self.finite3(&format!("{path}.position"), *position);
                 (power, format!("{path}.power"))
             }
-            LightSpec::Sphere { center, radius, power } => {
+            LightSpec::Sphere {
+                center,
+                radius,
+                power,
+            } => {
                 self.finite3(&format!("{path}.center"), *center);
                 self.positive(&format!("{path}.radius"), *radius, "radius");
                 (power, format!("{path}.power"))
             }
         };
         if self.finite3(&power_path, *power) && power.iter().any(|c| *c < 0.0) {
-            self.err(&power_path, format!("must not be negative, found {}", fmt3(*power)));
+            self.err(
+                &power_path,
+                format!("must not be negative, found {}", fmt3(*power)),
+            );
         }
     }
 
     fn node(&mut self, path: &str, n: &'a NodeSpec, depth: usize) {
         if depth > MAX_NESTING {
-            self.err(path, format!("groups are nested more than {MAX_NESTING} levels deep"));
+            self.err(
+                path,
+                format!("groups are nested more than {MAX_NESTING} levels deep"),
+            );
             return;
         }
         for (i, step) in n.transform().iter().enumerate() {
@@ -241,7 +331,10 @@ impl<'a> Validator<'a> {
             }
             NodeSpec::Mesh { file, .. } => {
                 if file.trim().is_empty() {
-                    self.err(&format!("{path}.file"), "must name an OBJ file, found an empty string".into());
+                    self.err(
+                        &format!("{path}.file"),
+                        "must name an OBJ file, found an empty string".into(),
+                    );
                 }
             }
         }
@@ -256,7 +349,10 @@ impl<'a> Validator<'a> {
         let list = quoted_list(names.clone());
         let mut d = Diagnostic::error(
             path,
-            format!("unknown material `{name}`; defined materials: {}", if list.is_empty() { "none" } else { &list }),
+            format!(
+                "unknown material `{name}`; defined materials: {}",
+                if list.is_empty() { "none" } else { &list }
+            ),
         );
         if let Some(s) = did_you_mean(name, names) {
             d = d.with_help(format!("did you mean `{s}`?"));
@@ -279,8 +375,14 @@ impl<'a> Validator<'a> {
                 };
                 if self.finite3(path, v) && v.iter().any(|c| *c == 0.0) {
                     self.out.push(
-                        Diagnostic::error(path, format!("scale {} is singular (a zero factor flattens the object)", fmt3(v)))
-                            .with_help("use a small positive factor, or remove the node"),
+                        Diagnostic::error(
+                            path,
+                            format!(
+                                "scale {} is singular (a zero factor flattens the object)",
+                                fmt3(v)
+                            ),
+                        )
+                        .with_help("use a small positive factor, or remove the node"),
                     );
                 }
             }

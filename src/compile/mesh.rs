@@ -1,0 +1,133 @@
+//! OBJ loading via tobj: triangulated, indices checked, each file read once per compilation.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+
+use glam::{Vec2, Vec3};
+
+/// One triangle corner: indices into positions, normals and texture coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Corner {
+    pub p: u32,
+    pub n: Option<u32>,
+    pub t: Option<u32>,
+}
+
+/// An OBJ file's geometry in object space.
+#[derive(Debug, Default)]
+pub(super) struct ObjMesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    pub triangles: Vec<[Corner; 3]>,
+}
+
+/// Loaded meshes by resolved path (errors are not cached; each node reports its own).
+#[derive(Default)]
+pub(super) struct MeshCache {
+    meshes: HashMap<PathBuf, Rc<ObjMesh>>,
+}
+
+impl MeshCache {
+    pub fn len(&self) -> usize {
+        self.meshes.len()
+    }
+
+    /// Loads `path` (or returns the cached copy); the error is a user-facing sentence.
+    pub fn load(&mut self, path: &Path) -> Result<Rc<ObjMesh>, String> {
+        if let Some(m) = self.meshes.get(path) {
+            return Ok(Rc::clone(m));
+        }
+        let mesh = Rc::new(read_obj(path)?);
+        self.meshes.insert(path.to_path_buf(), Rc::clone(&mesh));
+        Ok(mesh)
+    }
+}
+
+fn read_obj(path: &Path) -> Result<ObjMesh, String> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| format!("cannot read OBJ file `{}`: {e}", path.display()))?;
+    let options = tobj::LoadOptions {
+        single_index: false,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let mut reader = std::io::BufReader::new(&bytes[..]);
+    // Materials come from the scene file, so .mtl files are never opened.
+    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| format!("`{}` is not a valid OBJ file: {e}", path.display()))?;
+    let mut mesh = ObjMesh::default();
+    for model in &models {
+        let m = &model.mesh;
+        let (p0, n0, t0) = (
+            mesh.positions.len() as u32,
+            mesh.normals.len() as u32,
+            mesh.uvs.len() as u32,
+        );
+        mesh.positions.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2])),
+        );
+        mesh.normals.extend(
+            m.normals
+                .chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2])),
+        );
+        mesh.uvs
+            .extend(m.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])));
+        let has_n = m.normal_indices.len() == m.indices.len();
+        let has_t = m.texcoord_indices.len() == m.indices.len();
+        for (f, tri) in m.indices.chunks_exact(3).enumerate() {
+            let mut corners = [Corner {
+                p: 0,
+                n: None,
+                t: None,
+            }; 3];
+            for k in 0..3 {
+                let i = f * 3 + k;
+                corners[k] = Corner {
+                    p: p0 + tri[k],
+                    n: has_n.then(|| n0 + m.normal_indices[i]),
+                    t: has_t.then(|| t0 + m.texcoord_indices[i]),
+                };
+            }
+            mesh.triangles.push(corners);
+        }
+    }
+    check_indices(&mesh)
+        .map_err(|e| format!("`{}` is not a valid OBJ file: {e}", path.display()))?;
+    if mesh.triangles.is_empty() {
+        return Err(format!("`{}` contains no faces", path.display()));
+    }
+    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(format!(
+            "`{}`: vertex {} has a non-finite coordinate",
+            path.display(),
+            i + 1
+        ));
+    }
+    Ok(mesh)
+}
+
+fn check_indices(mesh: &ObjMesh) -> Result<(), String> {
+    let (np, nn, nt) = (mesh.positions.len(), mesh.normals.len(), mesh.uvs.len());
+    for (f, tri) in mesh.triangles.iter().enumerate() {
+        for c in tri {
+            let bad = c.p as usize >= np
+                || c.n.is_some_and(|n| n as usize >= nn)
+                || c.t.is_some_and(|t| t as usize >= nt);
+            if bad {
+                return Err(format!(
+                    "face {} refers to a vertex, normal or texture coordinate that does not exist",
+                    f + 1
+                ));
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,180 @@
+//! The only bridge between the file format and rendering: turns a validated [`SceneFile`] into a
+//! flat [`RenderScene`] (world-space primitives, resolved indices, BVH), keeping only what the
+//! scene uses.
+
+mod mesh;
+mod nodes;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+
+use crate::accel::BvhStats;
+use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
+use crate::render_scene::{Camera, Light, ObjectInfo, RenderParams, RenderScene};
+use crate::scene::Diagnostic;
+use crate::scene::schema::{CameraSpec, LightSpec, SceneFile};
+use crate::shading::Material;
+
+/// Counts and timings of a compilation, for `--stats`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CompileStats {
+    /// Triangles kept.
+    pub triangles: usize,
+    /// Zero-area triangles dropped.
+    pub degenerate_triangles: usize,
+    /// Spheres (similarity-transformed).
+    pub spheres: usize,
+    /// Ellipsoids (spheres under non-uniform scale).
+    pub ellipsoids: usize,
+    /// Materials kept (used by some node).
+    pub materials: usize,
+    /// Lights.
+    pub lights: usize,
+    /// Distinct OBJ files loaded.
+    pub meshes_loaded: usize,
+    /// Time to load meshes and flatten the node tree.
+    pub flatten_time: Duration,
+    /// Time to build the BVH and reorder primitives.
+    pub bvh_time: Duration,
+    /// BVH shape.
+    pub bvh: BvhStats,
+}
+
+/// Compiles a validated scene. Asset paths resolve against `base_dir`. Returns all asset errors.
+pub fn compile(
+    scene: &SceneFile,
+    base_dir: &Path,
+) -> Result<(RenderScene, CompileStats), Vec<Diagnostic>> {
+    let t0 = Instant::now();
+    let mut stats = CompileStats::default();
+    let mut materials = MaterialTable::default();
+    let mut objects = Vec::new();
+    let mut builder = GeometryBuilder::default();
+    let mut errors = Vec::new();
+    let mut flattener = nodes::Flattener {
+        scene,
+        base_dir,
+        materials: &mut materials,
+        objects: &mut objects,
+        builder: &mut builder,
+        meshes: mesh::MeshCache::default(),
+        errors: &mut errors,
+        degenerate: 0,
+    };
+    for (i, node) in scene.nodes.iter().enumerate() {
+        flattener.node(&format!("nodes[{i}]"), node, glam::DAffine3::IDENTITY);
+    }
+    stats.degenerate_triangles = flattener.degenerate;
+    stats.meshes_loaded = flattener.meshes.len();
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+
+    let mut lights = Vec::with_capacity(scene.lights.len());
+    for (i, l) in scene.lights.iter().enumerate() {
+        match *l {
+            LightSpec::Point { position, power } => {
+                lights.push(Light::point(position.into(), power.into()))
+            }
+            LightSpec::Sphere {
+                center,
+                radius,
+                power,
+            } => {
+                let light = lights.len() as u32;
+                lights.push(Light::sphere(center.into(), radius, power.into()));
+                let object = objects.len() as u32;
+                objects.push(ObjectInfo {
+                    name: format!("lights[{i}]"),
+                    material: None,
+                    light: Some(light),
+                });
+                builder.spheres.push(SpherePrim {
+                    center: center.into(),
+                    radius,
+                    object,
+                });
+            }
+        }
+    }
+    stats.flatten_time = t0.elapsed();
+    stats.triangles = builder.triangles.len();
+    stats.spheres = builder.spheres.len();
+    stats.ellipsoids = builder.ellipsoids.len();
+    stats.materials = materials.list.len();
+    stats.lights = lights.len();
+
+    let t1 = Instant::now();
+    let geometry = builder.build();
+    stats.bvh_time = t1.elapsed();
+    stats.bvh = geometry.bvh.stats();
+
+    let r = &scene.render;
+    let params = RenderParams {
+        width: r.width,
+        height: r.height,
+        samples_per_pixel: r.samples_per_pixel,
+        max_depth: r.max_depth,
+        min_contribution: r.min_contribution,
+        light_samples: r.light_samples,
+        seed: r.seed,
+        background: r.background.into(),
+        exposure: r.exposure,
+    };
+    let CameraSpec::Pinhole {
+        eye,
+        look_at,
+        up,
+        fov_y,
+    } = scene.camera;
+    let camera = Camera::pinhole(
+        eye.into(),
+        look_at.into(),
+        up.into(),
+        fov_y,
+        r.width as f32 / r.height as f32,
+    );
+    let (material_names, materials) = materials.list.into_iter().unzip();
+    Ok((
+        RenderScene {
+            params,
+            camera,
+            materials,
+            material_names,
+            lights,
+            objects,
+            geometry,
+        },
+        stats,
+    ))
+}
+
+/// Materials resolved on first use, so unused ones are not compiled.
+#[derive(Default)]
+struct MaterialTable {
+    index: BTreeMap<String, u32>,
+    list: Vec<(String, Material)>,
+}
+
+impl MaterialTable {
+    fn resolve(&mut self, scene: &SceneFile, name: &str) -> Option<u32> {
+        if let Some(&i) = self.index.get(name) {
+            return Some(i);
+        }
+        let m = scene.materials.get(name)?;
+        let i = self.list.len() as u32;
+        let material = Material::new(
+            Vec3::from(m.color),
+            Vec3::from(m.specular),
+            m.shininess,
+            [m.diffuse, m.reflect, m.transmit],
+            m.ior,
+        );
+        self.list.push((name.to_string(), material));
+        self.index.insert(name.to_string(), i);
+        Some(i)
+    }
+}

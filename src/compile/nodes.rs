@@ -1,0 +1,250 @@
+//! Flattening the node tree: transforms composed and baked into world-space primitives.
+
+use std::path::Path;
+
+use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
+
+use super::MaterialTable;
+use super::mesh::MeshCache;
+use crate::geometry::triangle::is_degenerate;
+use crate::render_scene::ObjectInfo;
+use crate::render_scene::geometry::{
+    EllipsoidPrim, GeometryBuilder, MAX_PRIMS_PER_KIND, SpherePrim, TriAttrs,
+};
+use crate::scene::Diagnostic;
+use crate::scene::schema::{NodeSpec, ScaleSpec, SceneFile, TransformStep};
+
+pub(super) struct Flattener<'a> {
+    pub scene: &'a SceneFile,
+    pub base_dir: &'a Path,
+    pub materials: &'a mut MaterialTable,
+    pub objects: &'a mut Vec<ObjectInfo>,
+    pub builder: &'a mut GeometryBuilder,
+    pub meshes: MeshCache,
+    pub errors: &'a mut Vec<Diagnostic>,
+    pub degenerate: usize,
+}
+
+/// The affine map of a transform list: the first step is applied first.
+pub(crate) fn transform_of(steps: &[TransformStep]) -> DAffine3 {
+    steps.iter().fold(DAffine3::IDENTITY, |acc, step| {
+        let m = match *step {
+            TransformStep::Translate(x, y, z) => {
+                DAffine3::from_translation(DVec3::new(x.into(), y.into(), z.into()))
+            }
+            TransformStep::RotateX(a) => DAffine3::from_rotation_x(f64::from(a).to_radians()),
+            TransformStep::RotateY(a) => DAffine3::from_rotation_y(f64::from(a).to_radians()),
+            TransformStep::RotateZ(a) => DAffine3::from_rotation_z(f64::from(a).to_radians()),
+            TransformStep::Scale(ScaleSpec::Uniform(s)) => {
+                DAffine3::from_scale(DVec3::splat(s.into()))
+            }
+            TransformStep::Scale(ScaleSpec::PerAxis([x, y, z])) => {
+                DAffine3::from_scale(DVec3::new(x.into(), y.into(), z.into()))
+            }
+        };
+        m * acc
+    })
+}
+
+impl Flattener<'_> {
+    pub fn node(&mut self, path: &str, node: &NodeSpec, parent: DAffine3) {
+        let xf = parent * transform_of(node.transform());
+        let material = node
+            .material()
+            .and_then(|m| self.materials.resolve(self.scene, m));
+        let object = self.objects.len() as u32;
+        if !matches!(node, NodeSpec::Group { .. }) {
+            let name = node.name().map_or_else(|| path.to_string(), str::to_string);
+            self.objects.push(ObjectInfo {
+                name,
+                material,
+                light: None,
+            });
+        }
+        match node {
+            NodeSpec::Group { children, .. } => {
+                for (i, c) in children.iter().enumerate() {
+                    self.node(&format!("{path}.children[{i}]"), c, xf);
+                }
+            }
+            NodeSpec::Sphere { center, radius, .. } => {
+                let m = xf
+                    * DAffine3::from_translation(Vec3::from(*center).as_dvec3())
+                    * DAffine3::from_scale(DVec3::splat(f64::from(*radius)));
+                self.sphere(m, object);
+            }
+            NodeSpec::Cube { size, .. } => {
+                let m = xf * DAffine3::from_scale(DVec3::splat(f64::from(*size)));
+                for face in CUBE_FACES {
+                    self.quad(&m, face, object);
+                }
+            }
+            NodeSpec::Quad { size, .. } => {
+                let m = xf
+                    * DAffine3::from_scale(DVec3::new(f64::from(size[0]), f64::from(size[1]), 1.0));
+                self.quad(&m, QUAD_FACE, object);
+            }
+            NodeSpec::Mesh { file, smooth, .. } => {
+                let full = self.base_dir.join(file);
+                match self.meshes.load(&full) {
+                    Ok(mesh) => self.mesh(&xf, &mesh, *smooth, object),
+                    Err(msg) => self
+                        .errors
+                        .push(Diagnostic::error(format!("{path}.file"), msg)),
+                }
+            }
+        }
+        if self.builder.triangles.len() > MAX_PRIMS_PER_KIND {
+            self.errors.push(Diagnostic::error(
+                path,
+                format!("the scene exceeds {MAX_PRIMS_PER_KIND} triangles"),
+            ));
+        }
+    }
+
+    /// A unit sphere under `m`: kept analytic as a sphere if `m` is a similarity, else an ellipsoid.
+    fn sphere(&mut self, m: DAffine3, object: u32) {
+        let l = m.matrix3;
+        let (a, b, c) = (l.x_axis, l.y_axis, l.z_axis);
+        let r = a.length();
+        let tol = 1e-9 * r * r;
+        let similar = (b.length() - r).abs() <= 1e-9 * r
+            && (c.length() - r).abs() <= 1e-9 * r
+            && a.dot(b).abs() <= tol
+            && b.dot(c).abs() <= tol
+            && a.dot(c).abs() <= tol;
+        if similar {
+            self.builder.spheres.push(SpherePrim {
+                center: m.translation.as_vec3(),
+                radius: r as f32,
+                object,
+            });
+        } else {
+            self.builder.ellipsoids.push(EllipsoidPrim {
+                object_from_world: m.inverse(),
+                world_from_object: m,
+                normal_to_world: normal_matrix(l),
+                object,
+            });
+        }
+    }
+
+    /// Two triangles for a unit square face given by its corners, counter-clockwise seen from outside.
+    fn quad(&mut self, m: &DAffine3, corners: [[f64; 3]; 4], object: u32) {
+        let flip = m.matrix3.determinant() < 0.0;
+        let p = corners.map(|c| m.transform_point3(DVec3::from(c)).as_vec3());
+        let uv = [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(0.0, 1.0),
+        ];
+        for [i, j, k] in [[0, 1, 2], [0, 2, 3]] {
+            let (j, k) = if flip { (k, j) } else { (j, k) };
+            self.triangle(
+                [p[i], p[j], p[k]],
+                TriAttrs {
+                    object,
+                    normals: None,
+                    uvs: [uv[i], uv[j], uv[k]],
+                },
+            );
+        }
+    }
+
+    fn mesh(&mut self, m: &DAffine3, mesh: &super::mesh::ObjMesh, smooth: bool, object: u32) {
+        let flip = m.matrix3.determinant() < 0.0;
+        let nm = normal_matrix(m.matrix3);
+        let pos: Vec<Vec3> = mesh
+            .positions
+            .iter()
+            .map(|p| m.transform_point3(p.as_dvec3()).as_vec3())
+            .collect();
+        let nor: Vec<Vec3> = mesh
+            .normals
+            .iter()
+            .map(|n| (nm * n.as_dvec3()).as_vec3().normalize_or_zero())
+            .collect();
+        for tri in &mesh.triangles {
+            let order = if flip { [0, 2, 1] } else { [0, 1, 2] };
+            let c = order.map(|k| tri[k]);
+            let normals = if smooth && c.iter().all(|c| c.n.is_some()) {
+                let n = c.map(|c| c.n.map_or(Vec3::ZERO, |i| nor[i as usize]));
+                n.iter().all(|n| *n != Vec3::ZERO).then_some(n)
+            } else {
+                None
+            };
+            let uvs = c.map(|c| c.t.map_or(Vec2::ZERO, |i| mesh.uvs[i as usize]));
+            self.triangle(
+                c.map(|c| pos[c.p as usize]),
+                TriAttrs {
+                    object,
+                    normals,
+                    uvs,
+                },
+            );
+        }
+    }
+
+    fn triangle(&mut self, p: [Vec3; 3], attrs: TriAttrs) {
+        if is_degenerate(p[0], p[1], p[2]) {
+            self.degenerate += 1;
+            return;
+        }
+        self.builder.triangles.push(p);
+        self.builder.tri_attrs.push(attrs);
+    }
+}
+
+/// Inverse transpose of a linear map, for transforming normals.
+fn normal_matrix(l: DMat3) -> DMat3 {
+    l.inverse().transpose()
+}
+
+/// The quad node's face: the unit square in the xy plane, facing +z.
+const QUAD_FACE: [[f64; 3]; 4] = [
+    [-0.5, -0.5, 0.0],
+    [0.5, -0.5, 0.0],
+    [0.5, 0.5, 0.0],
+    [-0.5, 0.5, 0.0],
+];
+
+/// The six faces of the unit cube centred on the origin, each counter-clockwise from outside.
+const CUBE_FACES: [[[f64; 3]; 4]; 6] = [
+    [
+        [-0.5, -0.5, 0.5],
+        [0.5, -0.5, 0.5],
+        [0.5, 0.5, 0.5],
+        [-0.5, 0.5, 0.5],
+    ], // +z
+    [
+        [0.5, -0.5, -0.5],
+        [-0.5, -0.5, -0.5],
+        [-0.5, 0.5, -0.5],
+        [0.5, 0.5, -0.5],
+    ], // -z
+    [
+        [0.5, -0.5, 0.5],
+        [0.5, -0.5, -0.5],
+        [0.5, 0.5, -0.5],
+        [0.5, 0.5, 0.5],
+    ], // +x
+    [
+        [-0.5, -0.5, -0.5],
+        [-0.5, -0.5, 0.5],
+        [-0.5, 0.5, 0.5],
+        [-0.5, 0.5, -0.5],
+    ], // -x
+    [
+        [-0.5, 0.5, 0.5],
+        [0.5, 0.5, 0.5],
+        [0.5, 0.5, -0.5],
+        [-0.5, 0.5, -0.5],
+    ], // +y
+    [
+        [-0.5, -0.5, -0.5],
+        [0.5, -0.5, -0.5],
+        [0.5, -0.5, 0.5],
+        [-0.5, -0.5, 0.5],
+    ], // -y
+];

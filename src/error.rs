@@ -1,0 +1,34 @@
+//! The crate's top-level error and the process exit codes it maps to.
+
+use crate::render::RenderError;
+use crate::render::output::OutputError;
+use crate::scene::SceneError;
+
+/// Anything that can stop a command.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The scene file (or an override) is unreadable or invalid.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The render could not run with the given options.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The image could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// A command-line value is malformed.
+    #[error("{0}")]
+    Usage(String),
+}
+
+impl Error {
+    /// Exit code: 2 for bad input (scene, assets, flags), 1 for failures while rendering or writing.
+    #[must_use]
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::Scene(_) | Error::Usage(_) | Error::Render(_) => 2,
+            Error::Output(OutputError::UnknownFormat { .. }) => 2,
+            Error::Output(_) => 1,
+        }
+    }
+}

@@ -1,0 +1,129 @@
+//! The whole front half of a run: read → override → validate → compile, with every diagnostic
+//! located in the file (or attributed to the command line).
+
+use std::path::Path;
+
+use crate::compile::{CompileStats, compile};
+use crate::error::Error;
+use crate::render_scene::RenderScene;
+use crate::scene::load::SourceFile;
+use crate::scene::overrides::apply_overrides;
+use crate::scene::validate::validate;
+use crate::scene::{Diagnostic, SceneError, SceneFile};
+
+/// Command-line changes to a scene: `--set` assignments and the dedicated render flags.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SceneOverrides {
+    /// `path=value` assignments, applied first.
+    pub sets: Vec<String>,
+    /// `render.width`.
+    pub width: Option<u32>,
+    /// `render.height`.
+    pub height: Option<u32>,
+    /// `render.samples_per_pixel`.
+    pub samples_per_pixel: Option<u32>,
+    /// `render.max_depth`.
+    pub max_depth: Option<u32>,
+    /// `render.seed`.
+    pub seed: Option<u64>,
+}
+
+impl SceneOverrides {
+    /// Applies the overrides to a parsed scene.
+    pub fn apply(&self, scene: &SceneFile) -> Result<SceneFile, SceneError> {
+        let mut s = apply_overrides(scene, &self.sets)?;
+        let r = &mut s.render;
+        r.width = self.width.unwrap_or(r.width);
+        r.height = self.height.unwrap_or(r.height);
+        r.samples_per_pixel = self.samples_per_pixel.unwrap_or(r.samples_per_pixel);
+        r.max_depth = self.max_depth.unwrap_or(r.max_depth);
+        r.seed = self.seed.unwrap_or(r.seed);
+        Ok(s)
+    }
+
+    /// Field paths these overrides change (diagnostics on them point at the command line).
+    #[must_use]
+    pub fn paths(&self) -> Vec<String> {
+        let mut p: Vec<String> = self
+            .sets
+            .iter()
+            .filter_map(|s| s.split_once('='))
+            .map(|(k, _)| k.trim().to_string())
+            .collect();
+        for (flag, set) in [
+            ("render.width", self.width.is_some()),
+            ("render.height", self.height.is_some()),
+            ("render.samples_per_pixel", self.samples_per_pixel.is_some()),
+            ("render.max_depth", self.max_depth.is_some()),
+            ("render.seed", self.seed.is_some()),
+        ] {
+            if set {
+                p.push(flag.to_string());
+            }
+        }
+        p
+    }
+}
+
+/// A scene ready to render.
+#[derive(Debug)]
+pub struct Prepared {
+    /// The source file (for later diagnostics).
+    pub source: SourceFile,
+    /// The scene after overrides.
+    pub scene: SceneFile,
+    /// The compiled scene.
+    pub render_scene: RenderScene,
+    /// Compilation figures.
+    pub stats: CompileStats,
+    /// Warnings found on the way.
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// Reads, overrides and validates; returns the scene and its warnings, or all errors.
+pub fn check(
+    path: &Path,
+    overrides: &SceneOverrides,
+) -> Result<(SourceFile, SceneFile, Vec<Diagnostic>), Error> {
+    let source = SourceFile::read(path)?;
+    let parsed = source.parse()?;
+    let scene = overrides.apply(&parsed)?;
+    let diags = locate(&source, validate(&scene), overrides);
+    if diags.iter().any(Diagnostic::is_error) {
+        return Err(SceneError::Invalid(diags).into());
+    }
+    Ok((source, scene, diags))
+}
+
+/// Reads, overrides, validates and compiles a scene file.
+pub fn prepare(path: &Path, overrides: &SceneOverrides) -> Result<Prepared, Error> {
+    let (source, scene, warnings) = check(path, overrides)?;
+    let (render_scene, stats) = compile(&scene, &source.base_dir())
+        .map_err(|errs| SceneError::Invalid(locate(&source, errs, overrides)))?;
+    Ok(Prepared {
+        source,
+        scene,
+        render_scene,
+        stats,
+        warnings,
+    })
+}
+
+fn locate(
+    source: &SourceFile,
+    diags: Vec<Diagnostic>,
+    overrides: &SceneOverrides,
+) -> Vec<Diagnostic> {
+    let overridden = overrides.paths();
+    let (from_cli, from_file): (Vec<_>, Vec<_>) = diags.into_iter().partition(|d| {
+        overridden
+            .iter()
+            .any(|p| d.path == *p || d.path.starts_with(&format!("{p}.")))
+    });
+    let mut out = source.locate(from_file);
+    out.extend(from_cli.into_iter().map(|mut d| {
+        d.message.push_str(" (value set on the command line)");
+        d
+    }));
+    out
+}

@@ -1,0 +1,12 @@
+//! Rendering: integrators, the tile scheduler, the film and image output.
+
+pub mod film;
+pub mod output;
+pub mod tiles;
+pub mod trace_log;
+pub mod whitted;
+
+pub use film::Film;
+pub use tiles::{
+    Region, RenderError, RenderOptions, RenderOutput, RenderStats, render, trace_pixel,
+};

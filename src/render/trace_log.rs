@@ -1,0 +1,171 @@
+//! The ray tree of one pixel sample, recorded by `caustic debug-pixel` (the report's `debug_render`).
+
+use glam::Vec3;
+
+/// Why a ray was cast.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RayKind {
+    /// From the camera.
+    Camera,
+    /// Mirror direction (mirror part or Fresnel reflection).
+    Reflect,
+    /// Refracted through a dielectric.
+    Refract,
+}
+
+/// What a traced ray hit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceHit {
+    /// Distance.
+    pub t: f32,
+    /// Hit point.
+    pub point: Vec3,
+    /// Shading normal, facing the ray.
+    pub normal: Vec3,
+    /// Object name.
+    pub object: String,
+    /// Material name, or `light` for an emitter.
+    pub material: String,
+    /// True when the ray arrived from outside the object.
+    pub entering: bool,
+}
+
+/// One shadow ray towards a light.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShadowRecord {
+    /// Light index.
+    pub light: usize,
+    /// Direction towards the light.
+    pub dir: Vec3,
+    /// Whether something blocked it.
+    pub occluded: bool,
+    /// Radiance it added (zero when occluded).
+    pub contribution: Vec3,
+}
+
+/// One ray of the tree.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceNode {
+    /// Recursion depth (camera ray = 0).
+    pub depth: u32,
+    /// Why it was cast.
+    pub kind: RayKind,
+    /// Origin.
+    pub origin: Vec3,
+    /// Direction.
+    pub dir: Vec3,
+    /// Product of lobe weights from the camera to this ray.
+    pub weight: Vec3,
+    /// The hit, or `None` for the background.
+    pub hit: Option<TraceHit>,
+    /// Shadow rays cast at the hit.
+    pub shadows: Vec<ShadowRecord>,
+    /// Radiance this ray returned.
+    pub radiance: Vec3,
+    /// Rays spawned at the hit.
+    pub children: Vec<usize>,
+    /// Why recursion stopped here, if it did.
+    pub note: Option<String>,
+}
+
+/// The whole tree; node 0 is the camera ray.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TraceLog {
+    /// Nodes in creation order.
+    pub nodes: Vec<TraceNode>,
+}
+
+fn v3(v: Vec3) -> String {
+    format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)
+}
+
+impl TraceLog {
+    /// Indented text, one ray per block.
+    #[must_use]
+    pub fn to_text(&self) -> String {
+        let mut out = String::new();
+        if !self.nodes.is_empty() {
+            self.write_node(0, &mut out);
+        }
+        out
+    }
+
+    fn write_node(&self, i: usize, out: &mut String) {
+        let n = &self.nodes[i];
+        let pad = "  ".repeat(n.depth as usize);
+        out.push_str(&format!(
+            "{pad}{:?} ray depth {} from {} dir {} weight {}\n",
+            n.kind,
+            n.depth,
+            v3(n.origin),
+            v3(n.dir),
+            v3(n.weight)
+        ));
+        match &n.hit {
+            Some(h) => out.push_str(&format!(
+                "{pad}  hit `{}` (material `{}`) at t={:.5} p={} n={} {}\n",
+                h.object,
+                h.material,
+                h.t,
+                v3(h.point),
+                v3(h.normal),
+                if h.entering {
+                    "from outside"
+                } else {
+                    "from inside"
+                }
+            )),
+            None => out.push_str(&format!("{pad}  miss: background\n")),
+        }
+        for s in &n.shadows {
+            out.push_str(&format!(
+                "{pad}  shadow ray to light {} dir {}: {}\n",
+                s.light,
+                v3(s.dir),
+                if s.occluded {
+                    "blocked".to_string()
+                } else {
+                    format!("lit, adds {}", v3(s.contribution))
+                }
+            ));
+        }
+        if let Some(note) = &n.note {
+            out.push_str(&format!("{pad}  {note}\n"));
+        }
+        for &c in &n.children {
+            self.write_node(c, out);
+        }
+        out.push_str(&format!("{pad}  => radiance {}\n", v3(n.radiance)));
+    }
+
+    /// The tree as JSON.
+    #[must_use]
+    pub fn to_json(&self) -> serde_json::Value {
+        use serde_json::json;
+        let arr = |v: Vec3| json!([v.x, v.y, v.z]);
+        let nodes: Vec<_> = self
+            .nodes
+            .iter()
+            .map(|n| {
+                json!({
+                    "depth": n.depth,
+                    "kind": format!("{:?}", n.kind),
+                    "origin": arr(n.origin),
+                    "dir": arr(n.dir),
+                    "weight": arr(n.weight),
+                    "hit": n.hit.as_ref().map(|h| json!({
+                        "t": h.t, "point": arr(h.point), "normal": arr(h.normal),
+                        "object": h.object, "material": h.material, "entering": h.entering,
+                    })),
+                    "shadows": n.shadows.iter().map(|s| json!({
+                        "light": s.light, "dir": arr(s.dir), "occluded": s.occluded, "contribution": arr(s.contribution),
+                    })).collect::<Vec<_>>(),
+                    "radiance": arr(n.radiance),
+                    "children": n.children,
+                    "note": n.note,
+                })
+            })
+            .collect();
+        json!({ "nodes": nodes })
+    }
+}

@@ -1,0 +1,255 @@
+//! The recursive ray tracer of the report: direct light with shadow rays (Phong highlight
+//! included), mirror reflection and Fresnel-weighted refraction, limited by depth and weight.
+
+use glam::Vec3;
+
+use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog, TraceNode};
+use crate::geometry::Ray;
+use crate::geometry::offset::offset_ray_origin;
+use crate::render_scene::{Light, RenderScene, SurfacePoint};
+use crate::sampling::Rng;
+use crate::shading::Material;
+
+/// Fraction of a shadow ray's length left unchecked at the light end.
+const SHADOW_EPSILON: f32 = 1e-4;
+
+/// Per-worker counters, summed after rendering.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Rays traced (camera, specular and shadow).
+    pub rays: u64,
+}
+
+/// The Whitted-style integrator over a compiled scene.
+pub struct Whitted<'a> {
+    scene: &'a RenderScene,
+}
+
+/// A ray to trace and how it contributes.
+struct Path {
+    ray: Ray,
+    depth: u32,
+    weight: Vec3,
+    kind: RayKind,
+}
+
+impl<'a> Whitted<'a> {
+    /// An integrator for `scene`.
+    #[must_use]
+    pub fn new(scene: &'a RenderScene) -> Self {
+        Self { scene }
+    }
+
+    /// Radiance arriving along a camera ray.
+    pub fn li(
+        &self,
+        ray: Ray,
+        rng: &mut Rng,
+        counters: &mut Counters,
+        log: Option<&mut TraceLog>,
+    ) -> Vec3 {
+        let path = Path {
+            ray,
+            depth: 0,
+            weight: Vec3::ONE,
+            kind: RayKind::Camera,
+        };
+        self.trace(path, rng, counters, log, None)
+    }
+
+    fn trace(
+        &self,
+        path: Path,
+        rng: &mut Rng,
+        counters: &mut Counters,
+        mut log: Option<&mut TraceLog>,
+        parent: Option<usize>,
+    ) -> Vec3 {
+        let me = log.as_deref_mut().map(|l| push_node(l, &path, parent));
+        let (l, hit_info) = self.shade(&path, rng, counters, log.as_deref_mut(), me);
+        if let (Some(log), Some(me)) = (log, me) {
+            log.nodes[me].radiance = l;
+            log.nodes[me].hit = hit_info;
+        }
+        l
+    }
+
+    fn shade(
+        &self,
+        path: &Path,
+        rng: &mut Rng,
+        counters: &mut Counters,
+        mut log: Option<&mut TraceLog>,
+        me: Option<usize>,
+    ) -> (Vec3, Option<TraceHit>) {
+        let scene = self.scene;
+        counters.rays += 1;
+        let ray = &path.ray;
+        let Some(hit) = scene.geometry.intersect(ray) else {
+            return (scene.params.background, None);
+        };
+        let sp = scene.geometry.surface(ray, &hit);
+        let object = &scene.objects[sp.object as usize];
+        let wo = -ray.dir.normalize();
+        let entering = wo.dot(sp.ng) > 0.0;
+        let (ng, ns) = if entering {
+            (sp.ng, sp.ns)
+        } else {
+            (-sp.ng, -sp.ns)
+        };
+        let info = log.is_some().then(|| TraceHit {
+            t: hit.t,
+            point: sp.p,
+            normal: ns,
+            object: object.name.clone(),
+            material: object
+                .material
+                .map_or("light".into(), |m| scene.material_names[m as usize].clone()),
+            entering,
+        });
+        let Some(material) = object.material.map(|m| &scene.materials[m as usize]) else {
+            // An emitter: its radiance is seen from outside only.
+            let l = match object.light.map(|i| scene.lights[i as usize]) {
+                Some(Light::Sphere { radiance, .. }) if entering => radiance,
+                _ => Vec3::ZERO,
+            };
+            return (l, info);
+        };
+        let mut l = Vec3::ZERO;
+        if material.has_local() {
+            l += self.direct(
+                &sp,
+                material,
+                wo,
+                ng,
+                ns,
+                rng,
+                counters,
+                log.as_deref_mut(),
+                me,
+            );
+        }
+        if !material.has_delta() {
+            return (l, info);
+        }
+        if path.depth >= scene.params.max_depth {
+            note(log, me, "max depth reached: specular rays not traced");
+            return (l, info);
+        }
+        let lobes = material.delta_lobes(wo, ns, ng, entering);
+        let min = scene.params.min_contribution;
+        let mut spawn = |dir: Vec3, w: Vec3, kind: RayKind, log: Option<&mut TraceLog>| -> Vec3 {
+            let weight = path.weight * w;
+            if weight.max_element() < min || weight.max_element() <= 0.0 {
+                return Vec3::ZERO;
+            }
+            let origin = offset_ray_origin(sp.p, sp.p_error, ng, dir);
+            let child = Path {
+                ray: Ray::new(origin, dir),
+                depth: path.depth + 1,
+                weight,
+                kind,
+            };
+            w * self.trace(child, rng, counters, log, me)
+        };
+        l += spawn(
+            lobes.reflect_dir,
+            lobes.reflect_weight,
+            RayKind::Reflect,
+            log.as_deref_mut(),
+        );
+        if let Some((dir, w)) = lobes.refract {
+            l += spawn(dir, w, RayKind::Refract, log.as_deref_mut());
+        }
+        (l, info)
+    }
+
+    /// Light arriving directly from every light source, through the non-delta part of the BSDF.
+    #[allow(clippy::too_many_arguments)]
+    fn direct(
+        &self,
+        sp: &SurfacePoint,
+        material: &Material,
+        wo: Vec3,
+        ng: Vec3,
+        ns: Vec3,
+        rng: &mut Rng,
+        counters: &mut Counters,
+        mut log: Option<&mut TraceLog>,
+        me: Option<usize>,
+    ) -> Vec3 {
+        let mut total = Vec3::ZERO;
+        for (index, light) in self.scene.lights.iter().enumerate() {
+            let n = match light {
+                Light::Point { .. } => 1,
+                Light::Sphere { .. } => self.scene.params.light_samples,
+            };
+            let mut sum = Vec3::ZERO;
+            for _ in 0..n {
+                let u = rng.next_2d();
+                let Some(ls) = light.sample(sp.p, u) else {
+                    continue;
+                };
+                let cos_s = ns.dot(ls.wi);
+                if cos_s <= 0.0 || ng.dot(ls.wi) <= 0.0 {
+                    continue;
+                }
+                let f = material.eval(wo, ls.wi, ns);
+                if f == Vec3::ZERO {
+                    continue;
+                }
+                let origin = offset_ray_origin(sp.p, sp.p_error, ng, ls.wi);
+                let shadow = Ray {
+                    origin,
+                    dir: ls.wi,
+                    t_max: ls.distance * (1.0 - SHADOW_EPSILON),
+                };
+                counters.rays += 1;
+                let occluded = self.scene.geometry.occluded(&shadow);
+                let c = if occluded {
+                    Vec3::ZERO
+                } else {
+                    f * ls.weight * cos_s
+                };
+                sum += c;
+                if let (Some(log), Some(me)) = (log.as_deref_mut(), me) {
+                    let contribution = c / n as f32;
+                    log.nodes[me].shadows.push(ShadowRecord {
+                        light: index,
+                        dir: ls.wi,
+                        occluded,
+                        contribution,
+                    });
+                }
+            }
+            total += sum / n as f32;
+        }
+        total
+    }
+}
+
+fn push_node(log: &mut TraceLog, path: &Path, parent: Option<usize>) -> usize {
+    let id = log.nodes.len();
+    log.nodes.push(TraceNode {
+        depth: path.depth,
+        kind: path.kind,
+        origin: path.ray.origin,
+        dir: path.ray.dir,
+        weight: path.weight,
+        hit: None,
+        shadows: Vec::new(),
+        radiance: Vec3::ZERO,
+        children: Vec::new(),
+        note: None,
+    });
+    if let Some(p) = parent {
+        log.nodes[p].children.push(id);
+    }
+    id
+}
+
+fn note(log: Option<&mut TraceLog>, me: Option<usize>, text: &str) {
+    if let (Some(log), Some(me)) = (log, me) {
+        log.nodes[me].note = Some(text.to_string());
+    }
+}

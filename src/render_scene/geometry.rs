@@ -1,0 +1,400 @@
+//! World-space primitives in BVH leaf order, with closest-hit, any-hit and surface queries.
+
+use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
+
+use crate::accel::{Bvh, RayBoxTest};
+use crate::geometry::float::gamma;
+use crate::geometry::sphere::{intersect_sphere, intersect_unit_quadric, reproject_to_sphere};
+use crate::geometry::triangle::{TriRay, hit_point_error, intersect_triangle};
+use crate::geometry::{Aabb, Ray};
+
+/// A primitive reference: kind in the top two bits, index into that kind's array below.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PrimRef(u32);
+
+/// The kinds of primitive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PrimKind {
+    /// A triangle (meshes, quads and cubes).
+    Triangle,
+    /// A sphere under a similarity transform.
+    Sphere,
+    /// A sphere under a general affine transform.
+    Ellipsoid,
+}
+
+impl PrimRef {
+    const SHIFT: u32 = 30;
+    const MASK: u32 = (1 << Self::SHIFT) - 1;
+
+    /// A reference to primitive `index` of `kind`.
+    #[must_use]
+    pub fn new(kind: PrimKind, index: usize) -> Self {
+        let k = match kind {
+            PrimKind::Triangle => 0,
+            PrimKind::Sphere => 1,
+            PrimKind::Ellipsoid => 2,
+        };
+        Self((k << Self::SHIFT) | (index as u32 & Self::MASK))
+    }
+
+    /// The primitive's kind.
+    #[inline]
+    #[must_use]
+    pub fn kind(self) -> PrimKind {
+        match self.0 >> Self::SHIFT {
+            0 => PrimKind::Triangle,
+            1 => PrimKind::Sphere,
+            _ => PrimKind::Ellipsoid,
+        }
+    }
+
+    /// Index within the kind's array.
+    #[inline]
+    #[must_use]
+    pub fn index(self) -> usize {
+        (self.0 & Self::MASK) as usize
+    }
+}
+
+/// Largest number of primitives of one kind a scene may hold.
+pub const MAX_PRIMS_PER_KIND: usize = PrimRef::MASK as usize;
+
+/// Per-triangle attributes besides its positions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriAttrs {
+    /// Owning object.
+    pub object: u32,
+    /// Vertex normals (world space, unit), or `None` for flat shading.
+    pub normals: Option<[Vec3; 3]>,
+    /// Texture coordinates at the three vertices.
+    pub uvs: [Vec2; 3],
+}
+
+/// A sphere in world space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpherePrim {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius.
+    pub radius: f32,
+    /// Owning object.
+    pub object: u32,
+}
+
+/// A unit sphere at the origin of its object space, mapped to world space by an affine transform.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EllipsoidPrim {
+    /// Object-from-world transform (f64 for accuracy).
+    pub object_from_world: DAffine3,
+    /// World-from-object transform.
+    pub world_from_object: DAffine3,
+    /// Inverse transpose of the linear part, for normals.
+    pub normal_to_world: DMat3,
+    /// Owning object.
+    pub object: u32,
+}
+
+/// The minimal record of a closest hit; expand it with [`Geometry::surface`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Ray parameter.
+    pub t: f32,
+    /// Primitive hit.
+    pub prim: PrimRef,
+    /// Barycentric weight of the second vertex (triangles).
+    pub b1: f32,
+    /// Barycentric weight of the third vertex (triangles).
+    pub b2: f32,
+}
+
+/// Everything shading needs about a hit point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    /// Position.
+    pub p: Vec3,
+    /// Absolute error bound of `p`, per component, for robust ray spawning.
+    pub p_error: Vec3,
+    /// Unit geometric normal, outward (by winding for triangles).
+    pub ng: Vec3,
+    /// Unit shading normal, on the same side as `ng`.
+    pub ns: Vec3,
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Owning object.
+    pub object: u32,
+}
+
+/// Primitives collected by the compiler before the BVH exists.
+#[derive(Debug, Default)]
+pub struct GeometryBuilder {
+    /// Triangle positions.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Triangle attributes, parallel to `triangles`.
+    pub tri_attrs: Vec<TriAttrs>,
+    /// Spheres.
+    pub spheres: Vec<SpherePrim>,
+    /// Ellipsoids.
+    pub ellipsoids: Vec<EllipsoidPrim>,
+}
+
+/// The scene's primitives, stored in BVH leaf order, and their BVH.
+#[derive(Debug, Default)]
+pub struct Geometry {
+    /// The hierarchy; leaf slots index `slots`.
+    pub bvh: Bvh,
+    /// Primitive at each leaf slot.
+    pub slots: Vec<PrimRef>,
+    /// Triangle positions, in leaf order.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Triangle attributes, parallel to `triangles`.
+    pub tri_attrs: Vec<TriAttrs>,
+    /// Spheres.
+    pub spheres: Vec<SpherePrim>,
+    /// Ellipsoids.
+    pub ellipsoids: Vec<EllipsoidPrim>,
+}
+
+impl GeometryBuilder {
+    /// Number of primitives collected.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.triangles.len() + self.spheres.len() + self.ellipsoids.len()
+    }
+
+    /// True if nothing was collected.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Builds the BVH and stores every primitive in leaf order.
+    #[must_use]
+    pub fn build(self) -> Geometry {
+        let mut refs = Vec::with_capacity(self.len());
+        let mut bounds = Vec::with_capacity(self.len());
+        for (i, t) in self.triangles.iter().enumerate() {
+            refs.push(PrimRef::new(PrimKind::Triangle, i));
+            bounds.push(Aabb::from_points(t));
+        }
+        for (i, s) in self.spheres.iter().enumerate() {
+            refs.push(PrimRef::new(PrimKind::Sphere, i));
+            bounds.push(Aabb {
+                min: s.center - Vec3::splat(s.radius),
+                max: s.center + Vec3::splat(s.radius),
+            });
+        }
+        for (i, e) in self.ellipsoids.iter().enumerate() {
+            refs.push(PrimRef::new(PrimKind::Ellipsoid, i));
+            bounds.push(ellipsoid_bounds(&e.world_from_object));
+        }
+        let bvh = Bvh::build(&bounds);
+        let mut g = Geometry {
+            slots: Vec::with_capacity(refs.len()),
+            triangles: Vec::with_capacity(self.triangles.len()),
+            tri_attrs: Vec::with_capacity(self.triangles.len()),
+            spheres: Vec::with_capacity(self.spheres.len()),
+            ellipsoids: Vec::with_capacity(self.ellipsoids.len()),
+            bvh: Bvh::default(),
+        };
+        for &o in &bvh.order {
+            let r = refs[o as usize];
+            let new = match r.kind() {
+                PrimKind::Triangle => {
+                    g.triangles.push(self.triangles[r.index()]);
+                    g.tri_attrs.push(self.tri_attrs[r.index()]);
+                    PrimRef::new(PrimKind::Triangle, g.triangles.len() - 1)
+                }
+                PrimKind::Sphere => {
+                    g.spheres.push(self.spheres[r.index()]);
+                    PrimRef::new(PrimKind::Sphere, g.spheres.len() - 1)
+                }
+                PrimKind::Ellipsoid => {
+                    g.ellipsoids.push(self.ellipsoids[r.index()]);
+                    PrimRef::new(PrimKind::Ellipsoid, g.ellipsoids.len() - 1)
+                }
+            };
+            g.slots.push(new);
+        }
+        g.bvh = bvh;
+        g
+    }
+}
+
+/// Tight bounds of the image of the unit sphere under `m`: centre ± the row norms of the linear part.
+fn ellipsoid_bounds(m: &DAffine3) -> Aabb {
+    let l = m.matrix3;
+    let half = DVec3::new(l.row(0).length(), l.row(1).length(), l.row(2).length());
+    let c = m.translation;
+    // Round outward so the f32 box contains the f64 surface.
+    let lo = (c - half)
+        .as_vec3()
+        .to_array()
+        .map(crate::geometry::float::next_down);
+    let hi = (c + half)
+        .as_vec3()
+        .to_array()
+        .map(crate::geometry::float::next_up);
+    Aabb {
+        min: lo.into(),
+        max: hi.into(),
+    }
+}
+
+impl Geometry {
+    /// The closest hit along `ray` within `(0, ray.t_max)`. Invalid rays (NaN/Inf) miss.
+    #[inline]
+    #[must_use]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        if !ray.is_valid() {
+            return None;
+        }
+        let tri_ray = TriRay::new(ray);
+        let box_ray = RayBoxTest::new(ray.origin, ray.dir);
+        let mut best = None;
+        self.bvh.closest(&box_ray, ray.t_max, |slot, t_max| {
+            let prim = self.slots[slot as usize];
+            let (t, b1, b2) = self.intersect_prim(prim, &tri_ray, ray, t_max)?;
+            best = Some(Hit { t, prim, b1, b2 });
+            Some(t)
+        });
+        best
+    }
+
+    /// True if anything blocks `ray` within `(0, ray.t_max)`.
+    #[inline]
+    #[must_use]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        if !ray.is_valid() {
+            return false;
+        }
+        let tri_ray = TriRay::new(ray);
+        let box_ray = RayBoxTest::new(ray.origin, ray.dir);
+        self.bvh.any(&box_ray, ray.t_max, |slot, t_max| {
+            self.intersect_prim(self.slots[slot as usize], &tri_ray, ray, t_max)
+                .is_some()
+        })
+    }
+
+    #[inline(always)]
+    fn intersect_prim(
+        &self,
+        prim: PrimRef,
+        tri_ray: &TriRay,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<(f32, f32, f32)> {
+        match prim.kind() {
+            PrimKind::Triangle => {
+                let [p0, p1, p2] = self.triangles[prim.index()];
+                intersect_triangle(tri_ray, p0, p1, p2, t_max).map(|h| (h.t, h.b1, h.b2))
+            }
+            PrimKind::Sphere => {
+                let s = &self.spheres[prim.index()];
+                let r = Ray { t_max, ..*ray };
+                intersect_sphere(s.center, s.radius, &r).map(|t| (t, 0.0, 0.0))
+            }
+            PrimKind::Ellipsoid => {
+                let e = &self.ellipsoids[prim.index()];
+                let o = e.object_from_world.transform_point3(ray.origin.as_dvec3());
+                let d = e.object_from_world.transform_vector3(ray.dir.as_dvec3());
+                intersect_unit_quadric(o, d, 1.0, t_max).map(|t| (t, 0.0, 0.0))
+            }
+        }
+    }
+
+    /// The object a primitive belongs to.
+    #[must_use]
+    pub fn object_of(&self, prim: PrimRef) -> u32 {
+        match prim.kind() {
+            PrimKind::Triangle => self.tri_attrs[prim.index()].object,
+            PrimKind::Sphere => self.spheres[prim.index()].object,
+            PrimKind::Ellipsoid => self.ellipsoids[prim.index()].object,
+        }
+    }
+
+    /// Expands a hit of `ray` into a full surface record.
+    #[must_use]
+    pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfacePoint {
+        match hit.prim.kind() {
+            PrimKind::Triangle => {
+                let [p0, p1, p2] = self.triangles[hit.prim.index()];
+                let a = &self.tri_attrs[hit.prim.index()];
+                let b0 = 1.0 - hit.b1 - hit.b2;
+                let p = p0 * b0 + p1 * hit.b1 + p2 * hit.b2;
+                let th = crate::geometry::triangle::TriHit {
+                    t: hit.t,
+                    b0,
+                    b1: hit.b1,
+                    b2: hit.b2,
+                };
+                let ng = (p1 - p0).cross(p2 - p0).normalize();
+                let ns = match a.normals {
+                    Some([n0, n1, n2]) => {
+                        let n = (n0 * b0 + n1 * hit.b1 + n2 * hit.b2).normalize_or_zero();
+                        if n == Vec3::ZERO {
+                            ng
+                        } else if n.dot(ng) < 0.0 {
+                            -n
+                        } else {
+                            n
+                        }
+                    }
+                    None => ng,
+                };
+                let uv = a.uvs[0] * b0 + a.uvs[1] * hit.b1 + a.uvs[2] * hit.b2;
+                SurfacePoint {
+                    p,
+                    p_error: hit_point_error(&th, p0, p1, p2),
+                    ng,
+                    ns,
+                    uv,
+                    object: a.object,
+                }
+            }
+            PrimKind::Sphere => {
+                let s = &self.spheres[hit.prim.index()];
+                let c = s.center.as_dvec3();
+                let raw = ray.origin.as_dvec3() + ray.dir.as_dvec3() * f64::from(hit.t);
+                let pd = reproject_to_sphere(c, f64::from(s.radius), raw);
+                let n = ((pd - c) / f64::from(s.radius)).as_vec3().normalize();
+                let p = pd.as_vec3();
+                let uv = sphere_uv(n);
+                SurfacePoint {
+                    p,
+                    p_error: p.abs() * gamma(2),
+                    ng: n,
+                    ns: n,
+                    uv,
+                    object: s.object,
+                }
+            }
+            PrimKind::Ellipsoid => {
+                let e = &self.ellipsoids[hit.prim.index()];
+                let o = e.object_from_world.transform_point3(ray.origin.as_dvec3());
+                let d = e.object_from_world.transform_vector3(ray.dir.as_dvec3());
+                let po = reproject_to_sphere(DVec3::ZERO, 1.0, o + d * f64::from(hit.t));
+                let pd = e.world_from_object.transform_point3(po);
+                let n = (e.normal_to_world * po).as_vec3().normalize();
+                let p = pd.as_vec3();
+                let uv = sphere_uv(po.as_vec3());
+                SurfacePoint {
+                    p,
+                    p_error: p.abs() * gamma(3),
+                    ng: n,
+                    ns: n,
+                    uv,
+                    object: e.object,
+                }
+            }
+        }
+    }
+}
+
+/// Longitude/latitude coordinates of a unit direction: u from the azimuth about +y, v from the pole.
+#[inline]
+fn sphere_uv(n: Vec3) -> Vec2 {
+    let u = 0.5 + n.z.atan2(n.x) / std::f32::consts::TAU;
+    let v = n.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
+    Vec2::new(u, v)
+}

@@ -1,0 +1,66 @@
+//! The flat, world-space, immutable scene that integrators render: produced only by `compile`.
+
+pub mod camera;
+pub mod geometry;
+pub mod light;
+
+pub use camera::Camera;
+pub use geometry::{Geometry, Hit, PrimRef, SurfacePoint};
+pub use light::Light;
+
+use glam::Vec3;
+
+use crate::shading::Material;
+
+/// Rendering parameters after command-line overrides.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderParams {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Camera samples per pixel.
+    pub samples_per_pixel: u32,
+    /// Maximum specular recursion depth.
+    pub max_depth: u32,
+    /// Paths with a smaller weight are not continued.
+    pub min_contribution: f32,
+    /// Shadow samples per sphere light per shaded point.
+    pub light_samples: u32,
+    /// Seed of all random streams.
+    pub seed: u64,
+    /// Radiance of rays leaving the scene.
+    pub background: Vec3,
+    /// Radiance scale applied when writing 8-bit images.
+    pub exposure: f32,
+}
+
+/// A named scene object, for diagnostics and ray-tree dumps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjectInfo {
+    /// Name from the file, or `kind#index` when unnamed.
+    pub name: String,
+    /// Material index, or `None` for light emitters.
+    pub material: Option<u32>,
+    /// Index of the light this object emits as, if it is an emitter.
+    pub light: Option<u32>,
+}
+
+/// Everything an integrator needs, resolved to indices.
+#[derive(Debug)]
+pub struct RenderScene {
+    /// Image and sampling parameters.
+    pub params: RenderParams,
+    /// The camera.
+    pub camera: Camera,
+    /// Materials, indexed by `ObjectInfo::material`.
+    pub materials: Vec<Material>,
+    /// Material names, parallel to `materials`.
+    pub material_names: Vec<String>,
+    /// Lights.
+    pub lights: Vec<Light>,
+    /// Objects, indexed by the `object` of each primitive.
+    pub objects: Vec<ObjectInfo>,
+    /// Primitives and their BVH.
+    pub geometry: Geometry,
+}

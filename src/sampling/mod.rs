@@ -1,0 +1,6 @@
+//! Deterministic random streams and the warps that turn uniform numbers into directions.
+
+pub mod rng;
+pub mod warp;
+
+pub use rng::Rng;

@@ -1,0 +1,6 @@
+//! The one material model shared by every integrator, and the optics it is built from.
+
+pub mod material;
+pub mod optics;
+
+pub use material::Material;
