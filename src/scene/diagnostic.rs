@@ -156,7 +156,8 @@ fn token_width(rest: &str) -> usize {
         Some(_) => rest
             .chars()
             .take_while(|c| {
-                !matches!(c, ',' | ')' | ']' | '}' | '(' | '[' | '{') && !c.is_whitespace()
+                !matches!(c, ',' | ')' | ']' | '}' | '(' | '[' | '{' | ':' | '=')
+                    && !c.is_whitespace()
             })
             .count()
             .max(1),

@@ -53,8 +53,12 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
     for (i, n) in scene.nodes.iter().enumerate() {
         v.node(&format!("nodes[{i}]"), n, 1);
     }
+    let dangling_refs = v
+        .out
+        .iter()
+        .any(|d| d.is_error() && d.message.starts_with("unknown material"));
     for name in scene.materials.keys() {
-        if !v.used.contains(name.as_str()) {
+        if !dangling_refs && !v.used.contains(name.as_str()) {
             v.out.push(Diagnostic::warning(
                 format!("materials.{name}"),
                 format!("material `{name}` is never used"),
