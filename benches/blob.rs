@@ -1,1 +1,203 @@
-fn main() {}
+//! Ray-casting benchmark on the "bumpy blob" workload of shared/bench/blob-workload.md, timed
+//! as that text prescribes (chunks of 4096 rays from an atomic counter, medians of 5), so the
+//! figures compare with Embree 3.13's `rtcIntersect1` / `rtcOccluded1` on the same machine kind.
+//!
+//! Run: `cargo bench --bench blob` (both meshes) or `cargo bench --bench blob -- blob100k`.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+use caustic::bench::blob::{BlobMesh, WorkloadRay, blob_mesh, primary_rays, secondary_rays};
+use caustic::geometry::Ray;
+use caustic::render_scene::geometry::{Geometry, GeometryBuilder, TriAttrs};
+use glam::{Vec2, Vec3};
+
+const REPS: usize = 5;
+const CHUNK: usize = 4096;
+
+/// Embree 3.13 on a 2-vCPU Zen 3 (blob-workload.md): (mesh, threads) → primary, secondary closest,
+/// secondary any-hit (Mrays/s), build (s).
+const EMBREE: [(&str, usize, f64, f64, f64, f64); 4] = [
+    ("blob100k", 1, 9.02, 6.12, 6.54, 0.184),
+    ("blob100k", 2, 17.61, 12.04, 12.95, 0.093),
+    ("blob1m", 1, 7.32, 4.84, 5.10, 1.484),
+    ("blob1m", 2, 13.27, 9.17, 9.72, 0.730),
+];
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn builder(mesh: &BlobMesh) -> GeometryBuilder {
+    let mut b = GeometryBuilder::default();
+    for t in &mesh.triangles {
+        b.triangles
+            .push(t.map(|i| Vec3::from(mesh.positions[i as usize])));
+        b.tri_attrs.push(TriAttrs {
+            object: 0,
+            normals: None,
+            uvs: [Vec2::ZERO; 3],
+        });
+    }
+    b
+}
+
+fn ray_of(r: &WorkloadRay) -> Ray {
+    Ray::new(Vec3::from(r.origin), Vec3::from(r.dir))
+}
+
+/// Runs `f(i)` for every ray index on `threads` OS threads taking chunks from a shared counter;
+/// returns the elapsed seconds.
+fn timed<F: Fn(usize) + Sync>(n: usize, threads: usize, f: F) -> f64 {
+    let next = AtomicUsize::new(0);
+    let start = Instant::now();
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                loop {
+                    let begin = next.fetch_add(CHUNK, Ordering::Relaxed);
+                    if begin >= n {
+                        break;
+                    }
+                    for i in begin..(begin + CHUNK).min(n) {
+                        f(i);
+                    }
+                }
+            });
+        }
+    });
+    start.elapsed().as_secs_f64()
+}
+
+fn closest(g: &Geometry, rays: &[WorkloadRay], threads: usize) -> (f64, Vec<Option<(f32, u32)>>) {
+    let results: Vec<std::sync::atomic::AtomicU64> = (0..rays.len())
+        .map(|_| std::sync::atomic::AtomicU64::new(u64::MAX))
+        .collect();
+    let secs = timed(rays.len(), threads, |i| {
+        if let Some(h) = g.intersect(&ray_of(&rays[i])) {
+            let packed = (u64::from(h.t.to_bits()) << 32) | h.prim.index() as u64;
+            results[i].store(packed, Ordering::Relaxed);
+        }
+    });
+    let hits = results
+        .iter()
+        .map(|a| {
+            let v = a.load(Ordering::Relaxed);
+            (v != u64::MAX).then(|| (f32::from_bits((v >> 32) as u32), (v & 0xFFFF_FFFF) as u32))
+        })
+        .collect();
+    (secs, hits)
+}
+
+fn any_hit(g: &Geometry, rays: &[WorkloadRay], threads: usize) -> (f64, usize) {
+    let count = AtomicUsize::new(0);
+    let secs = timed(rays.len(), threads, |i| {
+        if g.occluded(&ray_of(&rays[i])) {
+            count.fetch_add(1, Ordering::Relaxed);
+        }
+    });
+    (secs, count.into_inner())
+}
+
+fn main() {
+    let filter: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    println!(
+        "| mesh | threads | build s | primary Mrays/s | secondary closest | secondary any-hit | vs Embree (prim / sec / any / build) |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for (name, k) in [("blob100k", 71u32), ("blob1m", 224)] {
+        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
+            continue;
+        }
+        let mesh = blob_mesh(k);
+        let mut build_times = Vec::new();
+        let mut geometry = None;
+        for _ in 0..REPS {
+            let b = builder(&mesh);
+            let t0 = Instant::now();
+            let g = b.build();
+            build_times.push(t0.elapsed().as_secs_f64());
+            geometry = Some(g);
+        }
+        let Some(g) = geometry else { return };
+        let build = median(build_times);
+        // The triangles in leaf order, as a mesh, so secondary rays use the hit triangle's vertices.
+        let leaf_mesh = BlobMesh {
+            positions: g
+                .triangles
+                .iter()
+                .flat_map(|t| t.map(|p| p.to_array()))
+                .collect(),
+            normals: Vec::new(),
+            triangles: (0..g.triangles.len() as u32)
+                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .collect(),
+        };
+        let primary = primary_rays();
+        let (_, hits) = closest(&g, &primary, 1);
+        let hit_count = hits.iter().flatten().count();
+        let t_sum: f64 = hits.iter().flatten().map(|h| f64::from(h.0)).sum();
+        let secondary = secondary_rays(&leaf_mesh, &primary, &hits);
+        let (_, sec_hits) = closest(&g, &secondary, 1);
+        let sec_count = sec_hits.iter().flatten().count();
+        let sec_sum: f64 = sec_hits.iter().flatten().map(|h| f64::from(h.0)).sum();
+        let (_, occluded) = any_hit(&g, &secondary, 1);
+        let bs = g.bvh.stats();
+        eprintln!(
+            "{name}: bvh {} nodes, {} leaves (mean {:.2} prims), depth {}, SAH {:.1}",
+            bs.nodes,
+            bs.leaves,
+            g.triangles.len() as f64 / bs.leaves as f64,
+            bs.max_depth,
+            bs.sah_cost
+        );
+        eprintln!(
+            "{name}: {} triangles; primary hits {hit_count} (sum t {t_sum:.2}); secondary {} rays, hits {sec_count} (sum t {sec_sum:.2}), occluded {occluded}",
+            g.triangles.len(),
+            secondary.len()
+        );
+        for threads in [1usize, 2] {
+            let prim = median(
+                (0..REPS)
+                    .map(|_| closest(&g, &primary, threads).0)
+                    .collect(),
+            );
+            let sec = median(
+                (0..REPS)
+                    .map(|_| closest(&g, &secondary, threads).0)
+                    .collect(),
+            );
+            let any = median(
+                (0..REPS)
+                    .map(|_| any_hit(&g, &secondary, threads).0)
+                    .collect(),
+            );
+            let mr = |n: usize, s: f64| n as f64 / s / 1e6;
+            let (p, s, a) = (
+                mr(primary.len(), prim),
+                mr(secondary.len(), sec),
+                mr(secondary.len(), any),
+            );
+            let e = EMBREE.iter().find(|e| e.0 == name && e.1 == threads);
+            let ratio = e.map_or(String::new(), |e| {
+                format!(
+                    "{:.0}% / {:.0}% / {:.0}% / {:.2}×",
+                    100.0 * p / e.2,
+                    100.0 * s / e.3,
+                    100.0 * a / e.4,
+                    build / e.5
+                )
+            });
+            let b = if threads == 1 {
+                format!("{build:.3}")
+            } else {
+                "—".into()
+            };
+            println!("| {name} | {threads} | {b} | {p:.2} | {s:.2} | {a:.2} | {ratio} |");
+        }
+    }
+}

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use super::bvh::{Bvh, BvhNode};
+use super::bvh::BvhNode;
 use crate::geometry::Aabb;
 use crate::geometry::float::{next_down, next_up};
 
@@ -13,7 +13,7 @@ const MAX_LEAF: usize = 8;
 /// tree depth by `SAH_DEPTH + log2(n)` and so keeps it within the traversal stack.
 const SAH_DEPTH: usize = 32;
 /// Cost of visiting a node relative to intersecting one primitive.
-const TRAVERSAL_COST: f32 = 1.0;
+const TRAVERSAL_COST: f32 = 2.0;
 
 struct Task {
     node: usize,
@@ -22,10 +22,10 @@ struct Task {
     depth: usize,
 }
 
-pub(super) fn build(bounds: &[Aabb]) -> Bvh {
+pub(super) fn build(bounds: &[Aabb]) -> (Vec<BvhNode>, Vec<u32>) {
     let n = bounds.len();
     if n == 0 {
-        return Bvh::default();
+        return (Vec::new(), Vec::new());
     }
     let centroids: Vec<Vec3> = bounds.iter().map(Aabb::center).collect();
     let mut order: Vec<u32> = (0..n as u32).collect();
@@ -86,7 +86,7 @@ pub(super) fn build(bounds: &[Aabb]) -> Bvh {
             None => nodes[node] = leaf(node_bounds, start, count),
         }
     }
-    Bvh { nodes, order }
+    (nodes, order)
 }
 
 fn leaf(b: Aabb, first: usize, count: usize) -> BvhNode {

@@ -7,7 +7,7 @@ pub const MACHINE_EPSILON: f32 = f32::EPSILON * 0.5;
 /// (Higham's γₙ, as used by pbrt).
 #[inline]
 #[must_use]
-pub fn gamma(n: i32) -> f32 {
+pub const fn gamma(n: i32) -> f32 {
     let ne = n as f32 * MACHINE_EPSILON;
     ne / (1.0 - ne)
 }

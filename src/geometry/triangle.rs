@@ -32,6 +32,13 @@ pub struct TriHit {
 }
 
 impl TriRay {
+    /// The ray direction's dominant axis (0 = x, 1 = y, 2 = z).
+    #[inline]
+    #[must_use]
+    pub fn dominant_axis(&self) -> usize {
+        self.kz
+    }
+
     /// Precomputes the permutation and shear for `ray` (its direction must be non-zero and finite).
     #[inline]
     #[must_use]
@@ -65,7 +72,28 @@ impl TriRay {
 #[inline]
 #[must_use]
 pub fn intersect_triangle(r: &TriRay, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<TriHit> {
-    let (kx, ky, kz) = (r.kx, r.ky, r.kz);
+    match r.kz {
+        0 => intersect_triangle_k::<0>(r, p0, p1, p2, t_max),
+        1 => intersect_triangle_k::<1>(r, p0, p1, p2, t_max),
+        _ => intersect_triangle_k::<2>(r, p0, p1, p2, t_max),
+    }
+}
+
+/// [`intersect_triangle`] for a ray whose dominant axis is known at compile time (`KZ` must equal
+/// [`TriRay::dominant_axis`]); lets hot loops hoist the axis dispatch out of the primitive loop.
+#[inline(always)]
+#[must_use]
+pub fn intersect_triangle_k<const KZ: usize>(
+    r: &TriRay,
+    p0: Vec3,
+    p1: Vec3,
+    p2: Vec3,
+    t_max: f32,
+) -> Option<TriHit> {
+    debug_assert_eq!(KZ, r.kz);
+    let kz = KZ;
+    let kx = (KZ + 1) % 3;
+    let ky = (KZ + 2) % 3;
     let o = r.origin;
     let (p0, p1, p2) = (p0.to_array(), p1.to_array(), p2.to_array());
     // Translate to the ray origin and permute so that the ray's dominant axis is z.

@@ -5,7 +5,7 @@ use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 use crate::accel::{Bvh, RayBoxTest};
 use crate::geometry::float::gamma;
 use crate::geometry::sphere::{intersect_sphere, intersect_unit_quadric, reproject_to_sphere};
-use crate::geometry::triangle::{TriRay, hit_point_error, intersect_triangle};
+use crate::geometry::triangle::{TriRay, hit_point_error, intersect_triangle_k};
 use crate::geometry::{Aabb, Ray};
 
 /// A primitive reference: kind in the top two bits, index into that kind's array below.
@@ -250,11 +250,20 @@ impl Geometry {
             return None;
         }
         let tri_ray = TriRay::new(ray);
+        match tri_ray.dominant_axis() {
+            0 => self.intersect_k::<0>(ray, &tri_ray),
+            1 => self.intersect_k::<1>(ray, &tri_ray),
+            _ => self.intersect_k::<2>(ray, &tri_ray),
+        }
+    }
+
+    #[inline(always)]
+    fn intersect_k<const KZ: usize>(&self, ray: &Ray, tri_ray: &TriRay) -> Option<Hit> {
         let box_ray = RayBoxTest::new(ray.origin, ray.dir);
         let mut best = None;
         self.bvh.closest(&box_ray, ray.t_max, |slot, t_max| {
             let prim = self.slots[slot as usize];
-            let (t, b1, b2) = self.intersect_prim(prim, &tri_ray, ray, t_max)?;
+            let (t, b1, b2) = self.intersect_prim::<KZ>(prim, tri_ray, ray, t_max)?;
             best = Some(Hit { t, prim, b1, b2 });
             Some(t)
         });
@@ -269,15 +278,24 @@ impl Geometry {
             return false;
         }
         let tri_ray = TriRay::new(ray);
+        match tri_ray.dominant_axis() {
+            0 => self.occluded_k::<0>(ray, &tri_ray),
+            1 => self.occluded_k::<1>(ray, &tri_ray),
+            _ => self.occluded_k::<2>(ray, &tri_ray),
+        }
+    }
+
+    #[inline(always)]
+    fn occluded_k<const KZ: usize>(&self, ray: &Ray, tri_ray: &TriRay) -> bool {
         let box_ray = RayBoxTest::new(ray.origin, ray.dir);
         self.bvh.any(&box_ray, ray.t_max, |slot, t_max| {
-            self.intersect_prim(self.slots[slot as usize], &tri_ray, ray, t_max)
+            self.intersect_prim::<KZ>(self.slots[slot as usize], tri_ray, ray, t_max)
                 .is_some()
         })
     }
 
     #[inline(always)]
-    fn intersect_prim(
+    fn intersect_prim<const KZ: usize>(
         &self,
         prim: PrimRef,
         tri_ray: &TriRay,
@@ -287,7 +305,7 @@ impl Geometry {
         match prim.kind() {
             PrimKind::Triangle => {
                 let [p0, p1, p2] = self.triangles[prim.index()];
-                intersect_triangle(tri_ray, p0, p1, p2, t_max).map(|h| (h.t, h.b1, h.b2))
+                intersect_triangle_k::<KZ>(tri_ray, p0, p1, p2, t_max).map(|h| (h.t, h.b1, h.b2))
             }
             PrimKind::Sphere => {
                 let s = &self.spheres[prim.index()];
