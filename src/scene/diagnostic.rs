@@ -210,6 +210,24 @@ pub fn did_you_mean<'a>(
         .map(|(_, c)| c)
 }
 
+/// Rewrites serde's Rust-flavoured wording (`expected f32`, `u32`, `a sequence`) for scene authors.
+#[must_use]
+pub fn humanize(msg: &str) -> String {
+    [
+        ("expected f32", "expected a number"),
+        ("expected f64", "expected a number"),
+        ("expected u32", "expected a whole number ≥ 0"),
+        ("expected u64", "expected a whole number ≥ 0"),
+        ("expected usize", "expected a whole number ≥ 0"),
+        ("Expected float", "expected a number"),
+        ("Expected integer", "expected a whole number"),
+        ("a sequence", "a list"),
+        ("missing field", "missing required field"),
+    ]
+    .iter()
+    .fold(msg.to_string(), |m, (from, to)| m.replace(from, to))
+}
+
 /// Formats a list of names as `` `a`, `b`, `c` ``.
 #[must_use]
 pub fn quoted_list<'a>(names: impl IntoIterator<Item = &'a str>) -> String {

@@ -4,7 +4,7 @@
 use std::cell::OnceCell;
 use std::path::{Path, PathBuf};
 
-use super::diagnostic::{Diagnostic, SourcePoint, did_you_mean, quoted_list};
+use super::diagnostic::{Diagnostic, SourcePoint, did_you_mean, humanize, quoted_list};
 use super::locate::{SourceFormat, SourceIndex};
 use super::schema::SceneFile;
 
@@ -180,7 +180,7 @@ impl SourceFile {
                     ron::Error::MissingStructField { field, .. } => {
                         Diagnostic::error(&path, format!("missing required field `{field}`"))
                     }
-                    other => Diagnostic::error(&path, other.to_string()),
+                    other => Diagnostic::error(&path, humanize(&other.to_string())),
                 };
                 let diag = Diagnostic { path, ..diag };
                 Err(Box::new(self.place(
@@ -201,7 +201,7 @@ impl SourceFile {
     }
 
     fn toml_error(&self, e: &toml::de::Error, path: String) -> Diagnostic {
-        let msg = e.message().trim().to_string();
+        let msg = humanize(e.message().trim());
         let diag = parse_unknown_name(&msg).unwrap_or_else(|| Diagnostic::error("", msg));
         let diag = Diagnostic { path, ..diag };
         let at = e
@@ -270,7 +270,7 @@ fn unknown_name(kind: &str, found: &str, expected: &[&str]) -> Diagnostic {
 
 /// serde's path (`nodes[0].Sphere.radius`) with enum variant names removed (`nodes[0].radius`),
 /// the form users write and the locator understands.
-fn user_path(raw: &str) -> String {
+pub(crate) fn user_path(raw: &str) -> String {
     if raw == "." {
         return String::new();
     }
@@ -291,7 +291,7 @@ fn user_path(raw: &str) -> String {
     let mut out: Vec<&str> = Vec::new();
     for seg in raw.split('.') {
         let is_map_key = out.last().is_some_and(|prev| *prev == "materials");
-        if !is_map_key && VARIANTS.contains(&seg) {
+        if seg == "?" || (!is_map_key && VARIANTS.contains(&seg)) {
             continue;
         }
         out.push(seg);

@@ -2,7 +2,7 @@
 
 use serde_json::Value;
 
-use super::diagnostic::{Diagnostic, did_you_mean, quoted_list};
+use super::diagnostic::{Diagnostic, did_you_mean, humanize, quoted_list};
 use super::load::SceneError;
 use super::schema::SceneFile;
 
@@ -24,10 +24,13 @@ pub fn apply_overrides(scene: &SceneFile, sets: &[String]) -> Result<SceneFile, 
         return Err(SceneError::Invalid(errors));
     }
     serde_path_to_error::deserialize::<_, SceneFile>(tree).map_err(|e| {
-        let path = e.path().to_string();
+        let path = super::load::user_path(&e.path().to_string());
         invalid(
             &format!("--set {path}"),
-            format!("{} (the override does not fit the schema)", e.inner()),
+            format!(
+                "{} (the override does not fit the schema)",
+                humanize(&e.inner().to_string())
+            ),
         )
     })
 }

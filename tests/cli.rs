@@ -1,0 +1,248 @@
+//! The command line: schema freshness, checks of every shipped scene, overrides, output safety,
+//! debug-pixel, exit codes.
+
+mod common;
+
+use common::{caustic, root};
+
+fn stderr(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn committed_schema_is_fresh() {
+    let out = caustic(&["schema"]);
+    assert!(out.status.success());
+    let committed =
+        std::fs::read_to_string(root().join("schema/scene.schema.json")).expect("schema file");
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        committed,
+        "schema/scene.schema.json is stale: run `caustic schema > schema/scene.schema.json`"
+    );
+}
+
+#[test]
+fn every_scene_checks_and_validates_against_the_json_schema() {
+    let schema: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("schema/scene.schema.json")).expect("schema"),
+    )
+    .expect("schema is JSON");
+    let validator = jsonschema::validator_for(&schema).expect("schema compiles");
+    for path in common::scene_files() {
+        let rel = path
+            .strip_prefix(root())
+            .expect("under root")
+            .to_string_lossy()
+            .into_owned();
+        let out = caustic(&["check", &rel]);
+        assert!(out.status.success(), "{rel}: {}", stderr(&out));
+        // The file's own data (TOML as written; RON through its typed parse) must satisfy the schema.
+        let value: serde_json::Value = if rel.ends_with(".toml") {
+            let t: toml::Value =
+                toml::from_str(&std::fs::read_to_string(&path).expect("read")).expect("toml");
+            serde_json::to_value(t).expect("json")
+        } else {
+            serde_json::to_value(caustic::scene::load::load(&path).expect("loads").scene)
+                .expect("json")
+        };
+        let errors: Vec<String> = validator
+            .iter_errors(&value)
+            .map(|e| format!("{e} at {}", e.instance_path()))
+            .collect();
+        assert!(errors.is_empty(), "{rel} violates the schema: {errors:#?}");
+    }
+}
+
+#[test]
+fn render_writes_the_image_and_a_summary() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let out_path = dir.path().join("c.png");
+    let out = caustic(&[
+        "render",
+        "scenes/cornell.ron",
+        "-o",
+        out_path.to_str().expect("utf8"),
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--spp",
+        "1",
+        "--threads",
+        "1",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(&out_path).expect("a readable PNG");
+    assert_eq!((img.width(), img.height()), (24, 16));
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        summary.contains("24×16, 1 spp") && summary.contains("Mrays/s"),
+        "{summary}"
+    );
+    // Nothing but the image is left in the directory (no temporary files).
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 1);
+}
+
+#[test]
+fn exr_output_is_linear_float() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let exr = dir.path().join("c.exr");
+    let args = [
+        "render",
+        "scenes/cornell.ron",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "1",
+        "--quiet",
+        "-o",
+    ];
+    let out = caustic(&[&args[..], &[exr.to_str().expect("utf8")]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(&exr).expect("EXR readable").into_rgb32f();
+    assert!(img.pixels().any(|p| p.0.iter().any(|c| *c > 0.0)));
+}
+
+#[test]
+fn set_override_equals_editing_the_file() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let text = std::fs::read_to_string(root().join("scenes/cornell.ron")).expect("read");
+    assert!(text.contains("fov_y: 39"));
+    let edited = dir.path().join("edited.ron");
+    std::fs::write(
+        &edited,
+        text.replace("fov_y: 39", "fov_y: 60")
+            .replace("ior: 1.5", "ior: 1.7"),
+    )
+    .expect("write");
+    let small = ["--width", "20", "--height", "20", "--spp", "1", "--quiet"];
+    let a = dir.path().join("a.png");
+    let b = dir.path().join("b.png");
+    let c = dir.path().join("c.png");
+    let run = |args: Vec<&str>| {
+        let o = caustic(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    let (a_s, b_s, c_s) = (
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        c.to_str().unwrap(),
+    );
+    run([
+        &[
+            "render",
+            "scenes/cornell.ron",
+            "-o",
+            a_s,
+            "--set",
+            "camera.fov_y=60",
+            "--set",
+            "materials.glass.ior=1.7",
+        ],
+        &small[..],
+    ]
+    .concat());
+    run([&["render", edited.to_str().unwrap(), "-o", b_s], &small[..]].concat());
+    run([&["render", "scenes/cornell.ron", "-o", c_s], &small[..]].concat());
+    let bytes = |p: &std::path::Path| std::fs::read(p).expect("image");
+    assert_eq!(
+        bytes(&a),
+        bytes(&b),
+        "--set renders exactly like the edited file"
+    );
+    assert_ne!(bytes(&a), bytes(&c), "and differently from the original");
+}
+
+#[test]
+fn bad_overrides_are_clear_errors() {
+    let cases = [
+        ("camera.fov=35", "has no field `fov`"),
+        ("camera.fov_y=wide", "camera.fov_y"),
+        ("materials.glas.ior=1.7", "did you mean `glass`?"),
+        ("lights[5].radius=1", "out of range"),
+        ("materials.glass.ior=-1", "greater than 0"),
+        ("render.width", "expected `path=value`"),
+    ];
+    for (set, expect) in cases {
+        let out = caustic(&["check", "scenes/cornell.ron", "--set", set]);
+        assert_eq!(out.status.code(), Some(2), "{set}");
+        let err = stderr(&out);
+        assert!(
+            err.contains(expect),
+            "--set {set}: expected `{expect}` in:\n{err}"
+        );
+        assert!(!err.contains("panicked"));
+    }
+}
+
+#[test]
+fn bad_flags_exit_2_and_write_nothing() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let png = dir.path().join("x.png");
+    let p = png.to_str().expect("utf8");
+    for args in [
+        vec!["render", "scenes/cornell.ron", "-o", p, "--region", "1,2,3"],
+        vec![
+            "render",
+            "scenes/cornell.ron",
+            "-o",
+            p,
+            "--region",
+            "60,60,10,10",
+            "--width",
+            "64",
+            "--height",
+            "64",
+        ],
+        vec!["render", "scenes/cornell.ron", "-o", p, "--threads", "0"],
+        vec!["render", "scenes/cornell.ron", "-o", p, "--width", "0"],
+        vec![
+            "render",
+            "scenes/cornell.ron",
+            "-o",
+            dir.path().join("x.jpg").to_str().unwrap(),
+        ],
+        vec!["render", "scenes/missing.ron", "-o", p],
+        vec!["render", "README.md", "-o", p],
+    ] {
+        let out = caustic(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(!stderr(&out).contains("panicked"));
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).expect("dir").count(),
+        0,
+        "no file written"
+    );
+}
+
+#[test]
+fn debug_pixel_prints_the_ray_tree() {
+    // The centre of the glass ball: camera ray, refraction into and out of the ball, the wall behind.
+    let args = [
+        "debug-pixel",
+        "scenes/cornell.ron",
+        "--width",
+        "64",
+        "--height",
+        "64",
+    ];
+    let out = caustic(&[&args[..], &["40", "50"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("Camera ray depth 0"), "{text}");
+    assert!(text.contains("hit `glass ball`"), "{text}");
+    assert!(text.contains("Refract ray depth 1"), "{text}");
+    assert!(text.contains("from inside"), "{text}");
+    let out = caustic(&[&args[..], &["40", "50", "--json"]].concat());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    assert!(v["nodes"].as_array().is_some_and(|n| n.len() >= 3));
+    assert_eq!(v["pixel"], serde_json::json!([40, 50]));
+    let out = caustic(&[&args[..], &["64", "0"]].concat());
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("outside"));
+}

@@ -1,0 +1,56 @@
+//! Helpers shared by the integration tests.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use caustic::pipeline::{SceneOverrides, prepare};
+use caustic::render::{Film, RenderOptions, RenderStats, render};
+
+/// The crate root (tests run with it as the working directory, but be explicit).
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Every scene file in `scenes/`, sorted.
+pub fn scene_files() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("scenes"))
+        .expect("scenes/ exists")
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("ron" | "toml")))
+        .collect();
+    v.sort();
+    v
+}
+
+/// Overrides for a small test render.
+pub fn small(width: u32, height: u32, spp: u32) -> SceneOverrides {
+    SceneOverrides {
+        width: Some(width),
+        height: Some(height),
+        samples_per_pixel: Some(spp),
+        ..SceneOverrides::default()
+    }
+}
+
+/// Loads, compiles and renders a scene through the library.
+pub fn render_file(
+    path: &Path,
+    overrides: &SceneOverrides,
+    options: &RenderOptions,
+) -> (Film, RenderStats) {
+    let prepared = prepare(path, overrides).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let out = render(&prepared.render_scene, options)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    (out.film, out.stats)
+}
+
+/// Runs the `caustic` binary with `args` from the crate root.
+pub fn caustic(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_caustic"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("caustic runs")
+}
