@@ -5,6 +5,8 @@
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
+// `!(x > 0.0)` is used on purpose throughout: it is true for NaN, which must fail such checks.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod accel;
 pub mod bench;

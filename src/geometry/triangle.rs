@@ -10,8 +10,6 @@ use super::float::gamma;
 #[derive(Debug, Clone, Copy)]
 pub struct TriRay {
     origin: [f32; 3],
-    kx: usize,
-    ky: usize,
     kz: usize,
     sx: f32,
     sy: f32,
@@ -57,8 +55,6 @@ impl TriRay {
         let dz = d[kz];
         Self {
             origin: ray.origin.to_array(),
-            kx,
-            ky,
             kz,
             sx: -d[kx] / dz,
             sy: -d[ky] / dz,
@@ -178,6 +174,7 @@ pub fn is_degenerate(p0: Vec3, p1: Vec3, p2: Vec3) -> bool {
 }
 
 #[cfg(test)]
+#[allow(clippy::excessive_precision, clippy::inconsistent_digit_grouping)]
 mod tests {
     use super::*;
 

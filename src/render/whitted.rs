@@ -159,7 +159,7 @@ impl<'a> Whitted<'a> {
             log.as_deref_mut(),
         );
         if let Some((dir, w)) = lobes.refract {
-            l += spawn(dir, w, RayKind::Refract, log.as_deref_mut());
+            l += spawn(dir, w, RayKind::Refract, log);
         }
         (l, info)
     }

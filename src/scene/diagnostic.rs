@@ -83,10 +83,11 @@ impl Diagnostic {
     /// Attaches the file position of `self.path`, found with `index` in `text`.
     #[must_use]
     pub fn located(mut self, file: &Path, text: &str, index: &SourceIndex) -> Self {
-        if self.location.is_none() && !self.path.is_empty() {
-            if let Some(loc) = index.locate(&self.path) {
-                self.location = Some(SourcePoint::at(file, text, loc));
-            }
+        if self.location.is_none()
+            && !self.path.is_empty()
+            && let Some(loc) = index.locate(&self.path)
+        {
+            self.location = Some(SourcePoint::at(file, text, loc));
         }
         self
     }

@@ -166,10 +166,10 @@ fn parse_value(text: &str) -> Value {
     if let Ok(v) = serde_json::from_str::<Value>(text) {
         return v;
     }
-    if let Some(inner) = text.strip_prefix('(').and_then(|t| t.strip_suffix(')')) {
-        if let Ok(v) = serde_json::from_str::<Value>(&format!("[{inner}]")) {
-            return v;
-        }
+    if let Some(inner) = text.strip_prefix('(').and_then(|t| t.strip_suffix(')'))
+        && let Ok(v) = serde_json::from_str::<Value>(&format!("[{inner}]"))
+    {
+        return v;
     }
     Value::String(text.trim_matches('"').to_string())
 }

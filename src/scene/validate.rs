@@ -377,7 +377,7 @@ impl<'a> Validator<'a> {
                     ScaleSpec::Uniform(u) => [*u; 3],
                     ScaleSpec::PerAxis(v) => *v,
                 };
-                if self.finite3(path, v) && v.iter().any(|c| *c == 0.0) {
+                if self.finite3(path, v) && v.contains(&0.0) {
                     self.out.push(
                         Diagnostic::error(
                             path,

@@ -244,10 +244,8 @@ mod tests {
                     if l.reflect_dir.dot(ng) <= 0.0 {
                         bad += 1;
                     }
-                    if let Some((t, _)) = l.refract {
-                        if t.dot(ng) >= 0.0 {
-                            bad += 1;
-                        }
+                    if l.refract.is_some_and(|(t, _)| t.dot(ng) >= 0.0) {
+                        bad += 1;
                     }
                 }
             }
