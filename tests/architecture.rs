@@ -4,13 +4,69 @@ use std::path::Path;
 
 /// (module directory, crate paths it must not use)
 const RULES: &[(&str, &[&str])] = &[
-    ("src/geometry", &["crate::accel", "crate::render", "crate::scene", "crate::compile", "crate::shading", "crate::pipeline"]),
-    ("src/accel", &["crate::render", "crate::scene", "crate::compile", "crate::shading", "crate::pipeline"]),
-    ("src/sampling", &["crate::accel", "crate::render", "crate::scene", "crate::compile", "crate::pipeline"]),
-    ("src/shading", &["crate::accel", "crate::render", "crate::scene", "crate::compile", "crate::pipeline"]),
-    ("src/render_scene", &["crate::render::", "crate::scene", "crate::compile", "crate::pipeline"]),
-    ("src/render", &["crate::scene", "crate::compile", "crate::pipeline"]),
-    ("src/scene", &["crate::render", "crate::compile", "crate::accel", "crate::pipeline"]),
+    (
+        "src/geometry",
+        &[
+            "crate::accel",
+            "crate::render",
+            "crate::scene",
+            "crate::compile",
+            "crate::shading",
+            "crate::pipeline",
+        ],
+    ),
+    (
+        "src/accel",
+        &[
+            "crate::render",
+            "crate::scene",
+            "crate::compile",
+            "crate::shading",
+            "crate::pipeline",
+        ],
+    ),
+    (
+        "src/sampling",
+        &[
+            "crate::accel",
+            "crate::render",
+            "crate::scene",
+            "crate::compile",
+            "crate::pipeline",
+        ],
+    ),
+    (
+        "src/shading",
+        &[
+            "crate::accel",
+            "crate::render",
+            "crate::scene",
+            "crate::compile",
+            "crate::pipeline",
+        ],
+    ),
+    (
+        "src/render_scene",
+        &[
+            "crate::render::",
+            "crate::scene",
+            "crate::compile",
+            "crate::pipeline",
+        ],
+    ),
+    (
+        "src/render",
+        &["crate::scene", "crate::compile", "crate::pipeline"],
+    ),
+    (
+        "src/scene",
+        &[
+            "crate::render",
+            "crate::compile",
+            "crate::accel",
+            "crate::pipeline",
+        ],
+    ),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {

@@ -20,13 +20,7 @@ const SNAPSHOTS: &str = "snapshots/bad_scenes";
 /// Invalid scenes that `caustic check` currently ACCEPTS: known defects in src/, listed so the
 /// test passes while the defect is open. Each must still be accepted; once one is refused, src/
 /// was fixed: remove it from this list and accept its new snapshot.
-const KNOWN_ACCEPTED: &[&str] = &[
-    // A RON map with the same key twice keeps the last one silently.
-    "duplicate_material_name.ron",
-    // TOML arrays longer than 3 are truncated to 3 silently, whatever the extra elements are.
-    "type_array_too_long_mixed.toml",
-    "type_wrong_tuple_length.toml",
-];
+const KNOWN_ACCEPTED: &[&str] = &[];
 
 /// Files exempt from the "first line is a comment" rule (they could not contain one).
 const NO_COMMENT: &[&str] = &["empty.ron"];

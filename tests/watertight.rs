@@ -10,11 +10,19 @@ use glam::{Vec2, Vec3};
 
 fn closed_mesh(k: u32, scale: f32, offset: Vec3) -> (Geometry, Vec<Vec3>) {
     let mesh = blob_mesh(k);
-    let verts: Vec<Vec3> = mesh.positions.iter().map(|p| Vec3::from(*p) * scale + offset).collect();
+    let verts: Vec<Vec3> = mesh
+        .positions
+        .iter()
+        .map(|p| Vec3::from(*p) * scale + offset)
+        .collect();
     let mut b = GeometryBuilder::default();
     for t in &mesh.triangles {
         b.triangles.push(t.map(|i| verts[i as usize]));
-        b.tri_attrs.push(TriAttrs { object: 0, normals: None, uvs: [Vec2::ZERO; 3] });
+        b.tri_attrs.push(TriAttrs {
+            object: 0,
+            normals: None,
+            uvs: [Vec2::ZERO; 3],
+        });
     }
     (b.build(), verts)
 }
@@ -57,7 +65,10 @@ fn no_ray_escapes_a_closed_mesh_at_the_origin() {
 
 #[test]
 fn no_ray_escapes_a_closed_mesh_far_from_the_origin() {
-    assert_eq!(leaks(Vec3::new(148_376.0, 1234.0, -223_423.0), 200_000), (0, 0));
+    assert_eq!(
+        leaks(Vec3::new(148_376.0, 1234.0, -223_423.0), 200_000),
+        (0, 0)
+    );
 }
 
 #[test]

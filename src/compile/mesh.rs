@@ -48,6 +48,14 @@ impl MeshCache {
 fn read_obj(path: &Path) -> Result<ObjMesh, String> {
     let bytes = std::fs::read(path)
         .map_err(|e| format!("cannot read OBJ file `{}`: {e}", path.display()))?;
+    let text = std::str::from_utf8(&bytes).map_err(|e| {
+        format!(
+            "`{}` is not a text OBJ file (invalid UTF-8 at byte {})",
+            path.display(),
+            e.valid_up_to()
+        )
+    })?;
+    check_obj_text(text).map_err(|e| format!("`{}` {e}", path.display()))?;
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: true,
@@ -112,6 +120,75 @@ fn read_obj(path: &Path) -> Result<ObjMesh, String> {
         ));
     }
     Ok(mesh)
+}
+
+/// Checks the statements tobj relies on, so errors name the OBJ line: vertex records need
+/// numbers, faces need at least three corners whose indices refer to records defined so far.
+fn check_obj_text(text: &str) -> Result<(), String> {
+    let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
+    for (n, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        let mut words = line.split_whitespace();
+        let at = |msg: String| format!("line {}: `{}`: {msg}", n + 1, raw.trim());
+        match words.next() {
+            Some(kind @ ("v" | "vt" | "vn")) => {
+                let need = if kind == "vt" { 1 } else { 3 };
+                let nums: Vec<&str> = words.collect();
+                if nums.len() < need || nums.iter().any(|w| w.parse::<f32>().is_err()) {
+                    let what = if kind == "vt" {
+                        "a texture coordinate"
+                    } else {
+                        "a vertex or normal"
+                    };
+                    return Err(at(format!("{what} needs {need} or more numbers")));
+                }
+                match kind {
+                    "v" => v += 1,
+                    "vt" => vt += 1,
+                    _ => vn += 1,
+                }
+            }
+            Some("f") => {
+                let corners: Vec<&str> = words.collect();
+                if corners.len() < 3 {
+                    return Err(at("a face needs at least three corners".into()));
+                }
+                for corner in corners {
+                    for (i, (part, count, what)) in corner
+                        .split('/')
+                        .zip([(v, "vertex"), (vt, "texture coordinate"), (vn, "normal")])
+                        .map(|(p, (c, w))| (p, c, w))
+                        .enumerate()
+                    {
+                        if part.is_empty() && i > 0 {
+                            continue;
+                        }
+                        let index: i64 = part
+                            .parse()
+                            .map_err(|_| at(format!("`{corner}` is not a face corner")))?;
+                        let resolved = if index < 0 { count + index + 1 } else { index };
+                        if resolved < 1 || resolved > count {
+                            let plural = match what {
+                                "vertex" => "vertices",
+                                "normal" => "normals",
+                                _ => "texture coordinates",
+                            };
+                            return Err(at(format!(
+                                "the face uses {what} {index}, but only {count} {} defined above it",
+                                if count == 1 {
+                                    format!("{what} is")
+                                } else {
+                                    format!("{plural} are")
+                                }
+                            )));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 fn check_indices(mesh: &ObjMesh) -> Result<(), String> {

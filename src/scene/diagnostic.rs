@@ -119,7 +119,7 @@ impl SourcePoint {
 
 /// Width of the value token at the start of `rest`: a bracketed group on one line, a string, or
 /// a run of characters up to a delimiter.
-fn token_width(rest: &str) -> usize {
+pub(crate) fn token_width(rest: &str) -> usize {
     let mut chars = rest.chars();
     match chars.next() {
         None => 1,
@@ -174,27 +174,69 @@ impl fmt::Display for Diagnostic {
         if self.path.is_empty() {
             writeln!(f, "{label}: {}", self.message)?;
         } else {
-            writeln!(f, "{label}: {}: {}", self.path, self.message)?;
+            writeln!(f, "{label}: {}: {}", short_path(&self.path), self.message)?;
         }
         if let Some(p) = &self.location {
             let num = p.line.to_string();
             let pad = " ".repeat(num.len());
             writeln!(f, "{pad}--> {}:{}:{}", p.file.display(), p.line, p.column)?;
             writeln!(f, "{pad} |")?;
-            writeln!(f, "{num} | {}", p.line_text)?;
-            let lead: String = p
-                .line_text
+            let (text, caret_col) = excerpt_window(&p.line_text, p.column);
+            writeln!(f, "{num} | {text}")?;
+            let lead: String = text
                 .chars()
-                .take(p.column.saturating_sub(1))
+                .take(caret_col.saturating_sub(1))
                 .map(|c| if c == '\t' { '\t' } else { ' ' })
                 .collect();
-            writeln!(f, "{pad} | {lead}{}", "^".repeat(p.width))?;
+            let room = text
+                .chars()
+                .count()
+                .saturating_sub(caret_col.saturating_sub(1))
+                .max(1);
+            writeln!(f, "{pad} | {lead}{}", "^".repeat(p.width.clamp(1, room)))?;
         }
         if let Some(help) = &self.help {
             writeln!(f, "  = help: {help}")?;
         }
         Ok(())
     }
+}
+
+/// A field path shortened in the middle when it is very long (deeply nested groups).
+fn short_path(path: &str) -> String {
+    let chars: Vec<char> = path.chars().collect();
+    if chars.len() <= 120 {
+        return path.to_string();
+    }
+    let head: String = chars[..40].iter().collect();
+    let tail: String = chars[chars.len() - 70..].iter().collect();
+    format!("{head}…{tail}")
+}
+
+/// Longest excerpt shown; longer lines are cut to a window around the caret.
+const EXCERPT_WIDTH: usize = 100;
+
+/// A window of `line` around `column` no wider than [`EXCERPT_WIDTH`], and the column within it.
+fn excerpt_window(line: &str, column: usize) -> (String, usize) {
+    let chars: Vec<char> = line.chars().collect();
+    if chars.len() <= EXCERPT_WIDTH + 20 {
+        return (line.to_string(), column);
+    }
+    let start = column
+        .saturating_sub(1)
+        .saturating_sub(EXCERPT_WIDTH / 2)
+        .min(chars.len());
+    let end = (start + EXCERPT_WIDTH).min(chars.len());
+    let mut text: String = chars[start..end].iter().collect();
+    let mut col = column - start;
+    if start > 0 {
+        text.insert(0, '…');
+        col += 1;
+    }
+    if end < chars.len() {
+        text.push('…');
+    }
+    (text, col)
 }
 
 /// The closest of `candidates` to `found` by edit distance, if it is close enough to be a likely typo.

@@ -5,6 +5,7 @@ pub mod diagnostic;
 pub mod load;
 pub mod locate;
 pub mod overrides;
+mod parse;
 pub mod schema;
 pub mod validate;
 

@@ -24,7 +24,7 @@ pub fn apply_overrides(scene: &SceneFile, sets: &[String]) -> Result<SceneFile, 
         return Err(SceneError::Invalid(errors));
     }
     serde_path_to_error::deserialize::<_, SceneFile>(tree).map_err(|e| {
-        let path = super::load::user_path(&e.path().to_string());
+        let path = super::parse::user_path(&e.path().to_string());
         invalid(
             &format!("--set {path}"),
             format!(

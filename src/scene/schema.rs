@@ -24,6 +24,7 @@ pub struct SceneFile {
     /// The viewpoint.
     pub camera: CameraSpec,
     /// Named materials, referenced by name from nodes.
+    #[serde(deserialize_with = "unique_keys")]
     pub materials: BTreeMap<String, MaterialSpec>,
     /// Light sources. A scene without lights renders black except for what is emissive.
     #[serde(default)]
@@ -51,6 +52,7 @@ pub struct RenderSettings {
     /// Seed of every random stream; same seed and scene give the same image.
     pub seed: u64,
     /// Radiance seen by rays that leave the scene.
+    #[serde(deserialize_with = "exact_floats::<_, 3>")]
     pub background: Rgb,
     /// Linear scale applied to radiance before writing 8-bit images.
     pub exposure: f32,
@@ -89,11 +91,14 @@ pub enum CameraSpec {
     /// A pinhole camera.
     Pinhole {
         /// Eye position.
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
         eye: Vec3Spec,
         /// Point the camera looks at.
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
         look_at: Vec3Spec,
         /// Approximate up direction.
         #[serde(default = "default_up")]
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
         up: Vec3Spec,
         /// Vertical field of view in degrees, in (0, 180).
         fov_y: f32,
@@ -111,9 +116,11 @@ fn default_up() -> Vec3Spec {
 pub struct MaterialSpec {
     /// Albedo of the diffuse part and tint of the mirror and of transmitted light, each in [0, 1].
     #[serde(default = "default_color")]
+    #[serde(deserialize_with = "exact_floats::<_, 3>")]
     pub color: Rgb,
     /// Reflectance of the normalised Phong highlight, each in [0, 1].
     #[serde(default)]
+    #[serde(deserialize_with = "exact_floats::<_, 3>")]
     pub specular: Rgb,
     /// Phong exponent of the highlight.
     #[serde(default = "default_shininess")]
@@ -149,17 +156,21 @@ pub enum LightSpec {
     /// An isotropic point light with inverse-square falloff.
     Point {
         /// Position.
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
         position: Vec3Spec,
         /// Total emitted flux (W).
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
         power: Rgb,
     },
     /// A spherical area light emitting uniformly from its surface; gives soft shadows.
     Sphere {
         /// Centre.
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
         center: Vec3Spec,
         /// Radius (> 0).
         radius: f32,
         /// Total emitted flux (W).
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
         power: Rgb,
     },
 }
@@ -193,6 +204,7 @@ pub enum NodeSpec {
         material: String,
         /// Centre in object space.
         #[serde(default)]
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
         center: Vec3Spec,
         /// Radius in object space (> 0).
         #[serde(default = "one")]
@@ -224,6 +236,7 @@ pub enum NodeSpec {
         material: String,
         /// Width (x) and height (y) in object space (> 0).
         #[serde(default = "unit_size")]
+        #[serde(deserialize_with = "exact_floats::<_, 2>")]
         size: [f32; 2],
     },
     /// A triangle mesh from a Wavefront OBJ file (path relative to the scene file).
@@ -280,6 +293,70 @@ pub enum ScaleSpec {
     Uniform(f32),
     /// One factor per axis.
     PerAxis(Vec3Spec),
+}
+
+/// Deserialises a map, rejecting a key given twice (RON maps would otherwise keep the last one).
+fn unique_keys<'de, D: serde::Deserializer<'de>, V: Deserialize<'de>>(
+    d: D,
+) -> Result<BTreeMap<String, V>, D::Error> {
+    struct Unique<V>(std::marker::PhantomData<V>);
+    impl<'de, V: Deserialize<'de>> serde::de::Visitor<'de> for Unique<V> {
+        type Value = BTreeMap<String, V>;
+        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("a map of names to definitions")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut map: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out = BTreeMap::new();
+            while let Some(key) = map.next_key::<String>()? {
+                if out.contains_key(&key) {
+                    return Err(serde::de::Error::custom(format!(
+                        "`{key}` is defined twice"
+                    )));
+                }
+                let value = map.next_value()?;
+                out.insert(key, value);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_map(Unique(std::marker::PhantomData))
+}
+
+/// Deserialises exactly `N` numbers, rejecting longer lists (TOML arrays would otherwise be
+/// silently truncated to their first `N` items).
+fn exact_floats<'de, D: serde::Deserializer<'de>, const N: usize>(
+    d: D,
+) -> Result<[f32; N], D::Error> {
+    struct Exact<const N: usize>;
+    impl<'de, const N: usize> serde::de::Visitor<'de> for Exact<N> {
+        type Value = [f32; N];
+        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            write!(f, "{N} numbers")
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(
+            self,
+            mut seq: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out = [0.0f32; N];
+            for (i, slot) in out.iter_mut().enumerate() {
+                *slot = seq
+                    .next_element()?
+                    .ok_or_else(|| serde::de::Error::invalid_length(i, &self))?;
+            }
+            let mut extra = 0;
+            while seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                extra += 1;
+            }
+            if extra > 0 {
+                return Err(serde::de::Error::invalid_length(N + extra, &self));
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_tuple(N, Exact::<N>)
 }
 
 impl NodeSpec {

@@ -53,10 +53,8 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
     for (i, n) in scene.nodes.iter().enumerate() {
         v.node(&format!("nodes[{i}]"), n, 1);
     }
-    let dangling_refs = v
-        .out
-        .iter()
-        .any(|d| d.is_error() && d.message.starts_with("unknown material"));
+    // Unused materials are worth a warning only in a scene that is otherwise valid.
+    let dangling_refs = v.out.iter().any(Diagnostic::is_error);
     for name in scene.materials.keys() {
         if !dangling_refs && !v.used.contains(name.as_str()) {
             v.out.push(Diagnostic::warning(
