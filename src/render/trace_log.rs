@@ -41,6 +41,8 @@ pub struct ShadowRecord {
     pub occluded: bool,
     /// Radiance it added (zero when occluded).
     pub contribution: Vec3,
+    /// What blocked it (object name and distance), when occluded.
+    pub blocker: Option<(String, f32)>,
 }
 
 /// One ray of the tree.
@@ -159,6 +161,7 @@ impl TraceLog {
                     })),
                     "shadows": n.shadows.iter().map(|s| json!({
                         "light": s.light, "dir": arr(s.dir), "occluded": s.occluded, "contribution": arr(s.contribution),
+                        "blocker": s.blocker.as_ref().map(|(name, t)| json!({"object": name, "t": t})),
                     })).collect::<Vec<_>>(),
                     "radiance": arr(n.radiance),
                     "children": n.children,

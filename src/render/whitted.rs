@@ -198,11 +198,18 @@ impl<'a> Whitted<'a> {
                 if f == Vec3::ZERO {
                     continue;
                 }
-                let origin = offset_ray_origin(sp.p, sp.p_error, ng, ls.wi);
+                // Leaving a smooth mesh outward: start from the smooth surface (shadow terminator).
+                let start = if ng.dot(sp.ng) > 0.0 {
+                    sp.p_outside
+                } else {
+                    sp.p
+                };
+                let origin = offset_ray_origin(start, sp.p_error, ng, ls.wi);
+                // Aim at the sampled light point itself, stopping just short of it.
                 let shadow = Ray {
                     origin,
-                    dir: ls.wi,
-                    t_max: ls.distance * (1.0 - SHADOW_EPSILON),
+                    dir: ls.point - origin,
+                    t_max: 1.0 - SHADOW_EPSILON,
                 };
                 counters.rays += 1;
                 let occluded = self.scene.geometry.occluded(&shadow);
@@ -214,12 +221,21 @@ impl<'a> Whitted<'a> {
                 sum += c;
                 if let (Some(log), Some(me)) = (log.as_deref_mut(), me) {
                     let contribution = c / n as f32;
-                    log.nodes[me].shadows.push(ShadowRecord {
+                    let blocker = occluded
+                        .then(|| self.scene.geometry.intersect(&shadow))
+                        .flatten()
+                        .map(|h| {
+                            let object = self.scene.geometry.object_of(h.prim);
+                            (self.scene.objects[object as usize].name.clone(), h.t)
+                        });
+                    let record = ShadowRecord {
                         light: index,
                         dir: ls.wi,
                         occluded,
                         contribution,
-                    });
+                        blocker,
+                    };
+                    log.nodes[me].shadows.push(record);
                 }
             }
             total += sum / n as f32;

@@ -3,9 +3,8 @@
 use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 
 use crate::accel::{Bvh, RayBoxTest};
-use crate::geometry::float::gamma;
-use crate::geometry::sphere::{intersect_sphere, intersect_unit_quadric, reproject_to_sphere};
-use crate::geometry::triangle::{TriRay, hit_point_error, intersect_triangle_k};
+use crate::geometry::sphere::{intersect_sphere, intersect_unit_quadric};
+use crate::geometry::triangle::{TriRay, intersect_triangle_k};
 use crate::geometry::{Aabb, Ray};
 
 /// A primitive reference: kind in the top two bits, index into that kind's array below.
@@ -106,23 +105,6 @@ pub struct Hit {
     pub b1: f32,
     /// Barycentric weight of the third vertex (triangles).
     pub b2: f32,
-}
-
-/// Everything shading needs about a hit point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SurfacePoint {
-    /// Position.
-    pub p: Vec3,
-    /// Absolute error bound of `p`, per component, for robust ray spawning.
-    pub p_error: Vec3,
-    /// Unit geometric normal, outward (by winding for triangles).
-    pub ng: Vec3,
-    /// Unit shading normal, on the same side as `ng`.
-    pub ns: Vec3,
-    /// Texture coordinates.
-    pub uv: Vec2,
-    /// Owning object.
-    pub object: u32,
 }
 
 /// Primitives collected by the compiler before the BVH exists.
@@ -330,89 +312,4 @@ impl Geometry {
             PrimKind::Ellipsoid => self.ellipsoids[prim.index()].object,
         }
     }
-
-    /// Expands a hit of `ray` into a full surface record.
-    #[must_use]
-    pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfacePoint {
-        match hit.prim.kind() {
-            PrimKind::Triangle => {
-                let [p0, p1, p2] = self.triangles[hit.prim.index()];
-                let a = &self.tri_attrs[hit.prim.index()];
-                let b0 = 1.0 - hit.b1 - hit.b2;
-                let p = p0 * b0 + p1 * hit.b1 + p2 * hit.b2;
-                let th = crate::geometry::triangle::TriHit {
-                    t: hit.t,
-                    b0,
-                    b1: hit.b1,
-                    b2: hit.b2,
-                };
-                let ng = (p1 - p0).cross(p2 - p0).normalize();
-                let ns = match a.normals {
-                    Some([n0, n1, n2]) => {
-                        let n = (n0 * b0 + n1 * hit.b1 + n2 * hit.b2).normalize_or_zero();
-                        if n == Vec3::ZERO {
-                            ng
-                        } else if n.dot(ng) < 0.0 {
-                            -n
-                        } else {
-                            n
-                        }
-                    }
-                    None => ng,
-                };
-                let uv = a.uvs[0] * b0 + a.uvs[1] * hit.b1 + a.uvs[2] * hit.b2;
-                SurfacePoint {
-                    p,
-                    p_error: hit_point_error(&th, p0, p1, p2),
-                    ng,
-                    ns,
-                    uv,
-                    object: a.object,
-                }
-            }
-            PrimKind::Sphere => {
-                let s = &self.spheres[hit.prim.index()];
-                let c = s.center.as_dvec3();
-                let raw = ray.origin.as_dvec3() + ray.dir.as_dvec3() * f64::from(hit.t);
-                let pd = reproject_to_sphere(c, f64::from(s.radius), raw);
-                let n = ((pd - c) / f64::from(s.radius)).as_vec3().normalize();
-                let p = pd.as_vec3();
-                let uv = sphere_uv(n);
-                SurfacePoint {
-                    p,
-                    p_error: p.abs() * gamma(2),
-                    ng: n,
-                    ns: n,
-                    uv,
-                    object: s.object,
-                }
-            }
-            PrimKind::Ellipsoid => {
-                let e = &self.ellipsoids[hit.prim.index()];
-                let o = e.object_from_world.transform_point3(ray.origin.as_dvec3());
-                let d = e.object_from_world.transform_vector3(ray.dir.as_dvec3());
-                let po = reproject_to_sphere(DVec3::ZERO, 1.0, o + d * f64::from(hit.t));
-                let pd = e.world_from_object.transform_point3(po);
-                let n = (e.normal_to_world * po).as_vec3().normalize();
-                let p = pd.as_vec3();
-                let uv = sphere_uv(po.as_vec3());
-                SurfacePoint {
-                    p,
-                    p_error: p.abs() * gamma(3),
-                    ng: n,
-                    ns: n,
-                    uv,
-                    object: e.object,
-                }
-            }
-        }
-    }
-}
-
-/// Longitude/latitude coordinates of a unit direction: u from the azimuth about +y, v from the pole.
-#[inline]
-fn sphere_uv(n: Vec3) -> Vec2 {
-    let u = 0.5 + n.z.atan2(n.x) / std::f32::consts::TAU;
-    let v = n.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
-    Vec2::new(u, v)
 }

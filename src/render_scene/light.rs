@@ -33,6 +33,8 @@ pub struct LightSample {
     pub wi: Vec3,
     /// Distance to the sampled light point along `wi`.
     pub distance: f32,
+    /// The sampled point on the light (shadow rays end just before it).
+    pub point: Vec3,
     /// Incident radiance divided by the sample density (already includes 1/r² for points).
     pub weight: Vec3,
 }
@@ -74,6 +76,7 @@ impl Light {
                 Some(LightSample {
                     wi: d / dist,
                     distance: dist,
+                    point: position,
                     weight: intensity / dist2,
                 })
             }
@@ -106,6 +109,7 @@ impl Light {
                 Some(LightSample {
                     wi,
                     distance: t,
+                    point: p + wi * t,
                     weight: radiance * (2.0 * PI * one_minus_cos),
                 })
             }

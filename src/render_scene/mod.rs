@@ -3,10 +3,12 @@
 pub mod camera;
 pub mod geometry;
 pub mod light;
+pub mod surface;
 
 pub use camera::Camera;
-pub use geometry::{Geometry, Hit, PrimRef, SurfacePoint};
+pub use geometry::{Geometry, Hit, PrimRef};
 pub use light::Light;
+pub use surface::SurfacePoint;
 
 use glam::Vec3;
 
