@@ -47,14 +47,29 @@ fn ray_of(r: &WorkloadRay) -> Ray {
     Ray::new(Vec3::from(r.origin), Vec3::from(r.dir))
 }
 
+/// CPU time this thread has run, in seconds (Linux `schedstat`; 0 where unavailable). Unlike the
+/// wall clock it does not count time the thread waited for the CPU, so A/B comparisons on a
+/// shared machine are steadier.
+fn thread_cpu_secs() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<u64>().ok())
+        .map_or(0.0, |ns| ns as f64 * 1e-9)
+}
+
+/// Total CPU seconds of the worker threads of the last timed pass (see [`thread_cpu_secs`]).
+static CPU_NS: AtomicUsize = AtomicUsize::new(0);
+
 /// Runs `f(i)` for every ray index on `threads` OS threads taking chunks from a shared counter;
 /// returns the elapsed seconds.
 fn timed<F: Fn(usize) + Sync>(n: usize, threads: usize, f: F) -> f64 {
     let next = AtomicUsize::new(0);
+    CPU_NS.store(0, Ordering::Relaxed);
     let start = Instant::now();
     std::thread::scope(|s| {
         for _ in 0..threads {
             s.spawn(|| {
+                let _cpu = CpuTimer(thread_cpu_secs());
                 loop {
                     let begin = next.fetch_add(CHUNK, Ordering::Relaxed);
                     if begin >= n {
@@ -68,6 +83,20 @@ fn timed<F: Fn(usize) + Sync>(n: usize, threads: usize, f: F) -> f64 {
         }
     });
     start.elapsed().as_secs_f64()
+}
+
+/// Adds the thread's CPU time since construction to [`CPU_NS`] when dropped.
+struct CpuTimer(f64);
+
+impl Drop for CpuTimer {
+    fn drop(&mut self) {
+        let ns = ((thread_cpu_secs() - self.0) * 1e9) as usize;
+        CPU_NS.fetch_add(ns, Ordering::Relaxed);
+    }
+}
+
+fn cpu_secs() -> f64 {
+    CPU_NS.load(Ordering::Relaxed) as f64 * 1e-9
 }
 
 fn closest(g: &Geometry, rays: &[WorkloadRay], threads: usize) -> (f64, Vec<Option<(f32, u32)>>) {
@@ -161,21 +190,43 @@ fn main() {
             secondary.len()
         );
         for threads in [1usize, 2] {
+            let mut cpu = [Vec::new(), Vec::new(), Vec::new()];
             let prim = median(
                 (0..REPS)
-                    .map(|_| closest(&g, &primary, threads).0)
+                    .map(|_| {
+                        let s = closest(&g, &primary, threads).0;
+                        cpu[0].push(cpu_secs());
+                        s
+                    })
                     .collect(),
             );
             let sec = median(
                 (0..REPS)
-                    .map(|_| closest(&g, &secondary, threads).0)
+                    .map(|_| {
+                        let s = closest(&g, &secondary, threads).0;
+                        cpu[1].push(cpu_secs());
+                        s
+                    })
                     .collect(),
             );
             let any = median(
                 (0..REPS)
-                    .map(|_| any_hit(&g, &secondary, threads).0)
+                    .map(|_| {
+                        let s = any_hit(&g, &secondary, threads).0;
+                        cpu[2].push(cpu_secs());
+                        s
+                    })
                     .collect(),
             );
+            let [c0, c1, c2] = cpu.map(median);
+            if threads == 1 && c0 > 0.0 {
+                eprintln!(
+                    "{name}: 1 thread, rays per CPU second (Mrays/s): primary {:.3}, secondary closest {:.3}, any-hit {:.3}",
+                    primary.len() as f64 / c0 / 1e6,
+                    secondary.len() as f64 / c1 / 1e6,
+                    secondary.len() as f64 / c2 / 1e6
+                );
+            }
             let mr = |n: usize, s: f64| n as f64 / s / 1e6;
             let (p, s, a) = (
                 mr(primary.len(), prim),

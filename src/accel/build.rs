@@ -134,7 +134,8 @@ fn sah_split(
     let extent = centroid_bounds.extent();
     let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, bin boundary)
     for axis in 0..3 {
-        if !(extent[axis] > 0.0) {
+        // Also skips a NaN extent.
+        if extent[axis].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
         let scale = BINS as f32 / extent[axis];

@@ -1,5 +1,5 @@
-//! A flat two-wide bounding volume hierarchy, laid out for traversal: each 64-byte node holds
-//! the boxes of *both* children, so one cache line and one SIMD slab test decide both.
+//! A flat four-wide bounding volume hierarchy, laid out for traversal: each 128-byte node holds
+//! the boxes of up to four children in SIMD lanes, so one set of slab operations tests them all.
 
 use glam::Vec4;
 
@@ -19,34 +19,33 @@ pub struct BvhNode {
     pub count: u32,
 }
 
-/// A traversal node: the boxes of two children in SIMD-friendly order, and what each child is.
-/// `x = (a.min.x, a.max.x, b.min.x, b.max.x)`, likewise `y`, `z`. A child with `count > 0` is a
-/// leaf over slots `index .. index + count`; with `count == 0` it is the pair at `index`; an
-/// absent child has all bounds `+∞` (no ray enters it).
+/// A traversal node: the boxes of up to four children, one child per SIMD lane, and what each
+/// child is. `bounds[axis][0]` holds the children's lower slab planes on `axis`, `bounds[axis][1]`
+/// the upper ones. A child with `count > 0` is a leaf over slots `index .. index + count`; with
+/// `count == 0` it is the node at `index`. An absent child has the empty box `[+∞, -∞]` on every
+/// axis, which the slab test (near plane chosen by the direction's sign) never enters.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[repr(C, align(64))]
-pub struct NodePair {
-    /// x slabs of both children.
-    pub x: Vec4,
-    /// y slabs of both children.
-    pub y: Vec4,
-    /// z slabs of both children.
-    pub z: Vec4,
-    /// Child pair index or first slot, per child.
-    pub index: [u32; 2],
-    /// Leaf size per child (0 = interior).
-    pub count: [u32; 2],
+#[repr(C, align(128))]
+pub struct Node4 {
+    /// `[axis][min/max]` slab planes, one child per lane.
+    pub bounds: [[Vec4; 2]; 3],
+    /// Child node index or first slot, per child.
+    pub index: [u32; 4],
+    /// Leaf size per child (0 = interior or absent).
+    pub count: [u32; 4],
 }
 
 /// A BVH over a set of primitives: traversal nodes plus the order in which primitives appear in leaves.
 #[derive(Debug, Clone, Default)]
 pub struct Bvh {
-    /// Traversal nodes; pair 0 holds the root's children. Empty when there are no primitives.
-    pub pairs: Vec<NodePair>,
+    /// Traversal nodes; node 0 holds the root's children. Empty when there are no primitives.
+    pub nodes: Vec<Node4>,
     /// `order[slot]` is the index (in the build input) of the primitive stored at leaf slot `slot`.
     pub order: Vec<u32>,
     /// Bounds of everything.
     pub bounds: Aabb,
+    /// Upper bound on the traversal stack entries any ray can need (from the tree's shape).
+    pub(super) stack_need: usize,
 }
 
 /// Shape figures of a built BVH, for `--stats` and tests.
@@ -83,21 +82,42 @@ impl BvhNode {
     }
 }
 
-impl NodePair {
-    /// The bounds of child `i` (0 or 1).
+/// Slab planes of an absent child: the empty box.
+const ABSENT_MIN: f32 = f32::INFINITY;
+const ABSENT_MAX: f32 = f32::NEG_INFINITY;
+
+impl Node4 {
+    /// A node without children.
+    pub const EMPTY: Node4 = Node4 {
+        bounds: [[Vec4::splat(ABSENT_MIN), Vec4::splat(ABSENT_MAX)]; 3],
+        index: [0; 4],
+        count: [0; 4],
+    };
+
+    /// The bounds of child `i` (0..4).
     #[must_use]
     pub fn child_bounds(&self, i: usize) -> Aabb {
-        let (lo, hi) = (2 * i, 2 * i + 1);
+        let [x, y, z] = self.bounds;
         Aabb {
-            min: glam::Vec3::new(self.x[lo], self.y[lo], self.z[lo]),
-            max: glam::Vec3::new(self.x[hi], self.y[hi], self.z[hi]),
+            min: glam::Vec3::new(x[0][i], y[0][i], z[0][i]),
+            max: glam::Vec3::new(x[1][i], y[1][i], z[1][i]),
         }
     }
 
     /// True if child `i` exists.
     #[must_use]
     pub fn has_child(&self, i: usize) -> bool {
-        self.x[2 * i] != f32::INFINITY
+        self.bounds[0][0][i] != ABSENT_MIN
+    }
+
+    /// Makes child `c` the (padded) box `[min, max]` referring to `index`/`count`.
+    pub fn set_child(&mut self, c: usize, min: [f32; 3], max: [f32; 3], index: u32, count: u32) {
+        for axis in 0..3 {
+            self.bounds[axis][0][c] = min[axis];
+            self.bounds[axis][1][c] = max[axis];
+        }
+        self.index[c] = index;
+        self.count[c] = count;
     }
 }
 
@@ -105,12 +125,14 @@ impl Bvh {
     /// Builds a BVH with the binned surface-area heuristic over the given primitive bounds.
     #[must_use]
     pub fn build(bounds: &[Aabb]) -> Bvh {
-        let (nodes, order) = super::build::build(bounds);
-        let bounds = nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds);
+        let (binary, order) = super::build::build(bounds);
+        let bounds = binary.first().map_or(Aabb::EMPTY, BvhNode::bounds);
+        let (nodes, stack_need) = collapse(&binary);
         Bvh {
-            pairs: pair_up(&nodes),
+            nodes,
             order,
             bounds,
+            stack_need,
         }
     }
 
@@ -118,29 +140,29 @@ impl Bvh {
     #[must_use]
     pub fn stats(&self) -> BvhStats {
         let mut s = BvhStats::default();
-        if self.pairs.is_empty() {
+        if self.nodes.is_empty() {
             return s;
         }
         s.nodes = 1;
         let root_area = f64::from(self.bounds.half_area()).max(f64::MIN_POSITIVE);
         s.sah_cost = 1.0;
         let mut stack = vec![(0usize, 1usize)];
-        while let Some((p, depth)) = stack.pop() {
-            let pair = &self.pairs[p];
-            for c in 0..2 {
-                if !pair.has_child(c) {
+        while let Some((n, depth)) = stack.pop() {
+            let node = &self.nodes[n];
+            for c in 0..4 {
+                if !node.has_child(c) {
                     continue;
                 }
                 s.nodes += 1;
-                let area = f64::from(pair.child_bounds(c).half_area()) / root_area;
-                if pair.count[c] > 0 {
+                let area = f64::from(node.child_bounds(c).half_area()) / root_area;
+                if node.count[c] > 0 {
                     s.leaves += 1;
                     s.max_depth = s.max_depth.max(depth);
-                    s.max_leaf_size = s.max_leaf_size.max(pair.count[c] as usize);
-                    s.sah_cost += area * f64::from(pair.count[c]);
+                    s.max_leaf_size = s.max_leaf_size.max(node.count[c] as usize);
+                    s.sah_cost += area * f64::from(node.count[c]);
                 } else {
                     s.sah_cost += area;
-                    stack.push((pair.index[c] as usize, depth + 1));
+                    stack.push((node.index[c] as usize, depth + 1));
                 }
             }
         }
@@ -148,57 +170,75 @@ impl Bvh {
     }
 }
 
-const ABSENT: Vec4 = Vec4::splat(f32::INFINITY);
-
-/// Converts binary nodes into child pairs, depth first.
-fn pair_up(nodes: &[BvhNode]) -> Vec<NodePair> {
-    let Some(root) = nodes.first() else {
-        return Vec::new();
+/// Collapses the binary tree into four-wide nodes: starting from a node's two children, the
+/// interior child with the largest surface area is repeatedly replaced by its own two children
+/// until there are four or only leaves remain. Returns the nodes (depth first, parents before
+/// children) and a bound on the traversal stack: a node pushes at most `children - 1` entries.
+fn collapse(binary: &[BvhNode]) -> (Vec<Node4>, usize) {
+    let Some(root) = binary.first() else {
+        return (Vec::new(), 0);
     };
-    let empty = NodePair {
-        x: ABSENT,
-        y: ABSENT,
-        z: ABSENT,
-        index: [0; 2],
-        count: [0; 2],
-    };
-    let mut pairs = Vec::with_capacity(nodes.len() / 2 + 1);
     if root.is_leaf() {
-        let mut p = empty;
-        set_child(&mut p, 0, root, root.index);
-        p.count[0] = root.count;
-        pairs.push(p);
-        return pairs;
+        let mut n = Node4::EMPTY;
+        n.set_child(0, root.min, root.max, root.index, root.count);
+        return (vec![n], 0);
     }
-    // (binary interior node, pair slot to fill)
-    pairs.push(empty);
+    let mut nodes = Vec::with_capacity(binary.len() / 3 + 1);
+    nodes.push(Node4::EMPTY);
+    // (binary interior node, wide node to fill)
     let mut stack = vec![(0usize, 0usize)];
-    while let Some((node, slot)) = stack.pop() {
-        let first = nodes[node].index as usize;
-        let mut pair = empty;
-        for c in 0..2 {
-            let child = &nodes[first + c];
-            if child.is_leaf() {
-                set_child(&mut pair, c, child, child.index);
-                pair.count[c] = child.count;
+    while let Some((b, slot)) = stack.pop() {
+        let first = binary[b].index as usize;
+        let mut kids = [first, first + 1, 0, 0];
+        let mut k = 2;
+        while k < 4 {
+            let mut best: Option<(f32, usize)> = None;
+            for (i, &c) in kids[..k].iter().enumerate() {
+                if !binary[c].is_leaf() {
+                    let area = binary[c].bounds().half_area();
+                    if best.is_none_or(|(a, _)| area > a) {
+                        best = Some((area, i));
+                    }
+                }
+            }
+            let Some((_, i)) = best else { break };
+            let c = binary[kids[i]].index as usize;
+            kids[i] = c;
+            kids[k] = c + 1;
+            k += 1;
+        }
+        let mut node = Node4::EMPTY;
+        // Children's subtrees are filled in child order (stack pushed in reverse).
+        let mut pending = [(0usize, 0usize); 4];
+        let mut np = 0;
+        for (c, &child) in kids[..k].iter().enumerate() {
+            let n = &binary[child];
+            if n.is_leaf() {
+                node.set_child(c, n.min, n.max, n.index, n.count);
             } else {
-                let target = pairs.len();
-                pairs.push(empty);
-                set_child(&mut pair, c, child, target as u32);
-                stack.push((first + c, target));
+                let target = nodes.len();
+                nodes.push(Node4::EMPTY);
+                node.set_child(c, n.min, n.max, target as u32, 0);
+                pending[np] = (child, target);
+                np += 1;
             }
         }
-        pairs[slot] = pair;
+        nodes[slot] = node;
+        for &p in pending[..np].iter().rev() {
+            stack.push(p);
+        }
     }
-    pairs
-}
-
-fn set_child(pair: &mut NodePair, c: usize, node: &BvhNode, index: u32) {
-    pair.x[2 * c] = node.min[0];
-    pair.x[2 * c + 1] = node.max[0];
-    pair.y[2 * c] = node.min[1];
-    pair.y[2 * c + 1] = node.max[1];
-    pair.z[2 * c] = node.min[2];
-    pair.z[2 * c + 1] = node.max[2];
-    pair.index[c] = index;
+    // Children always follow their parent, so one backward sweep finds every subtree's need.
+    let mut need = vec![0usize; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        let n = &nodes[i];
+        let children = (0..4).filter(|&c| n.has_child(c)).count();
+        let deepest = (0..4)
+            .filter(|&c| n.has_child(c) && n.count[c] == 0)
+            .map(|c| need[n.index[c] as usize])
+            .max()
+            .unwrap_or(0);
+        need[i] = children.saturating_sub(1) + deepest;
+    }
+    (nodes, need[0])
 }

@@ -1,13 +1,17 @@
-//! Stack-based traversal without allocation: both children's slabs tested at once with SIMD,
-//! nearest child first, far children culled on pop once a closer hit is known.
+//! Stack-based traversal without allocation: the slabs of a node's four children tested at once
+//! with SIMD, children visited nearest first, far children culled on pop once a closer hit is known.
 
-use glam::{Vec3, Vec4, Vec4Swizzles};
+use glam::{Vec3, Vec4};
 
-use super::bvh::{Bvh, NodePair};
+use super::bvh::{Bvh, Node4};
 use crate::geometry::float::gamma;
 
-/// Traversal stack depth; the builder bounds tree depth well below this.
-const STACK: usize = 64;
+/// Traversal stack for ordinary trees; deeper trees (the builder's depth cap is what bounds them)
+/// use [`STACK_MAX`].
+const STACK_SMALL: usize = 48;
+/// Enough for any tree the builder makes: binary depth ≤ 64, so at most 64 wide levels pushing
+/// at most three entries each.
+const STACK_MAX: usize = 3 * 64 + 1;
 
 /// Widening of the far slab distance that covers the slab computation's rounding (pbrt's 1 + 2γ₃).
 const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
@@ -15,12 +19,18 @@ const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
 /// Per-ray constants of the slab test.
 #[derive(Debug, Clone, Copy)]
 pub struct RayBoxTest {
-    ox: Vec4,
-    oy: Vec4,
-    oz: Vec4,
-    ix: Vec4,
-    iy: Vec4,
-    iz: Vec4,
+    o: [Vec4; 3],
+    inv: [Vec4; 3],
+    /// Per axis, which of a node's planes (0 = min, 1 = max) the ray crosses first.
+    near: [usize; 3],
+}
+
+/// A deferred child: node index or first slot, leaf size (0 = node), entry distance.
+#[derive(Debug, Clone, Copy, Default)]
+struct Entry {
+    index: u32,
+    count: u32,
+    t: f32,
 }
 
 impl RayBoxTest {
@@ -29,37 +39,70 @@ impl RayBoxTest {
     /// an ulp beyond their geometry, so the ambiguous `0·∞` (an origin exactly on a slab plane)
     /// only occurs on planes that hold no geometry, where either answer is correct. A large finite
     /// stand-in for `1/0` would instead clip tiny boxes (tinybvh PR #286).
+    ///
+    /// The near plane per axis follows the sign of the reciprocal (so `-0` counts as negative,
+    /// consistently with `1/-0 = -∞`); the empty box `[+∞, -∞]` of an absent child then gives
+    /// near `+∞` and far `-∞` whatever the direction, and is never entered.
     #[inline]
     #[must_use]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        let inv = |d: f32| Vec4::splat(1.0 / d);
+        let inv = dir.recip();
+        let near = |i: f32| usize::from(i.is_sign_negative());
         Self {
-            ox: Vec4::splat(origin.x),
-            oy: Vec4::splat(origin.y),
-            oz: Vec4::splat(origin.z),
-            ix: inv(dir.x),
-            iy: inv(dir.y),
-            iz: inv(dir.z),
+            o: [
+                Vec4::splat(origin.x),
+                Vec4::splat(origin.y),
+                Vec4::splat(origin.z),
+            ],
+            inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            near: [near(inv.x), near(inv.y), near(inv.z)],
         }
     }
 
-    /// Entry distances of the ray into both children of `pair` (lanes 0 and 2), +∞ where the ray
-    /// misses the child or enters it only after `t_max`.
+    /// Which children of `node` the ray enters at or before `t_max` (bit `c` for child `c`), and
+    /// the entry distances per lane (`≥ 0`, never NaN; meaningful only for entered lanes).
+    ///
+    /// A NaN from `0·∞` is dropped by the min/max chains (SSE `min`/`max` return their second
+    /// operand), which only ever widens the slab interval: such a box is entered early or
+    /// spuriously, never skipped.
     #[inline(always)]
     #[must_use]
-    pub fn entries(&self, pair: &NodePair, t_max: f32) -> (f32, f32) {
-        let tx = (pair.x - self.ox) * self.ix;
-        let ty = (pair.y - self.oy) * self.iy;
-        let tz = (pair.z - self.oz) * self.iz;
-        // Lanes (lo, hi) per child after pairing each slab value with its partner.
-        let (sx, sy, sz) = (tx.yxwz(), ty.yxwz(), tz.yxwz());
-        let near = tx.min(sx).max(ty.min(sy)).max(tz.min(sz)).max(Vec4::ZERO);
-        let far = (tx.max(sx).min(ty.max(sy)).min(tz.max(sz)) * FAR_SCALE).min(Vec4::splat(t_max));
-        let hit = near.cmple(far).bitmask();
-        let a = if hit & 1 != 0 { near.x } else { f32::INFINITY };
-        let b = if hit & 4 != 0 { near.z } else { f32::INFINITY };
-        (a, b)
+    pub fn entries(&self, node: &Node4, t_max: f32) -> (u32, Vec4) {
+        let slab = |axis: usize| {
+            let n = self.near[axis] & 1;
+            let b = &node.bounds[axis];
+            let near = (b[n] - self.o[axis]) * self.inv[axis];
+            let far = (b[n ^ 1] - self.o[axis]) * self.inv[axis];
+            (near, far)
+        };
+        let (nx, fx) = slab(0);
+        let (ny, fy) = slab(1);
+        let (nz, fz) = slab(2);
+        let near = nx.max(ny).max(nz).max(Vec4::ZERO);
+        let far = (fx.min(fy).min(fz) * FAR_SCALE).min(Vec4::splat(t_max));
+        (near.cmple(far).bitmask(), near)
     }
+}
+
+/// Sort key of child `lane` entered at `t ≥ 0`: the distance's bits with the lane in the two
+/// lowest, so that keys order like distances (up to the dropped bits) and name their lane.
+#[inline(always)]
+fn key(t: f32, lane: u32) -> u32 {
+    (t.to_bits() & !3) | lane
+}
+
+/// The distance a key stands for: never more than the true entry distance, so culling with it
+/// is conservative.
+#[inline(always)]
+fn key_t(k: u32) -> f32 {
+    f32::from_bits(k & !3)
+}
+
+#[inline(always)]
+fn sort2(a: &mut u32, b: &mut u32) {
+    let (lo, hi) = ((*a).min(*b), (*a).max(*b));
+    *a = lo;
+    *b = hi;
 }
 
 impl Bvh {
@@ -70,55 +113,103 @@ impl Bvh {
     pub fn closest(
         &self,
         ray: &RayBoxTest,
+        t_max: f32,
+        test: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> f32 {
+        if self.nodes.is_empty() {
+            return t_max;
+        }
+        if self.stack_need <= STACK_SMALL {
+            self.closest_with::<STACK_SMALL>(ray, t_max, test)
+        } else {
+            self.closest_with::<STACK_MAX>(ray, t_max, test)
+        }
+    }
+
+    #[inline(always)]
+    fn closest_with<const N: usize>(
+        &self,
+        ray: &RayBoxTest,
         mut t_max: f32,
         mut test: impl FnMut(u32, f32) -> Option<f32>,
     ) -> f32 {
-        let pairs = &self.pairs[..];
-        if pairs.is_empty() {
-            return t_max;
-        }
-        let mut stack = [(0u32, 0.0f32); STACK];
+        let nodes = &self.nodes[..];
+        let mut stack = [Entry::default(); N];
         let mut sp = 0usize;
-        let mut pair = &pairs[0];
+        let (mut index, mut count) = (0u32, 0u32);
         loop {
-            let (ta, tb) = ray.entries(pair, t_max);
-            let (near, far, t_near, t_far) = if ta <= tb {
-                (0, 1, ta, tb)
-            } else {
-                (1, 0, tb, ta)
-            };
-            let mut next = None;
-            for (c, t) in [(near, t_near), (far, t_far)] {
-                // A missed child has t = +∞, which must be skipped even while t_max is +∞.
-                if t == f32::INFINITY || t > t_max {
-                    continue;
-                }
-                let (index, count) = (pair.index[c], pair.count[c]);
-                if count > 0 {
-                    for slot in index..index + count {
-                        if let Some(t) = test(slot, t_max) {
-                            t_max = t;
-                        }
+            if count == 0 {
+                let node = &nodes[index as usize];
+                let (mask, near) = ray.entries(node, t_max);
+                match mask.count_ones() {
+                    0 => {}
+                    1 => {
+                        let c = mask.trailing_zeros() as usize;
+                        (index, count) = (node.index[c], node.count[c]);
+                        continue;
                     }
-                } else if next.is_none() {
-                    next = Some(index);
-                } else {
-                    stack[sp] = (index, t);
-                    sp += 1;
+                    2 => {
+                        let a = mask.trailing_zeros() as usize;
+                        let b = 31 - mask.leading_zeros() as usize;
+                        let (ta, tb) = (near[a], near[b]);
+                        let (c, f, tf) = if ta <= tb { (a, b, tb) } else { (b, a, ta) };
+                        stack[sp] = Entry {
+                            index: node.index[f],
+                            count: node.count[f],
+                            t: tf,
+                        };
+                        sp += 1;
+                        (index, count) = (node.index[c], node.count[c]);
+                        continue;
+                    }
+                    n => {
+                        let t = near.to_array();
+                        let mut k = [u32::MAX; 4];
+                        let mut m = mask;
+                        for slot in &mut k {
+                            if m == 0 {
+                                break;
+                            }
+                            let c = m.trailing_zeros();
+                            *slot = key(t[c as usize], c);
+                            m &= m - 1;
+                        }
+                        let [mut k0, mut k1, mut k2, mut k3] = k;
+                        sort2(&mut k0, &mut k1);
+                        sort2(&mut k2, &mut k3);
+                        sort2(&mut k0, &mut k2);
+                        sort2(&mut k1, &mut k3);
+                        sort2(&mut k1, &mut k2);
+                        let sorted = [k0, k1, k2, k3];
+                        for &kk in sorted[1..n as usize].iter().rev() {
+                            let c = (kk & 3) as usize;
+                            stack[sp] = Entry {
+                                index: node.index[c],
+                                count: node.count[c],
+                                t: key_t(kk),
+                            };
+                            sp += 1;
+                        }
+                        let c = (k0 & 3) as usize;
+                        (index, count) = (node.index[c], node.count[c]);
+                        continue;
+                    }
                 }
-            }
-            if let Some(n) = next {
-                pair = &pairs[n as usize];
-                continue;
+            } else {
+                for slot in index..index + count {
+                    if let Some(t) = test(slot, t_max) {
+                        t_max = t;
+                    }
+                }
             }
             loop {
                 if sp == 0 {
                     return t_max;
                 }
                 sp -= 1;
-                let (index, t_entry) = stack[sp];
-                if t_entry <= t_max {
-                    pair = &pairs[index as usize];
+                let e = stack[sp];
+                if e.t <= t_max {
+                    (index, count) = (e.index, e.count);
                     break;
                 }
             }
@@ -127,49 +218,56 @@ impl Bvh {
 
     /// True as soon as `test(slot, t_max)` reports a hit in any leaf the ray reaches before `t_max`.
     #[inline]
-    pub fn any(
+    pub fn any(&self, ray: &RayBoxTest, t_max: f32, test: impl FnMut(u32, f32) -> bool) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        if self.stack_need <= STACK_SMALL {
+            self.any_with::<STACK_SMALL>(ray, t_max, test)
+        } else {
+            self.any_with::<STACK_MAX>(ray, t_max, test)
+        }
+    }
+
+    #[inline(always)]
+    fn any_with<const N: usize>(
         &self,
         ray: &RayBoxTest,
         t_max: f32,
         mut test: impl FnMut(u32, f32) -> bool,
     ) -> bool {
-        let pairs = &self.pairs[..];
-        if pairs.is_empty() {
-            return false;
-        }
-        let mut stack = [0u32; STACK];
+        let nodes = &self.nodes[..];
+        let mut stack = [(0u32, 0u32); N];
         let mut sp = 0usize;
-        let mut pair = &pairs[0];
+        let (mut index, mut count) = (0u32, 0u32);
         loop {
-            let (ta, tb) = ray.entries(pair, t_max);
-            let mut next = None;
-            for (c, t) in [(0, ta), (1, tb)] {
-                if t == f32::INFINITY {
+            if count == 0 {
+                let node = &nodes[index as usize];
+                let (mut mask, _) = ray.entries(node, t_max);
+                if mask != 0 {
+                    let c = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        let f = 31 - mask.leading_zeros() as usize;
+                        stack[sp] = (node.index[f], node.count[f]);
+                        sp += 1;
+                        mask &= !(1 << f);
+                    }
+                    (index, count) = (node.index[c], node.count[c]);
                     continue;
                 }
-                let (index, count) = (pair.index[c], pair.count[c]);
-                if count > 0 {
-                    for slot in index..index + count {
-                        if test(slot, t_max) {
-                            return true;
-                        }
+            } else {
+                for slot in index..index + count {
+                    if test(slot, t_max) {
+                        return true;
                     }
-                } else if next.is_none() {
-                    next = Some(index);
-                } else {
-                    stack[sp] = index;
-                    sp += 1;
                 }
-            }
-            if let Some(n) = next {
-                pair = &pairs[n as usize];
-                continue;
             }
             if sp == 0 {
                 return false;
             }
             sp -= 1;
-            pair = &pairs[stack[sp] as usize];
+            (index, count) = stack[sp];
         }
     }
 }
@@ -180,8 +278,8 @@ mod tests {
     use crate::accel::bvh::BvhNode;
     use crate::geometry::Aabb;
 
-    /// A pair whose first child is `b` (padded like the builder does) and whose second is absent.
-    fn pair_of(b: Aabb) -> NodePair {
+    /// A node whose first child is `b` (padded like the builder does) and whose others are absent.
+    fn node_of(b: Aabb) -> Node4 {
         let (min, max) = crate::accel::build::padded(b);
         let n = BvhNode {
             min,
@@ -189,20 +287,15 @@ mod tests {
             max,
             count: 1,
         };
-        let inf = f32::INFINITY;
-        NodePair {
-            x: Vec4::new(n.min[0], n.max[0], inf, inf),
-            y: Vec4::new(n.min[1], n.max[1], inf, inf),
-            z: Vec4::new(n.min[2], n.max[2], inf, inf),
-            index: [0, 0],
-            count: [1, 0],
-        }
+        let mut node = Node4::EMPTY;
+        node.set_child(0, n.min, n.max, n.index, n.count);
+        node
     }
 
     fn entry(b: Aabb, o: Vec3, d: Vec3, t_max: f32) -> Option<f32> {
-        let (a, absent) = RayBoxTest::new(o, d).entries(&pair_of(b), t_max);
-        assert_eq!(absent, f32::INFINITY, "absent child must never be entered");
-        (a != f32::INFINITY).then_some(a)
+        let (mask, near) = RayBoxTest::new(o, d).entries(&node_of(b), t_max);
+        assert_eq!(mask & !1, 0, "absent child must never be entered");
+        (mask & 1 != 0).then_some(near.x)
     }
 
     fn unit() -> Aabb {
