@@ -30,6 +30,13 @@ enum Command {
     Schema,
     /// Trace one sample of one pixel and print its ray tree.
     DebugPixel(DebugPixelArgs),
+    /// Compare an image with a reference (PNG or EXR): RMSE, relative MSE, max difference, bias.
+    Compare {
+        /// The image under test.
+        image: PathBuf,
+        /// The converged reference.
+        reference: PathBuf,
+    },
 }
 
 #[derive(Args)]
@@ -116,6 +123,7 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::DebugPixel(args) => cmd_debug_pixel(&args),
+        Command::Compare { image, reference } => cmd_compare(&image, &reference),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -257,5 +265,29 @@ fn cmd_debug_pixel(args: &DebugPixelArgs) -> Result<(), Error> {
         println!("pixel ({}, {}) sample {}:", args.x, args.y, args.sample);
         print!("{}", log.to_text());
     }
+    Ok(())
+}
+
+fn cmd_compare(image: &Path, reference: &Path) -> Result<(), Error> {
+    use caustic::render::metrics::{compare, read_film};
+    let read = |p: &Path| {
+        read_film(p).map_err(|e| Error::Usage(format!("error: cannot read `{}`: {e}", p.display())))
+    };
+    let (a, b) = (read(image)?, read(reference)?);
+    let e = compare(&a, &b).ok_or_else(|| {
+        Error::Usage(format!(
+            "error: `{}` is {}×{} but `{}` is {}×{}",
+            image.display(),
+            a.width,
+            a.height,
+            reference.display(),
+            b.width,
+            b.height
+        ))
+    })?;
+    println!(
+        "rmse {:.6}  relMSE {:.6}  max |diff| {:.6}  mean bias {:+.6}",
+        e.rmse, e.rel_mse, e.max_abs, e.mean_bias
+    );
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! Rendering: integrators, the tile scheduler, the film and image output.
 
 pub mod film;
+pub mod metrics;
 pub mod output;
 pub mod tiles;
 pub mod trace_log;
