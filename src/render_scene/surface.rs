@@ -27,6 +27,11 @@ pub struct SurfacePoint {
     pub p_outside: Vec3,
     /// Texture coordinates.
     pub uv: Vec2,
+    /// ∂p/∂u: how the position changes with `u` (a tangent; never zero — a surface without a
+    /// usable parameterisation gets an orthonormal tangent frame instead).
+    pub dpdu: Vec3,
+    /// ∂p/∂v.
+    pub dpdv: Vec3,
     /// Owning object.
     pub object: u32,
 }
@@ -62,6 +67,7 @@ impl Geometry {
                     None => ng,
                 };
                 let uv = a.uvs[0] * b0 + a.uvs[1] * hit.b1 + a.uvs[2] * hit.b2;
+                let (dpdu, dpdv) = triangle_derivatives([p0, p1, p2], a.uvs, ng);
                 let p_outside = a.normals.map_or(p, |n| {
                     terminator_point(p, [p0, p1, p2], n, [b0, hit.b1, hit.b2])
                 });
@@ -72,6 +78,8 @@ impl Geometry {
                     ng,
                     ns,
                     uv,
+                    dpdu,
+                    dpdv,
                     object: a.object,
                 }
             }
@@ -83,6 +91,7 @@ impl Geometry {
                 let n = ((pd - c) / f64::from(s.radius)).as_vec3().normalize();
                 let p = pd.as_vec3();
                 let uv = sphere_uv(n);
+                let (dpdu, dpdv) = sphere_derivatives(n, s.radius);
                 SurfacePoint {
                     p,
                     p_outside: p,
@@ -90,6 +99,8 @@ impl Geometry {
                     ng: n,
                     ns: n,
                     uv,
+                    dpdu,
+                    dpdv,
                     object: s.object,
                 }
             }
@@ -102,6 +113,10 @@ impl Geometry {
                 let n = (e.normal_to_world * po).as_vec3().normalize();
                 let p = pd.as_vec3();
                 let uv = sphere_uv(po.as_vec3());
+                let (du, dv) = sphere_derivatives(po.as_vec3(), 1.0);
+                let l = e.world_from_object.matrix3;
+                let dpdu = (l * du.as_dvec3()).as_vec3();
+                let dpdv = (l * dv.as_dvec3()).as_vec3();
                 SurfacePoint {
                     p,
                     p_outside: p,
@@ -109,11 +124,47 @@ impl Geometry {
                     ng: n,
                     ns: n,
                     uv,
+                    dpdu,
+                    dpdv,
                     object: e.object,
                 }
             }
         }
     }
+}
+
+/// ∂p/∂u and ∂p/∂v of a triangle from its vertex uvs; an orthonormal tangent frame around `ng`
+/// when the uvs are degenerate (e.g. a mesh without texture coordinates).
+fn triangle_derivatives(p: [Vec3; 3], uv: [Vec2; 3], ng: Vec3) -> (Vec3, Vec3) {
+    let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
+    let (dp02, dp12) = (p[0] - p[2], p[1] - p[2]);
+    let det = duv02.x * duv12.y - duv02.y * duv12.x;
+    if det.abs() > 1e-12 {
+        let inv = 1.0 / det;
+        let dpdu = (dp02 * duv12.y - dp12 * duv02.y) * inv;
+        let dpdv = (dp12 * duv02.x - dp02 * duv12.x) * inv;
+        if dpdu.cross(dpdv).length_squared() > 0.0 && dpdu.is_finite() && dpdv.is_finite() {
+            return (dpdu, dpdv);
+        }
+    }
+    let f = crate::geometry::Frame::from_normal(ng);
+    (f.s, f.t)
+}
+
+/// ∂p/∂u and ∂p/∂v of the longitude/latitude parameterisation of a sphere of radius `r` at unit
+/// direction `n` (relative to the centre); at the poles, where ∂p/∂u vanishes, a tangent frame.
+fn sphere_derivatives(n: Vec3, r: f32) -> (Vec3, Vec3) {
+    use std::f32::consts::{PI, TAU};
+    let rho = (n.x * n.x + n.z * n.z).sqrt();
+    if rho < 1e-6 {
+        let f = crate::geometry::Frame::from_normal(n);
+        return (f.s * (TAU * r), f.t * (PI * r));
+    }
+    // u = 0.5 + atan2(z, x)/2π, v = acos(y)/π.
+    let dpdu = Vec3::new(-n.z, 0.0, n.x) * (TAU * r);
+    let (cos_phi, sin_phi) = (n.x / rho, n.z / rho);
+    let dpdv = Vec3::new(n.y * cos_phi, -rho, n.y * sin_phi) * (PI * r);
+    (dpdu, dpdv)
 }
 
 /// `p` moved off a flat triangle onto the smooth surface its vertex normals describe: the
@@ -138,6 +189,58 @@ fn sphere_uv(n: Vec3) -> Vec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sphere_derivatives_match_finite_differences_of_the_parameterisation() {
+        // p(u, v) for the parameterisation u = 0.5 + atan2(z, x)/2π, v = acos(y)/π.
+        let p = |u: f32, v: f32| {
+            let (phi, theta) = ((u - 0.5) * std::f32::consts::TAU, v * std::f32::consts::PI);
+            Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            ) * 2.0
+        };
+        for (u, v) in [(0.3f32, 0.4f32), (0.8, 0.7), (0.55, 0.1)] {
+            let n = p(u, v) / 2.0;
+            assert!(sphere_uv(n).distance(Vec2::new(u, v)) < 1e-5);
+            let (du, dv) = sphere_derivatives(n, 2.0);
+            let h = 1e-3;
+            let fu = (p(u + h, v) - p(u - h, v)) / (2.0 * h);
+            let fv = (p(u, v + h) - p(u, v - h)) / (2.0 * h);
+            assert!(du.distance(fu) < 1e-2 * fu.length(), "{du} vs {fu}");
+            assert!(dv.distance(fv) < 1e-2 * fv.length(), "{dv} vs {fv}");
+        }
+        // Poles: finite, tangent, non-zero.
+        let (du, dv) = sphere_derivatives(Vec3::Y, 1.0);
+        assert!(
+            du.length() > 0.0
+                && dv.length() > 0.0
+                && du.dot(Vec3::Y).abs() < 1e-6
+                && dv.dot(Vec3::Y).abs() < 1e-6
+        );
+    }
+
+    #[test]
+    fn triangle_derivatives_follow_the_uvs_or_fall_back_to_a_frame() {
+        let p = [
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 3.0, 0.0),
+        ];
+        let uv = [Vec2::ZERO, Vec2::X, Vec2::Y];
+        let (du, dv) = triangle_derivatives(p, uv, Vec3::Z);
+        assert!(
+            du.distance(Vec3::new(2.0, 0.0, 0.0)) < 1e-6
+                && dv.distance(Vec3::new(0.0, 3.0, 0.0)) < 1e-6
+        );
+        let (du, dv) = triangle_derivatives(p, [Vec2::ZERO; 3], Vec3::Z);
+        assert!(
+            (du.length() - 1.0).abs() < 1e-6
+                && du.dot(dv).abs() < 1e-6
+                && du.dot(Vec3::Z).abs() < 1e-6
+        );
+    }
 
     #[test]
     fn terminator_point_lifts_a_flat_facet_towards_the_smooth_sphere() {
