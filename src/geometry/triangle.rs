@@ -217,6 +217,46 @@ mod tests {
     }
 
     #[test]
+    fn ray_starting_on_the_triangle_does_not_rehit_it() {
+        let tri = [
+            Vec3::new(1e4, 0.0, 3.0),
+            Vec3::new(1e4 + 1.0, 0.2, 3.1),
+            Vec3::new(1e4, 1.0, 2.9),
+        ];
+        let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize();
+        let mut rehits = 0;
+        for i in 1..20 {
+            for j in 1..(20 - i) {
+                let h = TriHit {
+                    t: 0.0,
+                    b0: 1.0 - (i + j) as f32 / 20.0,
+                    b1: i as f32 / 20.0,
+                    b2: j as f32 / 20.0,
+                };
+                let p = tri[0] * h.b0 + tri[1] * h.b1 + tri[2] * h.b2;
+                let err = hit_point_error(&h, tri[0], tri[1], tri[2]);
+                for w in [
+                    n,
+                    -n,
+                    (n + Vec3::X).normalize(),
+                    (Vec3::Y - n * 0.999).normalize(),
+                ] {
+                    let o = crate::geometry::offset::offset_ray_origin(p, err, n, w);
+                    if hit(o, w, tri).is_some() {
+                        rehits += 1;
+                    }
+                    // Grazing: almost in the plane.
+                    let graze = (w - n * n.dot(w) + n * 1e-4 * n.dot(w).signum()).normalize();
+                    if hit(o, graze, tri).is_some() {
+                        rehits += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(rehits, 0);
+    }
+
+    #[test]
     fn degenerate_triangles_never_hit() {
         let same = [Vec3::ONE, Vec3::ONE, Vec3::ONE];
         let collinear = [Vec3::ZERO, Vec3::X, Vec3::X * 2.0];
