@@ -2,6 +2,18 @@
 //!
 //! The pipeline is `scene` (schema, load, validate) → `compile` (flat render scene) → `render`
 //! (integrators, tiles, film), with `geometry`, `accel`, `shading` and `sampling` beneath.
+//!
+//! ```
+//! use caustic::pipeline::{SceneOverrides, prepare};
+//! use caustic::render::{RenderOptions, render};
+//!
+//! let small = SceneOverrides { width: Some(8), height: Some(6), samples_per_pixel: Some(1), ..Default::default() };
+//! let prepared = prepare(std::path::Path::new("scenes/cornell.ron"), &small)?;
+//! let out = render(&prepared.render_scene, &RenderOptions::default())?;
+//! assert_eq!((out.film.width, out.film.height), (8, 6));
+//! assert_eq!(out.stats.nan_samples, 0);
+//! # Ok::<(), caustic::Error>(())
+//! ```
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
