@@ -15,9 +15,13 @@ pub fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
 #[inline]
 #[must_use]
 pub fn refract(wo: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    if eta == 1.0 {
+        // Index-matched: exactly straight through, even at grazing angles.
+        return Some(-wo);
+    }
     let cos_i = n.dot(wo).clamp(-1.0, 1.0);
     let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
-    if sin2_t >= 1.0 {
+    if sin2_t > 1.0 {
         return None;
     }
     let cos_t = (1.0 - sin2_t).sqrt();
