@@ -8,18 +8,25 @@ use glam::{Vec2, Vec3};
 
 /// One triangle corner: indices into positions, normals and texture coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Corner {
+pub struct Corner {
+    /// Position index.
     pub p: u32,
+    /// Normal index, if the face has normals.
     pub n: Option<u32>,
+    /// Texture-coordinate index, if the face has them.
     pub t: Option<u32>,
 }
 
-/// An OBJ file's geometry in object space.
+/// An OBJ file's geometry in object space, every index checked.
 #[derive(Debug, Default)]
-pub(super) struct ObjMesh {
+pub struct ObjMesh {
+    /// Vertex positions.
     pub positions: Vec<Vec3>,
+    /// Vertex normals (as written, not normalised).
     pub normals: Vec<Vec3>,
+    /// Texture coordinates.
     pub uvs: Vec<Vec2>,
+    /// Triangles (polygons are fan-triangulated by tobj).
     pub triangles: Vec<[Corner; 3]>,
 }
 
@@ -48,6 +55,11 @@ impl MeshCache {
 fn read_obj(path: &Path) -> Result<ObjMesh, String> {
     let bytes = std::fs::read(path)
         .map_err(|e| format!("cannot read OBJ file `{}`: {e}", path.display()))?;
+    parse_obj(&bytes, path)
+}
+
+/// Parses OBJ bytes (`path` only names the file in messages); the error is a user-facing sentence.
+pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
     let text = std::str::from_utf8(&bytes).map_err(|e| {
         format!(
             "`{}` is not a text OBJ file (invalid UTF-8 at byte {})",
@@ -62,7 +74,7 @@ fn read_obj(path: &Path) -> Result<ObjMesh, String> {
         ignore_points: true,
         ignore_lines: true,
     };
-    let mut reader = std::io::BufReader::new(&bytes[..]);
+    let mut reader = std::io::BufReader::new(bytes);
     // Materials come from the scene file, so .mtl files are never opened.
     let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)

@@ -2,7 +2,7 @@
 //! flat [`RenderScene`] (world-space primitives, resolved indices, BVH), keeping only what the
 //! scene uses.
 
-mod mesh;
+pub mod mesh;
 mod nodes;
 
 use std::collections::BTreeMap;
