@@ -60,7 +60,7 @@ fn read_obj(path: &Path) -> Result<ObjMesh, String> {
 
 /// Parses OBJ bytes (`path` only names the file in messages); the error is a user-facing sentence.
 pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
-    let text = std::str::from_utf8(&bytes).map_err(|e| {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
         format!(
             "`{}` is not a text OBJ file (invalid UTF-8 at byte {})",
             path.display(),
