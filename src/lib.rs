@@ -31,5 +31,6 @@ pub mod render_scene;
 pub mod sampling;
 pub mod scene;
 pub mod shading;
+pub mod texture;
 
 pub use error::Error;
