@@ -3,6 +3,7 @@
 use glam::Vec3;
 
 use super::Film;
+use crate::texture::srgb_to_linear;
 
 /// Differences between a test image and a reference of the same size.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,7 +49,7 @@ pub fn read_film(path: &std::path::Path) -> Result<Film, image::ImageError> {
     let img = image::open(path)?;
     let linear = matches!(path.extension().and_then(|e| e.to_str()), Some(e) if e.eq_ignore_ascii_case("exr"));
     let rgb = img.into_rgb32f();
-    let decode = |c: f32| if linear { c } else { srgb_decode(c) };
+    let decode = |c: f32| if linear { c } else { srgb_to_linear(c) };
     let pixels = rgb
         .pixels()
         .map(|p| Vec3::new(decode(p.0[0]), decode(p.0[1]), decode(p.0[2])))
@@ -58,16 +59,6 @@ pub fn read_film(path: &std::path::Path) -> Result<Film, image::ImageError> {
         height: rgb.height(),
         pixels,
     })
-}
-
-/// Inverse of the sRGB transfer function.
-#[must_use]
-pub fn srgb_decode(v: f32) -> f32 {
-    if v <= 0.040_45 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 #[cfg(test)]
@@ -92,7 +83,7 @@ mod tests {
     fn srgb_round_trip() {
         for v in [0.0f32, 0.002, 0.2, 0.5, 1.0] {
             let e = crate::render::output::srgb_encode(v);
-            assert!((srgb_decode(e) - v).abs() < 1e-5);
+            assert!((srgb_to_linear(e) - v).abs() < 1e-5);
         }
     }
 }
