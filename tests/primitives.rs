@@ -1,6 +1,8 @@
 //! Primitives as compiled from scene files: transforms baked correctly (non-uniform scale of a
 //! sphere, rotated cubes, mirrored transforms keep outward normals), hits at the right distance.
 
+mod common;
+
 use std::path::Path;
 
 use caustic::compile::compile;
@@ -10,13 +12,10 @@ use caustic::scene::SourceFile;
 use glam::Vec3;
 
 fn scene(nodes: &str) -> RenderScene {
-    let text = format!(
+    common::scene_from_text(&format!(
         "Scene(camera: Pinhole(eye: (0, 0, 10), look_at: (0, 0, 0), fov_y: 40), \
          materials: {{ \"m\": () }}, lights: [Point(position: (0, 5, 5), power: (10, 10, 10))], nodes: [{nodes}])"
-    );
-    let src = SourceFile::new(Path::new("inline.ron"), text).expect("ron");
-    let file = src.parse().unwrap_or_else(|e| panic!("{e}"));
-    compile(&file, Path::new(".")).expect("compiles").0
+    ))
 }
 
 fn hit(s: &RenderScene, o: Vec3, d: Vec3) -> Option<(f32, Vec3)> {

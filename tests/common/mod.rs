@@ -5,8 +5,12 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use caustic::compile::compile;
 use caustic::pipeline::{SceneOverrides, prepare};
 use caustic::render::{Film, RenderOptions, RenderStats, render};
+use caustic::render_scene::RenderScene;
+use caustic::scene::SourceFile;
+use caustic::scene::validate::validate;
 
 /// The crate root (tests run with it as the working directory, but be explicit).
 pub fn root() -> PathBuf {
@@ -53,4 +57,13 @@ pub fn caustic(args: &[&str]) -> Output {
         .current_dir(root())
         .output()
         .expect("caustic runs")
+}
+
+/// Parses, validates (no errors allowed) and compiles a RON scene given as text.
+pub fn scene_from_text(text: &str) -> RenderScene {
+    let src = SourceFile::new(Path::new("inline.ron"), text.to_string()).expect("ron");
+    let file = src.parse().unwrap_or_else(|e| panic!("{e}\n{text}"));
+    let diags = validate(&file);
+    assert!(!diags.iter().any(|d| d.is_error()), "{diags:?}");
+    compile(&file, Path::new(".")).expect("compiles").0
 }
