@@ -20,12 +20,6 @@ pub struct SourceFile {
     index: OnceCell<SourceIndex>,
 }
 
-impl std::fmt::Debug for SourceIndex {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("SourceIndex")
-    }
-}
-
 /// A parsed (not yet validated) scene with its source.
 #[derive(Debug)]
 pub struct LoadedScene {

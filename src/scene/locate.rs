@@ -78,6 +78,7 @@ impl Tree {
 }
 
 /// An index from field paths to the positions of their values in one source text.
+#[derive(Debug)]
 pub struct SourceIndex {
     text: String,
     line_starts: Vec<usize>,

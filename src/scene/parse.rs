@@ -99,14 +99,6 @@ fn ron_error(src: &SourceFile, code: &ron::Error, path: &str, at: (usize, usize)
             return place(src, d(text), Some(at));
         }
     };
-    let diag = if diag.path.is_empty() {
-        Diagnostic {
-            path: path.to_string(),
-            ..diag
-        }
-    } else {
-        diag
-    };
     place(
         src,
         Diagnostic {
