@@ -24,7 +24,8 @@ pub struct ObjMesh {
     pub positions: Vec<Vec3>,
     /// Vertex normals (as written, not normalised).
     pub normals: Vec<Vec3>,
-    /// Texture coordinates.
+    /// Texture coordinates in the renderer's convention (v grows downwards, so OBJ's
+    /// bottom-up `vt` v is stored as 1 − v).
     pub uvs: Vec<Vec2>,
     /// Triangles (polygons are fan-triangulated by tobj).
     pub triangles: Vec<[Corner; 3]>,
@@ -98,8 +99,11 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
                 .chunks_exact(3)
                 .map(|c| Vec3::new(c[0], c[1], c[2])),
         );
-        mesh.uvs
-            .extend(m.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])));
+        mesh.uvs.extend(
+            m.texcoords
+                .chunks_exact(2)
+                .map(|c| Vec2::new(c[0], 1.0 - c[1])),
+        );
         let has_n = m.normal_indices.len() == m.indices.len();
         let has_t = m.texcoord_indices.len() == m.indices.len();
         for (f, tri) in m.indices.chunks_exact(3).enumerate() {

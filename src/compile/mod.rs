@@ -2,21 +2,18 @@
 //! flat [`RenderScene`] (world-space primitives, resolved indices, BVH), keeping only what the
 //! scene uses.
 
+mod materials;
 pub mod mesh;
 mod nodes;
 
-use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::{Duration, Instant};
-
-use glam::Vec3;
 
 use crate::accel::BvhStats;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::render_scene::{Camera, Light, ObjectInfo, RenderParams, RenderScene};
 use crate::scene::Diagnostic;
-use crate::scene::schema::{CameraSpec, LightSpec, SceneFile};
-use crate::shading::Material;
+use crate::scene::schema::{CameraSpec, LightSpec, SceneFile, TextureFilter};
 
 /// Counts and timings of a compilation, for `--stats`.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -35,6 +32,10 @@ pub struct CompileStats {
     pub lights: usize,
     /// Distinct OBJ files loaded.
     pub meshes_loaded: usize,
+    /// Textures kept (used by some kept material).
+    pub textures: usize,
+    /// Image files decoded for textures.
+    pub images_loaded: usize,
     /// Time to load meshes and flatten the node tree.
     pub flatten_time: Duration,
     /// Time to build the BVH and reorder primitives.
@@ -50,7 +51,7 @@ pub fn compile(
 ) -> Result<(RenderScene, CompileStats), Vec<Diagnostic>> {
     let t0 = Instant::now();
     let mut stats = CompileStats::default();
-    let mut materials = MaterialTable::default();
+    let mut materials = materials::MaterialTable::default();
     let mut objects = Vec::new();
     let mut builder = GeometryBuilder::default();
     let mut errors = Vec::new();
@@ -105,6 +106,8 @@ pub fn compile(
     stats.spheres = builder.spheres.len();
     stats.ellipsoids = builder.ellipsoids.len();
     stats.materials = materials.list.len();
+    stats.textures = materials.textures.list.len();
+    stats.images_loaded = materials.textures.images_loaded;
     stats.lights = lights.len();
 
     let t1 = Instant::now();
@@ -123,6 +126,7 @@ pub fn compile(
         seed: r.seed,
         background: r.background.into(),
         exposure: r.exposure,
+        mipmaps: r.texture_filter == TextureFilter::Trilinear,
     };
     let CameraSpec::Pinhole {
         eye,
@@ -137,12 +141,14 @@ pub fn compile(
         fov_y,
         r.width as f32 / r.height as f32,
     );
+    let textures = std::mem::take(&mut materials.textures.list);
     let (material_names, materials) = materials.list.into_iter().unzip();
     Ok((
         RenderScene {
             params,
             camera,
             materials,
+            textures,
             material_names,
             lights,
             objects,
@@ -150,31 +156,4 @@ pub fn compile(
         },
         stats,
     ))
-}
-
-/// Materials resolved on first use, so unused ones are not compiled.
-#[derive(Default)]
-struct MaterialTable {
-    index: BTreeMap<String, u32>,
-    list: Vec<(String, Material)>,
-}
-
-impl MaterialTable {
-    fn resolve(&mut self, scene: &SceneFile, name: &str) -> Option<u32> {
-        if let Some(&i) = self.index.get(name) {
-            return Some(i);
-        }
-        let m = scene.materials.get(name)?;
-        let i = self.list.len() as u32;
-        let material = Material::new(
-            Vec3::from(m.color),
-            Vec3::from(m.specular),
-            m.shininess,
-            [m.diffuse, m.reflect, m.transmit],
-            m.ior,
-        );
-        self.list.push((name.to_string(), material));
-        self.index.insert(name.to_string(), i);
-        Some(i)
-    }
 }

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 
-use super::MaterialTable;
+use super::materials::MaterialTable;
 use super::mesh::MeshCache;
 use crate::geometry::triangle::is_degenerate;
 use crate::render_scene::ObjectInfo;
@@ -49,9 +49,10 @@ pub(crate) fn transform_of(steps: &[TransformStep]) -> DAffine3 {
 impl Flattener<'_> {
     pub fn node(&mut self, path: &str, node: &NodeSpec, parent: DAffine3) {
         let xf = parent * transform_of(node.transform());
-        let material = node
-            .material()
-            .and_then(|m| self.materials.resolve(self.scene, m));
+        let material = node.material().and_then(|m| {
+            self.materials
+                .resolve(self.scene, self.base_dir, m, self.errors)
+        });
         let object = self.objects.len() as u32;
         if !matches!(node, NodeSpec::Group { .. }) {
             let name = node.name().map_or_else(|| path.to_string(), str::to_string);
@@ -133,11 +134,13 @@ impl Flattener<'_> {
     fn quad(&mut self, m: &DAffine3, corners: [[f64; 3]; 4], object: u32) {
         let flip = m.matrix3.determinant() < 0.0;
         let p = corners.map(|c| m.transform_point3(DVec3::from(c)).as_vec3());
+        // Corners run bottom-left, bottom-right, top-right, top-left; v grows downwards, so
+        // an image appears upright.
         let uv = [
-            Vec2::new(0.0, 0.0),
-            Vec2::new(1.0, 0.0),
-            Vec2::new(1.0, 1.0),
             Vec2::new(0.0, 1.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(0.0, 0.0),
         ];
         for [i, j, k] in [[0, 1, 2], [0, 2, 3]] {
             let (j, k) = if flip { (k, j) } else { (j, k) };
@@ -174,7 +177,11 @@ impl Flattener<'_> {
             } else {
                 None
             };
-            let uvs = c.map(|c| c.t.map_or(Vec2::ZERO, |i| mesh.uvs[i as usize]));
+            let uvs = if c.iter().all(|c| c.t.is_some()) {
+                c.map(|c| c.t.map_or(Vec2::ZERO, |i| mesh.uvs[i as usize]))
+            } else {
+                box_projection(c.map(|c| mesh.positions[c.p as usize]))
+            };
             self.triangle(
                 c.map(|c| pos[c.p as usize]),
                 TriAttrs {
@@ -194,6 +201,26 @@ impl Flattener<'_> {
         self.builder.triangles.push(p);
         self.builder.tri_attrs.push(attrs);
     }
+}
+
+/// Texture coordinates for a triangle of a mesh without `vt`: box (tri-planar) projection in
+/// object space. The triangle is projected along the axis its normal is closest to and the two
+/// remaining object-space coordinates are the uv, in object units (a texture with `tile: (1, 1)`
+/// repeats once per object unit), oriented so images appear upright on the side faces (v
+/// grows downwards with y). Continuous within each group of faces facing the same axis; seams
+/// where the dominant axis changes, as with any box mapping.
+fn box_projection(p: [Vec3; 3]) -> [Vec2; 3] {
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    let a = n.abs();
+    p.map(|q| {
+        if a.x >= a.y && a.x >= a.z {
+            Vec2::new(q.z * -n.x.signum(), -q.y)
+        } else if a.y >= a.z {
+            Vec2::new(q.x, q.z)
+        } else {
+            Vec2::new(q.x * n.z.signum(), -q.y)
+        }
+    })
 }
 
 /// Inverse transpose of a linear map, for transforming normals.

@@ -6,7 +6,7 @@ use glam::Vec3;
 use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog, TraceNode};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Light, RenderScene, SurfacePoint};
+use crate::render_scene::{Light, RenderScene, ShadingPoint, SurfacePoint};
 use crate::sampling::Rng;
 use crate::shading::Material;
 
@@ -23,6 +23,7 @@ pub struct Counters {
 /// The Whitted-style integrator over a compiled scene.
 pub struct Whitted<'a> {
     scene: &'a RenderScene,
+    pixel_spread: f32,
 }
 
 /// A ray to trace and how it contributes.
@@ -31,13 +32,44 @@ struct Path {
     depth: u32,
     weight: Vec3,
     kind: RayKind,
+    cone: RayCone,
+}
+
+/// The pixel footprint carried along a path as a cone (Akenine-Möller et al., "Texture Level of
+/// Detail Strategies for Real-Time Ray Tracing", Ray Tracing Gems ch. 20): its width at the
+/// ray's origin and how fast it grows per unit distance. Sizes texture filters at every hit,
+/// including those seen in mirrors and through glass.
+#[derive(Debug, Clone, Copy)]
+struct RayCone {
+    width: f32,
+    spread: f32,
+}
+
+impl RayCone {
+    /// The cone leaving a hit at `t` (in ray-parameter units of `ray`) after a specular event at
+    /// a surface of curvature `curvature`, bending rays by `bend` times the curvature (2 for a
+    /// mirror, about |1 − 1/η| for refraction; taken as 1, conservatively).
+    fn bounce(self, ray: &Ray, t: f32, curvature: f32, bend: f32) -> Self {
+        let width = self.width_at(ray, t);
+        Self {
+            width,
+            spread: self.spread + bend * curvature * width,
+        }
+    }
+
+    fn width_at(self, ray: &Ray, t: f32) -> f32 {
+        self.width + self.spread * t * ray.dir.length()
+    }
 }
 
 impl<'a> Whitted<'a> {
     /// An integrator for `scene`.
     #[must_use]
     pub fn new(scene: &'a RenderScene) -> Self {
-        Self { scene }
+        Self {
+            scene,
+            pixel_spread: scene.pixel_spread(),
+        }
     }
 
     /// Radiance arriving along a camera ray.
@@ -53,6 +85,10 @@ impl<'a> Whitted<'a> {
             depth: 0,
             weight: Vec3::ONE,
             kind: RayKind::Camera,
+            cone: RayCone {
+                width: 0.0,
+                spread: self.pixel_spread,
+            },
         };
         self.trace(path, rng, counters, log, None)
     }
@@ -92,22 +128,27 @@ impl<'a> Whitted<'a> {
         let object = &scene.objects[sp.object as usize];
         let wo = -ray.dir.normalize();
         let entering = wo.dot(sp.ng) > 0.0;
-        let (ng, ns) = if entering {
-            (sp.ng, sp.ns)
-        } else {
-            (-sp.ng, -sp.ns)
-        };
+        let shading = object.material.map(|m| {
+            let width = path.cone.width_at(ray, hit.t);
+            scene.shading_point(&scene.materials[m as usize], &sp, wo, width)
+        });
         let info = log.is_some().then(|| TraceHit {
             t: hit.t,
             point: sp.p,
-            normal: ns,
+            normal: shading.map_or(if entering { sp.ns } else { -sp.ns }, |s| s.ns),
             object: object.name.clone(),
             material: object
                 .material
                 .map_or("light".into(), |m| scene.material_names[m as usize].clone()),
             entering,
         });
-        let Some(material) = object.material.map(|m| &scene.materials[m as usize]) else {
+        let Some(ShadingPoint {
+            bsdf: material,
+            ng,
+            ns,
+            entering,
+        }) = shading
+        else {
             // An emitter: its radiance is seen from outside only.
             let l = match object.light.map(|i| scene.lights[i as usize]) {
                 Some(Light::Sphere { radiance, .. }) if entering => radiance,
@@ -119,7 +160,7 @@ impl<'a> Whitted<'a> {
         if material.has_local() {
             l += self.direct(
                 &sp,
-                material,
+                &material,
                 wo,
                 ng,
                 ns,
@@ -138,6 +179,7 @@ impl<'a> Whitted<'a> {
         }
         let lobes = material.delta_lobes(wo, ns, ng, entering);
         let min = scene.params.min_contribution;
+        let curvature = scene.geometry.curvature(&hit);
         let mut spawn = |dir: Vec3, w: Vec3, kind: RayKind, log: Option<&mut TraceLog>| -> Vec3 {
             let weight = path.weight * w;
             if weight.max_element() < min || weight.max_element() <= 0.0 {
@@ -149,6 +191,12 @@ impl<'a> Whitted<'a> {
                 depth: path.depth + 1,
                 weight,
                 kind,
+                cone: path.cone.bounce(
+                    ray,
+                    hit.t,
+                    curvature,
+                    if kind == RayKind::Reflect { 2.0 } else { 1.0 },
+                ),
             };
             w * self.trace(child, rng, counters, log, me)
         };

@@ -3,16 +3,18 @@
 pub mod camera;
 pub mod geometry;
 pub mod light;
+pub mod material;
 pub mod surface;
+pub mod texture;
 
 pub use camera::Camera;
 pub use geometry::{Geometry, Hit, PrimRef};
 pub use light::Light;
+pub use material::{ShadingPoint, SurfaceMaterial};
 pub use surface::SurfacePoint;
+pub use texture::Texture;
 
 use glam::Vec3;
-
-use crate::shading::Material;
 
 /// Rendering parameters after command-line overrides.
 #[derive(Debug, Clone, PartialEq)]
@@ -35,6 +37,8 @@ pub struct RenderParams {
     pub background: Vec3,
     /// Radiance scale applied when writing 8-bit images.
     pub exposure: f32,
+    /// Filter image textures with mipmaps at the pixel's footprint (else level 0, bilinear).
+    pub mipmaps: bool,
 }
 
 /// A named scene object, for diagnostics and ray-tree dumps.
@@ -56,7 +60,9 @@ pub struct RenderScene {
     /// The camera.
     pub camera: Camera,
     /// Materials, indexed by `ObjectInfo::material`.
-    pub materials: Vec<Material>,
+    pub materials: Vec<SurfaceMaterial>,
+    /// Textures the materials use, indexed by `SurfaceMaterial::{color_texture, bump}`.
+    pub textures: Vec<Texture>,
     /// Material names, parallel to `materials`.
     pub material_names: Vec<String>,
     /// Lights.
@@ -65,4 +71,15 @@ pub struct RenderScene {
     pub objects: Vec<ObjectInfo>,
     /// Primitives and their BVH.
     pub geometry: Geometry,
+}
+
+impl RenderScene {
+    /// The angle one camera sample's footprint subtends: the pixel's angular size, shrunk by
+    /// `1/√spp` (down to ⅛) since samples are spread over the pixel. The ray cones that size
+    /// texture footprints start from this.
+    #[must_use]
+    pub fn pixel_spread(&self) -> f32 {
+        let pixel = 2.0 * self.camera.up.length() / self.params.height.max(1) as f32;
+        pixel * (1.0 / (self.params.samples_per_pixel.max(1) as f32).sqrt()).max(0.125)
+    }
 }

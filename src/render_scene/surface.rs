@@ -133,6 +133,44 @@ impl Geometry {
     }
 }
 
+impl Geometry {
+    /// How strongly the surface curves at a hit, in 1/length (0 for flat faces): 1/r for a
+    /// sphere, 1/(shortest semi-axis) for an ellipsoid, and for a smooth-shaded triangle the
+    /// largest change of vertex normal per unit length along its edges. Used to widen texture
+    /// footprints seen in curved mirrors and lenses.
+    #[must_use]
+    pub fn curvature(&self, hit: &Hit) -> f32 {
+        let k = match hit.prim.kind() {
+            PrimKind::Sphere => 1.0 / self.spheres[hit.prim.index()].radius,
+            PrimKind::Ellipsoid => {
+                let m = self.ellipsoids[hit.prim.index()].world_from_object.matrix3;
+                let shortest = m
+                    .x_axis
+                    .length()
+                    .min(m.y_axis.length())
+                    .min(m.z_axis.length());
+                (1.0 / shortest) as f32
+            }
+            PrimKind::Triangle => {
+                let i = hit.prim.index();
+                match self.tri_attrs[i].normals {
+                    Some(n) => {
+                        let p = self.triangles[i];
+                        (0..3)
+                            .map(|a| {
+                                let b = (a + 1) % 3;
+                                (n[a] - n[b]).length() / (p[a] - p[b]).length()
+                            })
+                            .fold(0.0, f32::max)
+                    }
+                    None => 0.0,
+                }
+            }
+        };
+        if k.is_finite() { k } else { 0.0 }
+    }
+}
+
 /// ∂p/∂u and ∂p/∂v of a triangle from its vertex uvs; an orthonormal tangent frame around `ng`
 /// when the uvs are degenerate (e.g. a mesh without texture coordinates).
 fn triangle_derivatives(p: [Vec3; 3], uv: [Vec2; 3], ng: Vec3) -> (Vec3, Vec3) {

@@ -23,6 +23,9 @@ pub struct SceneFile {
     pub render: RenderSettings,
     /// The viewpoint.
     pub camera: CameraSpec,
+    /// Named textures, referenced by name from materials (`color` and `bump`).
+    #[serde(default, deserialize_with = "unique_keys")]
+    pub textures: BTreeMap<String, TextureSpec>,
     /// Named materials, referenced by name from nodes.
     #[serde(deserialize_with = "unique_keys")]
     pub materials: BTreeMap<String, MaterialSpec>,
@@ -58,6 +61,8 @@ pub struct RenderSettings {
     pub exposure: f32,
     /// Light-transport algorithm.
     pub integrator: IntegratorKind,
+    /// How image textures are filtered.
+    pub texture_filter: TextureFilter,
 }
 
 impl Default for RenderSettings {
@@ -73,6 +78,7 @@ impl Default for RenderSettings {
             background: [0.0; 3],
             exposure: 1.0,
             integrator: IntegratorKind::Whitted,
+            texture_filter: TextureFilter::Trilinear,
         }
     }
 }
@@ -82,6 +88,17 @@ impl Default for RenderSettings {
 pub enum IntegratorKind {
     /// Recursive (Whitted) ray tracing: direct light with shadow rays, mirror and refraction.
     Whitted,
+}
+
+/// How image textures (bitmaps and height maps) are filtered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub enum TextureFilter {
+    /// Mipmapped: bilinear in the two pyramid levels that match the pixel's footprint on the
+    /// surface (tracked through mirrors and refraction), blended linearly. No shimmer or moiré.
+    Trilinear,
+    /// Bilinear lookups in the full-resolution image only: sharp, but distant or grazing
+    /// textures alias (for comparison and debugging).
+    Bilinear,
 }
 
 /// Camera models.
@@ -114,10 +131,10 @@ fn default_up() -> Vec3Spec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
-    /// Albedo of the diffuse part and tint of the mirror and of transmitted light, each in [0, 1].
+    /// Albedo of the diffuse part and tint of the mirror and of transmitted light: an RGB triple
+    /// with components in [0, 1], or the name of a colour texture.
     #[serde(default = "default_color")]
-    #[serde(deserialize_with = "exact_floats::<_, 3>")]
-    pub color: Rgb,
+    pub color: ColorSpec,
     /// Reflectance of the normalised Phong highlight, each in [0, 1].
     #[serde(default)]
     #[serde(deserialize_with = "exact_floats::<_, 3>")]
@@ -137,10 +154,213 @@ pub struct MaterialSpec {
     /// Index of refraction of the transmitting part (inside relative to outside).
     #[serde(default = "default_ior")]
     pub ior: f32,
+    /// Name of a texture that perturbs the shading normal (a height map, ripples, or noise or
+    /// marble with a `depth`).
+    #[serde(default)]
+    pub bump: Option<String>,
 }
 
-fn default_color() -> Rgb {
-    [0.8; 3]
+fn default_color() -> ColorSpec {
+    ColorSpec::Rgb([0.8; 3])
+}
+
+/// A material colour: a constant or a texture.
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+#[serde(untagged)]
+pub enum ColorSpec {
+    /// A constant linear RGB triple, `(r, g, b)`.
+    Rgb(Rgb),
+    /// The name of a colour texture in `textures`.
+    Texture(String),
+}
+
+impl<'de> Deserialize<'de> for ColorSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = ColorSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("an RGB triple `(r, g, b)` or the name of a texture")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<ColorSpec, E> {
+                Ok(ColorSpec::Texture(v.to_string()))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                seq: A,
+            ) -> Result<ColorSpec, A::Error> {
+                ExactFloats::<3>.visit_seq(seq).map(ColorSpec::Rgb)
+            }
+        }
+        d.deserialize_any(Visit)
+    }
+}
+
+/// A named texture: a colour source, a bump (height) source, or both.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub enum TextureSpec {
+    /// A colour image (PNG or JPEG; EXR is read as linear), repeated over the surface's uv
+    /// square and mipmapped.
+    Bitmap {
+        /// Image file, relative to the scene file.
+        file: String,
+        /// How many times the image repeats over the uv square, per axis (> 0).
+        #[serde(default = "unit_size")]
+        #[serde(deserialize_with = "exact_floats::<_, 2>")]
+        tile: [f32; 2],
+        /// Decode 8/16-bit values from sRGB to linear (true for photographs and paintings).
+        #[serde(default = "yes")]
+        srgb: bool,
+    },
+    /// A grey image used as a height field for bump mapping: height = `depth` × grey value.
+    HeightMap {
+        /// Image file, relative to the scene file (colour images are reduced to luma).
+        file: String,
+        /// Height of white, in world units (may be negative to engrave).
+        depth: f32,
+        /// Repeats over the uv square, per axis (> 0).
+        #[serde(default = "unit_size")]
+        #[serde(deserialize_with = "exact_floats::<_, 2>")]
+        tile: [f32; 2],
+    },
+    /// Marble: turbulence-distorted veins between a base and a vein colour; also a bump source
+    /// when `depth` is not 0.
+    Marble {
+        /// Colour of the stone between veins, linear RGB in [0, 1].
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
+        base: Rgb,
+        /// Colour at the centre of a vein, linear RGB in [0, 1].
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
+        vein: Rgb,
+        /// Spatial frequency (veins run across x): `f` or per axis `(x, y, z)`, per world unit
+        /// (or per uv unit with `mapping: Uv`).
+        #[serde(default = "unit_scale")]
+        frequency: ScaleSpec,
+        /// Octaves of turbulence (0 gives straight veins).
+        #[serde(default = "default_octaves")]
+        octaves: u32,
+        /// How far the turbulence bends the veins (radians of phase).
+        #[serde(default = "default_turbulence")]
+        turbulence: f32,
+        /// Seed of the noise.
+        #[serde(default)]
+        seed: u64,
+        /// Height of a vein's centre when used as `bump`, in world units.
+        #[serde(default)]
+        depth: f32,
+        /// Where the pattern is evaluated.
+        #[serde(default)]
+        mapping: Mapping,
+    },
+    /// Fractal gradient noise (fBm, or turbulence) blended between two colours; also a bump
+    /// source when `depth` is not 0.
+    Noise {
+        /// Colour where the noise is lowest, linear RGB in [0, 1].
+        #[serde(default)]
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
+        low: Rgb,
+        /// Colour where the noise is highest, linear RGB in [0, 1].
+        #[serde(default = "white")]
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
+        high: Rgb,
+        /// Frequency of the first octave, per world unit (or per uv unit with `mapping: Uv`).
+        #[serde(default = "one")]
+        frequency: f32,
+        /// Octaves summed, each at twice the frequency and half the amplitude of the last.
+        #[serde(default = "default_octaves")]
+        octaves: u32,
+        /// Sum absolute values (turbulence: billowy, creased) instead of signed ones (fBm).
+        #[serde(default)]
+        turbulence: bool,
+        /// Seed of the noise.
+        #[serde(default)]
+        seed: u64,
+        /// Bump height of the noise's full range when used as `bump`, in world units.
+        #[serde(default)]
+        depth: f32,
+        /// Where the pattern is evaluated.
+        #[serde(default)]
+        mapping: Mapping,
+    },
+    /// Circular water ripples over the uv square, a bump source: the height is
+    /// `amplitude · (1 + decay·r) · e^(−decay·r) · cos(frequency · r)` summed over the centres.
+    Ripple {
+        /// Centres in uv coordinates.
+        #[serde(deserialize_with = "vec_of_pairs")]
+        centers: Vec<[f32; 2]>,
+        /// Angular frequency, radians per uv unit (wavelength 2π/frequency).
+        frequency: f32,
+        /// Peak height at a centre, in world units.
+        amplitude: f32,
+        /// Radial decay per uv unit (0: none).
+        #[serde(default)]
+        decay: f32,
+    },
+}
+
+/// Where a procedural (noise or marble) texture is evaluated.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub enum Mapping {
+    /// At the world-space position: a solid texture, continuous across faces and edges.
+    #[default]
+    Solid,
+    /// At `(u, v, 0)` of the surface's texture coordinates: follows the surface like an image.
+    Uv,
+}
+
+impl TextureSpec {
+    /// The texture's kind as written in the file.
+    #[must_use]
+    pub fn kind(&self) -> &'static str {
+        match self {
+            TextureSpec::Bitmap { .. } => "Bitmap",
+            TextureSpec::HeightMap { .. } => "HeightMap",
+            TextureSpec::Marble { .. } => "Marble",
+            TextureSpec::Noise { .. } => "Noise",
+            TextureSpec::Ripple { .. } => "Ripple",
+        }
+    }
+
+    /// True if the texture can give a material its colour.
+    #[must_use]
+    pub fn gives_color(&self) -> bool {
+        matches!(
+            self,
+            TextureSpec::Bitmap { .. } | TextureSpec::Marble { .. } | TextureSpec::Noise { .. }
+        )
+    }
+
+    /// True if the texture can perturb normals (is a height source).
+    #[must_use]
+    pub fn gives_bump(&self) -> bool {
+        !matches!(self, TextureSpec::Bitmap { .. })
+    }
+}
+
+fn unit_scale() -> ScaleSpec {
+    ScaleSpec::Uniform(1.0)
+}
+fn default_octaves() -> u32 {
+    5
+}
+fn default_turbulence() -> f32 {
+    4.0
+}
+fn white() -> Rgb {
+    [1.0; 3]
+}
+
+/// Deserialises a list of `(u, v)` pairs, each with exactly two numbers.
+fn vec_of_pairs<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f32; 2]>, D::Error> {
+    struct Pair([f32; 2]);
+    impl<'de> Deserialize<'de> for Pair {
+        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            exact_floats::<_, 2>(d).map(Pair)
+        }
+    }
+    let v: Vec<Pair> = Deserialize::deserialize(d)?;
+    Ok(v.into_iter().map(|p| p.0).collect())
 }
 fn default_shininess() -> f32 {
     32.0
@@ -330,33 +550,33 @@ fn unique_keys<'de, D: serde::Deserializer<'de>, V: Deserialize<'de>>(
 fn exact_floats<'de, D: serde::Deserializer<'de>, const N: usize>(
     d: D,
 ) -> Result<[f32; N], D::Error> {
-    struct Exact<const N: usize>;
-    impl<'de, const N: usize> serde::de::Visitor<'de> for Exact<N> {
-        type Value = [f32; N];
-        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-            write!(f, "{N} numbers")
-        }
-        fn visit_seq<A: serde::de::SeqAccess<'de>>(
-            self,
-            mut seq: A,
-        ) -> Result<Self::Value, A::Error> {
-            let mut out = [0.0f32; N];
-            for (i, slot) in out.iter_mut().enumerate() {
-                *slot = seq
-                    .next_element()?
-                    .ok_or_else(|| serde::de::Error::invalid_length(i, &self))?;
-            }
-            let mut extra = 0;
-            while seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
-                extra += 1;
-            }
-            if extra > 0 {
-                return Err(serde::de::Error::invalid_length(N + extra, &self));
-            }
-            Ok(out)
-        }
+    d.deserialize_tuple(N, ExactFloats::<N>)
+}
+
+/// Visitor for exactly `N` numbers.
+struct ExactFloats<const N: usize>;
+
+impl<'de, const N: usize> serde::de::Visitor<'de> for ExactFloats<N> {
+    type Value = [f32; N];
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{N} numbers")
     }
-    d.deserialize_tuple(N, Exact::<N>)
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+        let mut out = [0.0f32; N];
+        for (i, slot) in out.iter_mut().enumerate() {
+            *slot = seq
+                .next_element()?
+                .ok_or_else(|| serde::de::Error::invalid_length(i, &self))?;
+        }
+        let mut extra = 0;
+        while seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+            extra += 1;
+        }
+        if extra > 0 {
+            return Err(serde::de::Error::invalid_length(N + extra, &self));
+        }
+        Ok(out)
+    }
 }
 
 impl NodeSpec {

@@ -4,8 +4,8 @@ use std::collections::BTreeSet;
 
 use super::diagnostic::{Diagnostic, did_you_mean, quoted_list};
 use super::schema::{
-    CameraSpec, LightSpec, MaterialSpec, NodeSpec, RenderSettings, ScaleSpec, SceneFile,
-    TransformStep,
+    CameraSpec, ColorSpec, LightSpec, MaterialSpec, NodeSpec, RenderSettings, ScaleSpec, SceneFile,
+    TextureSpec, TransformStep,
 };
 
 /// Largest accepted image side, in pixels.
@@ -18,6 +18,17 @@ pub const MAX_SAMPLES_PER_PIXEL: u32 = 1 << 20;
 pub const MAX_DEPTH: u32 = 1024;
 /// Deepest accepted group nesting.
 pub const MAX_NESTING: usize = 64;
+/// Most noise octaves accepted (each halves the feature size; 24 reach below f32 precision).
+pub const MAX_OCTAVES: u32 = 24;
+/// Most ripple centres per texture.
+pub const MAX_RIPPLE_CENTERS: usize = 256;
+
+/// What a material uses a texture for.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum TextureUse {
+    Color,
+    Bump,
+}
 
 /// Checks a scene and returns all errors and warnings (errors first keep the file order).
 #[must_use]
@@ -25,10 +36,14 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
     let mut v = Validator {
         out: Vec::new(),
         used: BTreeSet::new(),
+        used_textures: BTreeSet::new(),
         scene,
     };
     v.render(&scene.render);
     v.camera(&scene.camera);
+    for (name, t) in &scene.textures {
+        v.texture(&format!("textures.{name}"), t);
+    }
     for (name, m) in &scene.materials {
         v.material(&format!("materials.{name}"), m);
     }
@@ -63,12 +78,23 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
             ));
         }
     }
+    // A texture counts as used when some material refers to it, used or not: the material's
+    // own warning already says it is unused.
+    for name in scene.textures.keys() {
+        if !dangling_refs && !v.used_textures.contains(name.as_str()) {
+            v.out.push(Diagnostic::warning(
+                format!("textures.{name}"),
+                format!("texture `{name}` is never used, so it is not loaded"),
+            ));
+        }
+    }
     v.out
 }
 
 struct Validator<'a> {
     out: Vec<Diagnostic>,
     used: BTreeSet<&'a str>,
+    used_textures: BTreeSet<&'a str>,
     scene: &'a SceneFile,
 }
 
@@ -219,8 +245,20 @@ impl<'a> Validator<'a> {
         }
     }
 
-    fn material(&mut self, path: &str, m: &MaterialSpec) {
-        self.unit_rgb(&format!("{path}.color"), m.color, "color");
+    fn material(&mut self, path: &str, m: &'a MaterialSpec) {
+        let color = match &m.color {
+            ColorSpec::Rgb(c) => {
+                self.unit_rgb(&format!("{path}.color"), *c, "color");
+                Some(*c)
+            }
+            ColorSpec::Texture(name) => {
+                self.texture_ref(&format!("{path}.color"), name, TextureUse::Color);
+                None
+            }
+        };
+        if let Some(name) = &m.bump {
+            self.texture_ref(&format!("{path}.bump"), name, TextureUse::Bump);
+        }
         self.unit_rgb(&format!("{path}.specular"), m.specular, "specular");
         if self.finite(&format!("{path}.shininess"), m.shininess) && m.shininess < 0.0 {
             self.err(
@@ -265,15 +303,175 @@ impl<'a> Validator<'a> {
                 .with_help("typical values: 1.0 air, 1.33 water, 1.5 glass, 2.42 diamond"),
             );
         }
-        let gains = (0..3).any(|i| m.color[i] + m.specular[i] > 1.0 + 1e-6);
+        let Some(color) = color else { return };
+        let gains = (0..3).any(|i| color[i] + m.specular[i] > 1.0 + 1e-6);
         if m.diffuse.unwrap_or(if any_given { 0.0 } else { 1.0 }) > 0.0
             && gains
-            && m.color.iter().all(|c| c.is_finite())
+            && color.iter().all(|c| c.is_finite())
         {
             self.out.push(Diagnostic::warning(
                 format!("{path}.specular"),
-                format!("color + specular exceeds 1 ({} + {}), so the surface reflects more light than it receives", fmt3(m.color), fmt3(m.specular)),
+                format!("color + specular exceeds 1 ({} + {}), so the surface reflects more light than it receives", fmt3(color), fmt3(m.specular)),
             ));
+        }
+    }
+
+    fn texture(&mut self, path: &str, t: &TextureSpec) {
+        let tile = |v: &mut Self, tile: &[f32; 2]| {
+            for (i, s) in tile.iter().enumerate() {
+                v.positive(&format!("{path}.tile[{i}]"), *s, "tile");
+            }
+        };
+        let file = |v: &mut Self, file: &str| {
+            if file.trim().is_empty() {
+                v.err(
+                    &format!("{path}.file"),
+                    "must name an image file, found an empty string".into(),
+                );
+            }
+        };
+        let octaves = |v: &mut Self, o: u32| {
+            if o > MAX_OCTAVES {
+                v.err(
+                    &format!("{path}.octaves"),
+                    format!("must be at most {MAX_OCTAVES}, found {o} (octaves beyond ~12 are finer than any pixel)"),
+                );
+            }
+        };
+        match t {
+            TextureSpec::Bitmap {
+                file: f, tile: t, ..
+            } => {
+                file(self, f);
+                tile(self, t);
+            }
+            TextureSpec::HeightMap {
+                file: f,
+                depth,
+                tile: t,
+            } => {
+                file(self, f);
+                tile(self, t);
+                self.finite(&format!("{path}.depth"), *depth);
+            }
+            TextureSpec::Marble {
+                base,
+                vein,
+                frequency,
+                octaves: o,
+                turbulence,
+                depth,
+                ..
+            } => {
+                self.unit_rgb(&format!("{path}.base"), *base, "base");
+                self.unit_rgb(&format!("{path}.vein"), *vein, "vein");
+                let f = match frequency {
+                    ScaleSpec::Uniform(u) => [*u; 3],
+                    ScaleSpec::PerAxis(v) => *v,
+                };
+                self.finite3(&format!("{path}.frequency"), f);
+                octaves(self, *o);
+                self.finite(&format!("{path}.turbulence"), *turbulence);
+                self.finite(&format!("{path}.depth"), *depth);
+            }
+            TextureSpec::Noise {
+                low,
+                high,
+                frequency,
+                octaves: o,
+                depth,
+                ..
+            } => {
+                self.unit_rgb(&format!("{path}.low"), *low, "low");
+                self.unit_rgb(&format!("{path}.high"), *high, "high");
+                self.positive(&format!("{path}.frequency"), *frequency, "frequency");
+                octaves(self, *o);
+                if *o == 0 {
+                    self.err(
+                        &format!("{path}.octaves"),
+                        "must be at least 1, found 0".into(),
+                    );
+                }
+                self.finite(&format!("{path}.depth"), *depth);
+            }
+            TextureSpec::Ripple {
+                centers,
+                frequency,
+                amplitude,
+                decay,
+            } => {
+                for (i, c) in centers.iter().enumerate() {
+                    let p = format!("{path}.centers[{i}]");
+                    if !c.iter().all(|x| x.is_finite()) {
+                        self.err(&p, format!("must be finite, found ({}, {})", c[0], c[1]));
+                    }
+                }
+                if centers.is_empty() {
+                    self.out.push(
+                        Diagnostic::error(
+                            format!("{path}.centers"),
+                            "needs at least one centre, found none",
+                        )
+                        .with_help("centres are uv coordinates, e.g. `[(0.5, 0.5)]`"),
+                    );
+                }
+                if centers.len() > MAX_RIPPLE_CENTERS {
+                    self.err(
+                        &format!("{path}.centers"),
+                        format!("at most {MAX_RIPPLE_CENTERS} centres are allowed (each costs time at every shaded point), found {}", centers.len()),
+                    );
+                }
+                self.positive(&format!("{path}.frequency"), *frequency, "frequency");
+                self.finite(&format!("{path}.amplitude"), *amplitude);
+                if self.finite(&format!("{path}.decay"), *decay) && *decay < 0.0 {
+                    self.err(
+                        &format!("{path}.decay"),
+                        format!("must not be negative, found {decay}"),
+                    );
+                }
+            }
+        }
+    }
+
+    fn texture_ref(&mut self, path: &str, name: &'a str, usage: TextureUse) {
+        let Some(t) = self.scene.textures.get(name) else {
+            let names = self.scene.textures.keys().map(String::as_str);
+            let list = quoted_list(names.clone());
+            let mut d = Diagnostic::error(
+                path,
+                format!(
+                    "unknown texture `{name}`; defined textures: {}",
+                    if list.is_empty() { "none" } else { &list }
+                ),
+            );
+            if let Some(s) = did_you_mean(name, names) {
+                d = d.with_help(format!("did you mean `{s}`?"));
+            } else if usage == TextureUse::Color {
+                d = d.with_help("a colour is an RGB triple `(r, g, b)` or the name of a texture defined under `textures`");
+            }
+            self.out.push(d);
+            return;
+        };
+        self.used_textures.insert(name);
+        match usage {
+            TextureUse::Color if !t.gives_color() => self.out.push(
+                Diagnostic::error(
+                    path,
+                    format!(
+                        "texture `{name}` is a {}, which gives heights, not colours",
+                        t.kind()
+                    ),
+                )
+                .with_help(format!("use it as `bump: Some(\"{name}\")`, or give `color` a Bitmap, Marble or Noise texture")),
+            ),
+            TextureUse::Bump if !t.gives_bump() => self.out.push(
+                Diagnostic::error(
+                    path,
+                    format!("texture `{name}` is a Bitmap, which gives colours, not heights"),
+                )
+                .with_help("bump with a HeightMap (a grey image with a `depth`), a Ripple, or a Noise or Marble with a `depth`"),
+            ),
+            _ => {}
         }
     }
 

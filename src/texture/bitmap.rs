@@ -1,5 +1,7 @@
 //! Tiled colour textures from images.
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3};
 
 use super::mipmap::MipMap;
@@ -8,8 +10,8 @@ use super::mipmap::MipMap;
 /// trilinear mipmapping.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BitmapTexture {
-    /// The linear-RGB pyramid.
-    pub mip: MipMap<Vec3>,
+    /// The linear-RGB pyramid (shared by every texture made from the same file).
+    pub mip: Arc<MipMap<Vec3>>,
     /// Repeat count per axis: the image appears `tile.x × tile.y` times over uv ∈ [0, 1]².
     pub tile: Vec2,
 }
@@ -17,8 +19,11 @@ pub struct BitmapTexture {
 impl BitmapTexture {
     /// A texture repeating `mip` `tile` times per axis.
     #[must_use]
-    pub fn new(mip: MipMap<Vec3>, tile: Vec2) -> Self {
-        Self { mip, tile }
+    pub fn new(mip: impl Into<Arc<MipMap<Vec3>>>, tile: Vec2) -> Self {
+        Self {
+            mip: mip.into(),
+            tile,
+        }
     }
 
     /// Linear RGB at surface coordinates `uv`; `footprint` is the pixel's width in surface uv

@@ -1,5 +1,7 @@
 //! Bump mapping: height maps and the normal perturbation they (or any height source) drive.
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3};
 
 use super::mipmap::GreyMipMap;
@@ -10,7 +12,7 @@ use crate::geometry::Frame;
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeightMap {
     /// The grey pyramid (raw grey values, typically in [0, 1]).
-    pub mip: GreyMipMap,
+    pub mip: Arc<GreyMipMap>,
     /// Height of a grey value of 1, in world units (the bump depth; may be negative).
     pub depth: f32,
     /// Repeat count per axis, as for [`BitmapTexture`](super::BitmapTexture).
@@ -20,8 +22,12 @@ pub struct HeightMap {
 impl HeightMap {
     /// A height map of `depth` × grey, repeated `tile` times per axis.
     #[must_use]
-    pub fn new(mip: GreyMipMap, depth: f32, tile: Vec2) -> Self {
-        Self { mip, depth, tile }
+    pub fn new(mip: impl Into<Arc<GreyMipMap>>, depth: f32, tile: Vec2) -> Self {
+        Self {
+            mip: mip.into(),
+            depth,
+            tile,
+        }
     }
 
     /// Filtered height at surface coordinates `uv`, in world units; `footprint` is the pixel's

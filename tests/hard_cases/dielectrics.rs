@@ -16,7 +16,7 @@ fn tir_fraction(ior: f32) -> f64 {
           materials: {{ \"b\": (transmit: 1, ior: {ior}) }}, lights: [Point(position: (0, 5, 0), power: (1, 1, 1))],
           nodes: [Sphere(material: \"b\")])"
     ));
-    let m: &Material = &s.materials[0];
+    let m: &Material = &s.materials[0].bsdf;
     let n = 400;
     let (mut disc, mut tir) = (0u32, 0u32);
     for i in 0..n {

@@ -1,0 +1,252 @@
+//! Materials and the textures they use, compiled on first use so nothing unused is loaded.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+
+use crate::render_scene::texture::{Mapping as RenderMapping, NoiseTexture};
+use crate::render_scene::{SurfaceMaterial, Texture};
+use crate::scene::Diagnostic;
+use crate::scene::schema::{ColorSpec, Mapping, ScaleSpec, SceneFile, TextureSpec};
+use crate::shading::Material;
+use crate::texture::{BitmapTexture, GreyMipMap, HeightMap, Marble, MipMap, Noise, Ripples};
+
+/// Materials resolved on first use, so unused ones (and their textures) are not compiled.
+#[derive(Default)]
+pub(super) struct MaterialTable {
+    index: BTreeMap<String, u32>,
+    pub list: Vec<(String, SurfaceMaterial)>,
+    pub textures: TextureTable,
+}
+
+impl MaterialTable {
+    /// The index of material `name`, compiling it (and its textures) on first use. Texture
+    /// errors go to `errors`; `None` only for a name the scene does not define.
+    pub fn resolve(
+        &mut self,
+        scene: &SceneFile,
+        base_dir: &Path,
+        name: &str,
+        errors: &mut Vec<Diagnostic>,
+    ) -> Option<u32> {
+        if let Some(&i) = self.index.get(name) {
+            return Some(i);
+        }
+        let m = scene.materials.get(name)?;
+        let (color, color_texture) = match &m.color {
+            ColorSpec::Rgb(c) => (Vec3::from(*c), None),
+            ColorSpec::Texture(t) => (
+                Vec3::ONE,
+                self.textures.resolve(
+                    scene,
+                    base_dir,
+                    t,
+                    &format!("materials.{name}.color"),
+                    errors,
+                ),
+            ),
+        };
+        let bump = m.bump.as_deref().and_then(|t| {
+            self.textures.resolve(
+                scene,
+                base_dir,
+                t,
+                &format!("materials.{name}.bump"),
+                errors,
+            )
+        });
+        let bsdf = Material::new(
+            color,
+            Vec3::from(m.specular),
+            m.shininess,
+            [m.diffuse, m.reflect, m.transmit],
+            m.ior,
+        );
+        let i = self.list.len() as u32;
+        self.list.push((
+            name.to_string(),
+            SurfaceMaterial {
+                bsdf,
+                color_texture,
+                bump,
+            },
+        ));
+        self.index.insert(name.to_string(), i);
+        Some(i)
+    }
+}
+
+/// Textures resolved on first use; each image file is decoded once per use (colour or grey).
+#[derive(Default)]
+pub(super) struct TextureTable {
+    index: BTreeMap<String, Option<u32>>,
+    pub list: Vec<Texture>,
+    colour_images: HashMap<(PathBuf, bool), Arc<MipMap<Vec3>>>,
+    grey_images: HashMap<PathBuf, Arc<GreyMipMap>>,
+    /// Image files decoded.
+    pub images_loaded: usize,
+}
+
+impl TextureTable {
+    fn resolve(
+        &mut self,
+        scene: &SceneFile,
+        base_dir: &Path,
+        name: &str,
+        used_at: &str,
+        errors: &mut Vec<Diagnostic>,
+    ) -> Option<u32> {
+        if let Some(&i) = self.index.get(name) {
+            return i;
+        }
+        let Some(spec) = scene.textures.get(name) else {
+            errors.push(Diagnostic::error(
+                used_at,
+                format!("unknown texture `{name}`"),
+            ));
+            return None;
+        };
+        let at = format!("textures.{name}");
+        let built = self.build(spec, base_dir, &at);
+        let i = match built {
+            Ok(t) => {
+                self.list.push(t);
+                Some(self.list.len() as u32 - 1)
+            }
+            Err(d) => {
+                errors.push(*d);
+                None
+            }
+        };
+        self.index.insert(name.to_string(), i);
+        i
+    }
+
+    fn build(
+        &mut self,
+        spec: &TextureSpec,
+        base_dir: &Path,
+        at: &str,
+    ) -> Result<Texture, Box<Diagnostic>> {
+        let file_error =
+            |file: &str, e: crate::texture::TextureError| {
+                Box::new(Diagnostic::error(
+                format!("{at}.file"),
+                format!(
+                    "cannot load image `{}`: {}",
+                    base_dir.join(file).display(),
+                    image_error_text(&e)
+                ),
+            )
+            .with_help(
+                "textures must be PNG, JPEG or EXR files; paths are relative to the scene file",
+            ))
+            };
+        Ok(match spec {
+            TextureSpec::Bitmap { file, tile, srgb } => {
+                let path = base_dir.join(file);
+                let key = (path.clone(), *srgb);
+                let mip = match self.colour_images.get(&key) {
+                    Some(m) => Arc::clone(m),
+                    None => {
+                        let m =
+                            Arc::new(MipMap::open(&path, *srgb).map_err(|e| file_error(file, e))?);
+                        self.images_loaded += 1;
+                        self.colour_images.insert(key, Arc::clone(&m));
+                        m
+                    }
+                };
+                Texture::Bitmap(BitmapTexture::new(mip, Vec2::from(*tile)))
+            }
+            TextureSpec::HeightMap { file, depth, tile } => {
+                let path = base_dir.join(file);
+                let mip = match self.grey_images.get(&path) {
+                    Some(m) => Arc::clone(m),
+                    None => {
+                        let m =
+                            Arc::new(MipMap::open_grey(&path).map_err(|e| file_error(file, e))?);
+                        self.images_loaded += 1;
+                        self.grey_images.insert(path, Arc::clone(&m));
+                        m
+                    }
+                };
+                Texture::HeightMap(HeightMap::new(mip, *depth, Vec2::from(*tile)))
+            }
+            TextureSpec::Marble {
+                base,
+                vein,
+                frequency,
+                octaves,
+                turbulence,
+                seed,
+                depth,
+                mapping,
+            } => {
+                let scale = match *frequency {
+                    ScaleSpec::Uniform(f) => Vec3::splat(f),
+                    ScaleSpec::PerAxis(v) => Vec3::from(v),
+                };
+                Texture::Marble {
+                    marble: Marble::new(
+                        scale,
+                        *octaves,
+                        *turbulence,
+                        Vec3::from(*base),
+                        Vec3::from(*vein),
+                        *seed,
+                    ),
+                    depth: *depth,
+                    mapping: render_mapping(*mapping),
+                }
+            }
+            TextureSpec::Noise {
+                low,
+                high,
+                frequency,
+                octaves,
+                turbulence,
+                seed,
+                depth,
+                mapping,
+            } => Texture::Noise(NoiseTexture {
+                noise: Noise::new(*seed),
+                low: Vec3::from(*low),
+                high: Vec3::from(*high),
+                frequency: *frequency,
+                octaves: *octaves,
+                turbulence: *turbulence,
+                depth: *depth,
+                mapping: render_mapping(*mapping),
+            }),
+            TextureSpec::Ripple {
+                centers,
+                frequency,
+                amplitude,
+                decay,
+            } => Texture::Ripple(Ripples::new(
+                centers.iter().map(|c| Vec2::from(*c)).collect(),
+                *frequency,
+                *amplitude,
+                *decay,
+            )),
+        })
+    }
+}
+
+fn render_mapping(m: Mapping) -> RenderMapping {
+    match m {
+        Mapping::Solid => RenderMapping::Solid,
+        Mapping::Uv => RenderMapping::Uv,
+    }
+}
+
+/// A texture error as a sentence without the redundant "cannot load texture image" prefix.
+fn image_error_text(e: &crate::texture::TextureError) -> String {
+    match e {
+        crate::texture::TextureError::Image(image::ImageError::IoError(io)) => io.to_string(),
+        crate::texture::TextureError::Image(img) => img.to_string(),
+        other => other.to_string(),
+    }
+}

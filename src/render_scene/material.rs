@@ -1,0 +1,153 @@
+//! Scene materials (BSDF parameters plus optional colour and bump textures) and their
+//! resolution at a hit into the exact BSDF and normals every integrator shades with.
+
+use glam::{Vec2, Vec3};
+
+use super::texture::Lookup;
+use super::{RenderScene, SurfacePoint};
+use crate::geometry::Frame;
+use crate::shading::{Material, usable_shading_normal};
+
+/// Grazing cosines below this are treated as this when sizing footprints (caps the footprint's
+/// elongation at 1000 : 1 instead of dividing by zero).
+const MIN_FOOTPRINT_COS: f32 = 1e-3;
+
+/// A material as compiled from the scene: the BSDF with constant parameters, and the textures
+/// that replace its colour and perturb its shading normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceMaterial {
+    /// The BSDF; its `color` is used when `color_texture` is `None`.
+    pub bsdf: Material,
+    /// Texture giving the colour, as an index into `RenderScene::textures`.
+    pub color_texture: Option<u32>,
+    /// Texture perturbing the shading normal, as an index into `RenderScene::textures`.
+    pub bump: Option<u32>,
+}
+
+/// The BSDF and frame at one hit, as seen from the outgoing direction `wo`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadingPoint {
+    /// The BSDF with textures applied.
+    pub bsdf: Material,
+    /// Unit geometric normal on the side of `wo`.
+    pub ng: Vec3,
+    /// Unit shading normal on the side of `wo`, bumped and made usable
+    /// ([`usable_shading_normal`]).
+    pub ns: Vec3,
+    /// Whether `wo` is on the outside (the side the geometric normal points to).
+    pub entering: bool,
+}
+
+impl RenderScene {
+    /// Resolves `material` at surface point `sp` seen along unit `wo` (pointing away from the
+    /// surface), where the pixel's footprint is `width` world units wide across the incoming
+    /// ray (0: sharpest). This is the single place textures, bump mapping and the
+    /// shading-normal rules are applied.
+    #[must_use]
+    pub fn shading_point(
+        &self,
+        material: &SurfaceMaterial,
+        sp: &SurfacePoint,
+        wo: Vec3,
+        width: f32,
+    ) -> ShadingPoint {
+        let entering = wo.dot(sp.ng) > 0.0;
+        let mut bsdf = material.bsdf;
+        let mut ns = sp.ns;
+        if material.color_texture.is_some() || material.bump.is_some() {
+            let filtered = [material.color_texture, material.bump]
+                .into_iter()
+                .flatten()
+                .any(|t| self.textures[t as usize].filtered());
+            let footprint = if filtered && self.params.mipmaps {
+                uv_footprint(width, -wo, sp.ng, sp.dpdu, sp.dpdv)
+            } else {
+                0.0
+            };
+            let lookup = Lookup {
+                p: sp.p,
+                uv: sp.uv,
+                footprint,
+            };
+            if let Some(t) = material.bump {
+                ns = self.textures[t as usize].bump(ns, sp.dpdu, sp.dpdv, &lookup);
+            }
+            if let Some(t) = material.color_texture {
+                bsdf.color = self.textures[t as usize].color(&lookup);
+            }
+        }
+        let (ng, ns) = if entering { (sp.ng, ns) } else { (-sp.ng, -ns) };
+        ShadingPoint {
+            bsdf,
+            ng,
+            ns: usable_shading_normal(ns, ng, wo),
+            entering,
+        }
+    }
+}
+
+/// The width in uv units of the footprint of a ray cone `width` wide arriving along `dir` at a
+/// surface with normal `ng` and derivatives `dpdu`, `dpdv`: the larger uv extent of the
+/// footprint ellipse (minor axis `width` across the ray, major axis `width / |cos θ|` along
+/// it), so lookups blur rather than alias. 0 when `width` is 0 or the parameterisation is
+/// degenerate.
+#[must_use]
+pub fn uv_footprint(width: f32, dir: Vec3, ng: Vec3, dpdu: Vec3, dpdv: Vec3) -> f32 {
+    if !(width > 0.0) {
+        return 0.0;
+    }
+    let d = dir.normalize_or_zero();
+    let cos = d.dot(ng).abs().max(MIN_FOOTPRINT_COS);
+    let along = d - ng * d.dot(ng);
+    let (major, minor) = match along.try_normalize() {
+        Some(a) => (a * (width / cos), ng.cross(a) * width),
+        None => {
+            let f = Frame::from_normal(ng);
+            (f.s * width, f.t * width)
+        }
+    };
+    // Least-squares uv of a tangent vector v: solve [dpdu dpdv]ᵀ[dpdu dpdv] x = [dpdu dpdv]ᵀ v.
+    let (a, b, c) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
+    let det = a * c - b * b;
+    if !(det > 0.0) {
+        return 0.0;
+    }
+    let to_uv = |v: Vec3| {
+        let (x, y) = (v.dot(dpdu), v.dot(dpdv));
+        Vec2::new(c * x - b * y, a * y - b * x) / det
+    };
+    let w = to_uv(major)
+        .abs()
+        .max_element()
+        .max(to_uv(minor).abs().max_element());
+    if w.is_finite() { w } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn footprint_of_a_head_on_cone_is_its_width_over_the_uv_scale() {
+        // A plane with 1 uv unit = 4 world units along both axes.
+        let (du, dv) = (Vec3::X * 4.0, Vec3::Y * 4.0);
+        let w = uv_footprint(0.02, -Vec3::Z, Vec3::Z, du, dv);
+        assert!((w - 0.005).abs() < 1e-7, "{w}");
+        assert_eq!(uv_footprint(0.0, -Vec3::Z, Vec3::Z, du, dv), 0.0);
+    }
+
+    #[test]
+    fn grazing_cones_stretch_along_the_ray_and_stay_finite() {
+        let (du, dv) = (Vec3::X, Vec3::Y);
+        // 60° from the normal, travelling along +x: the major axis 1/cos 60° = 2× longer in u.
+        let dir = Vec3::new(60f32.to_radians().sin(), 0.0, -60f32.to_radians().cos());
+        let w = uv_footprint(0.01, dir, Vec3::Z, du, dv);
+        assert!((w - 0.02).abs() < 1e-6, "{w}");
+        // Exactly tangent: capped, finite.
+        let w = uv_footprint(0.01, Vec3::X, Vec3::Z, du, dv);
+        assert!(w.is_finite() && (w - 10.0).abs() < 1e-3, "{w}");
+        // Skewed parameterisation (dpdv not orthogonal to dpdu): solved exactly.
+        let w = uv_footprint(1.0, -Vec3::Z, Vec3::Z, Vec3::X, Vec3::new(1.0, 1.0, 0.0));
+        assert!(w.is_finite() && w > 0.99, "{w}");
+    }
+}
