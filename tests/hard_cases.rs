@@ -9,5 +9,7 @@ mod acne;
 mod dielectrics;
 #[path = "hard_cases/extremes.rs"]
 mod extremes;
+#[path = "hard_cases/reintersect.rs"]
+mod reintersect;
 #[path = "hard_cases/support.rs"]
 mod support;
