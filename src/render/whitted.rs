@@ -24,7 +24,12 @@ pub struct Counters {
 pub struct Whitted<'a> {
     scene: &'a RenderScene,
     pixel_spread: f32,
+    /// Some material transmits, so shadow rays must look for what they pass through.
+    transmissive: bool,
 }
+
+/// Most transmitting surfaces a shadow ray passes through before it counts as blocked.
+const MAX_SHADOW_CROSSINGS: u32 = 64;
 
 /// A ray to trace and how it contributes.
 struct Path {
@@ -69,6 +74,7 @@ impl<'a> Whitted<'a> {
         Self {
             scene,
             pixel_spread: scene.pixel_spread(),
+            transmissive: scene.materials.iter().any(|m| m.bsdf.transmit > 0.0),
         }
     }
 
@@ -259,13 +265,9 @@ impl<'a> Whitted<'a> {
                     dir: ls.point - origin,
                     t_max: 1.0 - SHADOW_EPSILON,
                 };
-                counters.rays += 1;
-                let occluded = self.scene.geometry.occluded(&shadow);
-                let c = if occluded {
-                    Vec3::ZERO
-                } else {
-                    f * ls.weight * cos_s
-                };
+                let transmittance = self.transmittance(&shadow, counters);
+                let occluded = transmittance == Vec3::ZERO;
+                let c = f * ls.weight * cos_s * transmittance;
                 sum += c;
                 if let (Some(log), Some(me)) = (log.as_deref_mut(), me) {
                     let contribution = c / n as f32;
@@ -289,6 +291,53 @@ impl<'a> Whitted<'a> {
             total += sum / n as f32;
         }
         total
+    }
+}
+
+impl Whitted<'_> {
+    /// How much of the light travelling along `shadow` (up to its `t_max`) arrives: 0 when an
+    /// opaque surface is in the way, else the product of the straight-line transmittances of
+    /// the dielectric surfaces crossed (`Material::straight_transmittance`).
+    fn transmittance(&self, shadow: &Ray, counters: &mut Counters) -> Vec3 {
+        counters.rays += 1;
+        let scene = self.scene;
+        if !self.transmissive {
+            return if scene.geometry.occluded(shadow) {
+                Vec3::ZERO
+            } else {
+                Vec3::ONE
+            };
+        }
+        let end = shadow.origin + shadow.dir * shadow.t_max;
+        let mut ray = *shadow;
+        let mut t = Vec3::ONE;
+        for _ in 0..MAX_SHADOW_CROSSINGS {
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                return t;
+            };
+            let sp = scene.geometry.surface(&ray, &hit);
+            let Some(m) = scene.objects[sp.object as usize].material else {
+                return Vec3::ZERO;
+            };
+            let material = &scene.materials[m as usize];
+            if material.bsdf.transmit == 0.0 {
+                return Vec3::ZERO;
+            }
+            let wo = -ray.dir.normalize();
+            let s = scene.shading_point(material, &sp, wo, 0.0);
+            t *= s.bsdf.straight_transmittance(s.ns.dot(wo), s.entering);
+            if t.max_element() <= 0.0 {
+                return Vec3::ZERO;
+            }
+            let origin = offset_ray_origin(sp.p, sp.p_error, -s.ng, ray.dir);
+            ray = Ray {
+                origin,
+                dir: end - origin,
+                t_max: 1.0,
+            };
+            counters.rays += 1;
+        }
+        Vec3::ZERO
     }
 }
 

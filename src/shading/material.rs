@@ -100,6 +100,22 @@ impl Material {
         f * self.diffuse
     }
 
+    /// The fraction of light that crosses the surface in a straight line, for shadow rays of
+    /// integrators that do not follow refraction (Whitted): the dielectric part's Fresnel
+    /// transmittance, tinted by `color`. `cos` is the cosine between the crossing direction and
+    /// the shading normal on its side, `entering` whether it crosses from outside to inside.
+    /// Exact for `ior == 1` (the refracted ray is the straight one); for other indices it ignores
+    /// the bending, so the light that glass focuses (caustics) needs photon mapping instead.
+    #[inline]
+    #[must_use]
+    pub fn straight_transmittance(&self, cos: f32, entering: bool) -> Vec3 {
+        if self.transmit == 0.0 {
+            return Vec3::ZERO;
+        }
+        let eta = if entering { 1.0 / self.ior } else { self.ior };
+        self.color * (self.transmit * (1.0 - fresnel_dielectric(cos, eta)))
+    }
+
     /// The mirror and dielectric lobes at a point. `n` is the shading normal and `ng` the
     /// geometric normal, both on the side of `wo`; `entering` says whether `wo` is outside the
     /// object (so light refracts from outside to inside).
