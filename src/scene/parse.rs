@@ -86,13 +86,18 @@ fn ron_error(src: &SourceFile, code: &ron::Error, path: &str, at: (usize, usize)
             let msg = humanize(&other.to_string());
             let at = skip_space(src, at);
             let token = token_at(src, at);
-            let text = if msg.starts_with("expected") || msg.starts_with("Expected") {
+            // Serde's own messages ("… but found … instead") already say what was found.
+            let text = if (msg.starts_with("expected") || msg.starts_with("Expected"))
+                && !msg.contains(" instead")
+            {
                 let msg = lower_first(&msg);
                 if token.is_empty() {
                     format!("{msg}, found the end of the file")
                 } else {
                     format!("{msg}, found `{token}`")
                 }
+            } else if msg.starts_with("Expected") {
+                lower_first(&msg)
             } else {
                 msg
             };

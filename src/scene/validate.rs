@@ -462,7 +462,7 @@ impl<'a> Validator<'a> {
                         t.kind()
                     ),
                 )
-                .with_help(format!("use it as `bump: Some(\"{name}\")`, or give `color` a Bitmap, Marble or Noise texture")),
+                .with_help(format!("use it as `bump: \"{name}\"`, or give `color` a Bitmap, Marble or Noise texture")),
             ),
             TextureUse::Bump if !t.gives_bump() => self.out.push(
                 Diagnostic::error(
