@@ -198,10 +198,10 @@ fn sphere_derivatives(n: Vec3, r: f32) -> (Vec3, Vec3) {
         let f = crate::geometry::Frame::from_normal(n);
         return (f.s * (TAU * r), f.t * (PI * r));
     }
-    // u = 0.5 + atan2(z, x)/2π, v = acos(y)/π.
-    let dpdu = Vec3::new(-n.z, 0.0, n.x) * (TAU * r);
-    let (cos_phi, sin_phi) = (n.x / rho, n.z / rho);
-    let dpdv = Vec3::new(n.y * cos_phi, -rho, n.y * sin_phi) * (PI * r);
+    // u = 0.5 + atan2(−z, x)/2π, v = acos(y)/π: p = (sin θ cos φ, cos θ, −sin θ sin φ).
+    let dpdu = Vec3::new(n.z, 0.0, -n.x) * (TAU * r);
+    let (cos_phi, sin_phi) = (n.x / rho, -n.z / rho);
+    let dpdv = Vec3::new(n.y * cos_phi, -rho, -n.y * sin_phi) * (PI * r);
     (dpdu, dpdv)
 }
 
@@ -216,10 +216,12 @@ fn terminator_point(p: Vec3, v: [Vec3; 3], n: [Vec3; 3], b: [f32; 3]) -> Vec3 {
     if q.is_finite() { q } else { p }
 }
 
-/// Longitude/latitude coordinates of a unit direction: u from the azimuth about +y, v from the pole.
+/// Longitude/latitude coordinates of a unit direction: v from the north (+y) pole down, u
+/// increasing eastwards (clockwise seen from above), so an image wrapped around the sphere reads
+/// left to right and upright from outside; its seam (u = 0) faces −x.
 #[inline]
 fn sphere_uv(n: Vec3) -> Vec2 {
-    let u = 0.5 + n.z.atan2(n.x) / std::f32::consts::TAU;
+    let u = 0.5 + (-n.z).atan2(n.x) / std::f32::consts::TAU;
     let v = n.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
     Vec2::new(u, v)
 }
@@ -230,13 +232,13 @@ mod tests {
 
     #[test]
     fn sphere_derivatives_match_finite_differences_of_the_parameterisation() {
-        // p(u, v) for the parameterisation u = 0.5 + atan2(z, x)/2π, v = acos(y)/π.
+        // p(u, v) for the parameterisation u = 0.5 + atan2(−z, x)/2π, v = acos(y)/π.
         let p = |u: f32, v: f32| {
             let (phi, theta) = ((u - 0.5) * std::f32::consts::TAU, v * std::f32::consts::PI);
             Vec3::new(
                 theta.sin() * phi.cos(),
                 theta.cos(),
-                theta.sin() * phi.sin(),
+                -theta.sin() * phi.sin(),
             ) * 2.0
         };
         for (u, v) in [(0.3f32, 0.4f32), (0.8, 0.7), (0.55, 0.1)] {
