@@ -1,5 +1,5 @@
 //! The numerical hard-case suite (issue #7): each case asserts a figure. Cases that need
-//! features not built yet (photon maps, bump maps, ripples) are added with those features.
+//! features not built yet (photon maps) are added with those features.
 
 mod common;
 
@@ -11,5 +11,7 @@ mod dielectrics;
 mod extremes;
 #[path = "hard_cases/reintersect.rs"]
 mod reintersect;
+#[path = "hard_cases/shading_normals.rs"]
+mod shading_normals;
 #[path = "hard_cases/support.rs"]
 mod support;

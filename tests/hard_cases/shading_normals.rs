@@ -1,0 +1,224 @@
+//! Perturbed shading normals (ripples, bump maps) at grazing angles and in the dark: no black
+//! speckles, no light through surfaces, no NaN at singular points (hard cases B.9, B.12, B.13).
+//!
+//! Note: in this material model a back-facing shading normal would not by itself give black
+//! pixels (mirror and refraction fall back to the geometric normal, Lambert only tests the
+//! light side), so the speckle test also asserts the remedy directly: no normal that is shaded
+//! with faces away from the viewer.
+
+use caustic::geometry::Ray;
+use caustic::render::{Film, RenderOptions, render};
+use caustic::render_scene::RenderScene;
+use caustic::render_scene::texture::Lookup;
+use glam::Vec3;
+
+use super::support::scene;
+
+fn film(s: &RenderScene) -> (Film, u64) {
+    let out = render(s, &RenderOptions::default()).expect("renders");
+    (out.film, out.stats.nan_samples)
+}
+
+/// Water (ripples tilting the normal up to ~30°) or a bumped diffuse floor, seen 2° above the
+/// plane, over a lit floor and under a bright sky.
+fn grazing(material: &str, textures: &str) -> RenderScene {
+    scene(&format!(
+        r#"Scene(
+            render: (width: 160, height: 60, samples_per_pixel: 2, seed: 9, background: (0.5, 0.6, 0.8), max_depth: 6),
+            camera: Pinhole(eye: (0, 0.35, 10), look_at: (0, 0, 0), fov_y: 20),
+            textures: {{ {textures} }},
+            materials: {{ "surface": ({material}), "ground": (color: (0.6, 0.5, 0.4)) }},
+            lights: [Point(position: (3, 30, 5), power: (90000, 90000, 90000))],
+            nodes: [
+                Quad(material: "surface", size: (40, 40), transform: [RotateX(-90)]),
+                Quad(material: "ground", size: (40, 40), transform: [RotateX(-90), Translate(0, -1, 0)]),
+            ],
+        )"#
+    ))
+}
+
+const RIPPLES: &str =
+    r#""t": Ripple(centers: [(0.5, 0.5), (0.3, 0.6)], frequency: 400, amplitude: 0.0577)"#;
+const TILES: &str =
+    r#""t": HeightMap(file: "assets/tiles_height.png", depth: 0.05, tile: (40, 40))"#;
+
+/// Over the primary rays hitting bumped surfaces: the fraction whose raw perturbed normal faces
+/// away from the viewer although the geometric normal faces it (the case the remedy exists
+/// for), and how many of the normals actually shaded with still face away (must be none).
+fn back_facing(s: &RenderScene) -> (f64, u32) {
+    let (w, h) = (s.params.width, s.params.height);
+    let (mut hits, mut back, mut shaded_back) = (0u32, 0u32, 0u32);
+    for y in 0..h {
+        for x in 0..w {
+            let ray = s.camera.ray(x as f32 + 0.5, y as f32 + 0.5, w, h);
+            let Some(hit) = s.geometry.intersect(&ray) else {
+                continue;
+            };
+            let sp = s.geometry.surface(&ray, &hit);
+            let m =
+                &s.materials[s.objects[sp.object as usize].material.expect("material") as usize];
+            let Some(t) = m.bump else { continue };
+            let l = Lookup {
+                p: sp.p,
+                uv: sp.uv,
+                footprint: 0.0,
+            };
+            let n = s.textures[t as usize].bump(sp.ns, sp.dpdu, sp.dpdv, &l);
+            let wo = -ray.dir;
+            hits += 1;
+            if sp.ng.dot(wo) > 0.0 && n.dot(wo) < 0.0 {
+                back += 1;
+            }
+            if !(s.shading_point(m, &sp, wo, 0.0).ns.dot(wo) > 0.0) {
+                shaded_back += 1;
+            }
+        }
+    }
+    (f64::from(back) / f64::from(hits.max(1)), shaded_back)
+}
+
+/// Pixels below the horizon (the surface fills rows `from_row..`) that are exactly black.
+fn black_pixels(f: &Film, from_row: u32) -> usize {
+    (from_row..f.height)
+        .flat_map(|y| (0..f.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| f.get(x, y) == Vec3::ZERO)
+        .count()
+}
+
+#[test]
+fn grazing_ripples_and_bumps_leave_no_black_speckles() {
+    for (name, material, textures) in [
+        (
+            "rippled water",
+            r#"color: (1, 1, 1), diffuse: 0, transmit: 1, ior: 1.33, bump: "t""#,
+            RIPPLES,
+        ),
+        (
+            "rippled mirror",
+            r#"color: (0.9, 0.9, 0.9), diffuse: 0, reflect: 1, bump: "t""#,
+            RIPPLES,
+        ),
+        (
+            "bumped diffuse tiles",
+            r#"color: (0.8, 0.8, 0.8), bump: "t""#,
+            TILES,
+        ),
+    ] {
+        let s = grazing(material, textures);
+        let (back, shaded_back) = back_facing(&s);
+        let (f, nan) = film(&s);
+        // The horizon is at the middle row; start a little below it.
+        let black = black_pixels(&f, f.height / 2 + 2);
+        eprintln!(
+            "{name}: {:.1} % back-facing raw normals, {black} black pixels",
+            back * 100.0
+        );
+        assert!(back >= 0.05, "{name}: the case is not exercised ({back})");
+        assert_eq!(shaded_back, 0, "{name}: shaded with back-facing normals");
+        assert_eq!(nan, 0, "{name}: NaN/Inf samples");
+        assert_eq!(black, 0, "{name}: black speckles");
+    }
+}
+
+#[test]
+fn bumped_surfaces_let_no_light_through() {
+    // A point light 1 unit below a bumped opaque floor; the camera above sees only its top.
+    for textures in [RIPPLES, TILES] {
+        let s = scene(&format!(
+            r#"Scene(
+                render: (width: 48, height: 32, samples_per_pixel: 2),
+                camera: Pinhole(eye: (0, 3, 4), look_at: (0, 0, 0), fov_y: 40),
+                textures: {{ {textures} }},
+                materials: {{ "floor": (color: (0.9, 0.9, 0.9), specular: (0.1, 0.1, 0.1), bump: "t") }},
+                lights: [Point(position: (0, -1, 0), power: (1000, 1000, 1000))],
+                nodes: [Quad(material: "floor", size: (40, 40), transform: [RotateX(-90)])],
+            )"#
+        ));
+        let (f, nan) = film(&s);
+        let max = f.pixels.iter().map(|p| p.max_element()).fold(0.0, f32::max);
+        assert_eq!(nan, 0);
+        assert_eq!(max, 0.0, "light leaked through the bumped floor");
+    }
+}
+
+fn normal_at(s: &RenderScene, from: Vec3, to: Vec3) -> Vec3 {
+    let ray = Ray::new(from, (to - from).normalize());
+    let hit = s.geometry.intersect(&ray).expect("hits");
+    let sp = s.geometry.surface(&ray, &hit);
+    let m = s.objects[sp.object as usize].material.expect("material");
+    s.shading_point(&s.materials[m as usize], &sp, -ray.dir, 0.0)
+        .ns
+}
+
+#[test]
+fn singular_points_give_finite_exact_normals() {
+    // A ripple centred exactly under the ray: the normal is exactly geometric (B.13c).
+    let s = scene(
+        r#"Scene(
+            camera: Pinhole(eye: (0, 0, 5), look_at: (0, 0, 0), fov_y: 30),
+            textures: { "w": Ripple(centers: [(0.5, 0.5)], frequency: 50, amplitude: 0.01, decay: 1) },
+            materials: { "m": (diffuse: 0, transmit: 1, ior: 1.33, bump: "w") },
+            lights: [Point(position: (0, 0, 5), power: (10, 10, 10))],
+            nodes: [Quad(material: "m", size: (2, 2))],
+        )"#,
+    );
+    assert_eq!(normal_at(&s, Vec3::Z * 5.0, Vec3::ZERO), Vec3::Z);
+    // Bumps at a sphere's poles, where ∂p/∂u vanishes (B.13b): finite, unit, near the pole.
+    for textures in [
+        r#""b": Noise(frequency: 4, depth: 0.05)"#,
+        r#""b": HeightMap(file: "assets/tiles_height.png", depth: 0.01, tile: (8, 4))"#,
+        r#""b": Ripple(centers: [(0.5, 0.0)], frequency: 40, amplitude: 0.01)"#,
+    ] {
+        let s = scene(&format!(
+            r#"Scene(
+                camera: Pinhole(eye: (0, 5, 0.1), look_at: (0, 0, 0), fov_y: 30),
+                textures: {{ {textures} }},
+                materials: {{ "m": (bump: "b") }},
+                lights: [Point(position: (0, 5, 0), power: (10, 10, 10))],
+                nodes: [Sphere(material: "m", radius: 1)],
+            )"#
+        ));
+        for pole in [Vec3::Y, -Vec3::Y] {
+            let n = normal_at(&s, pole * 5.0, Vec3::ZERO);
+            assert!(
+                n.is_finite() && (n.length() - 1.0).abs() < 1e-5 && n.dot(pole) > 0.5,
+                "{textures} at {pole}: {n}"
+            );
+        }
+    }
+}
+
+#[test]
+fn zero_depth_and_zero_amplitude_bumps_are_bit_identical_to_none() {
+    let render_with = |bump: &str| {
+        let s = scene(&format!(
+            r#"Scene(
+                render: (width: 40, height: 30, samples_per_pixel: 2),
+                camera: Pinhole(eye: (0, 2, 4), look_at: (0, 0.5, 0), fov_y: 40),
+                textures: {{
+                    "flat_tiles": HeightMap(file: "assets/tiles_height.png", depth: 0, tile: (4, 4)),
+                    "calm": Ripple(centers: [(0.5, 0.5)], frequency: 40, amplitude: 0),
+                    "still_noise": Noise(frequency: 3),
+                }},
+                materials: {{
+                    "floor": (color: (0.7, 0.7, 0.7), specular: (0.2, 0.2, 0.2), shininess: 30 {bump}),
+                    "glass": (diffuse: 0, transmit: 1, ior: 1.5 {bump}),
+                }},
+                lights: [Point(position: (1, 4, 3), power: (300, 300, 300))],
+                nodes: [
+                    Quad(material: "floor", size: (6, 6), transform: [RotateX(-90)]),
+                    Sphere(material: "glass", radius: 0.5, center: (0, 0.5, 0)),
+                ],
+            )"#
+        ));
+        film(&s).0.pixels
+    };
+    let none = render_with("");
+    for bump in [
+        ", bump: \"flat_tiles\"",
+        ", bump: \"calm\"",
+        ", bump: \"still_noise\"",
+    ] {
+        assert!(render_with(bump) == none, "{bump} changed the image");
+    }
+}
