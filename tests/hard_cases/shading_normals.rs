@@ -69,7 +69,7 @@ fn back_facing(s: &RenderScene) -> (f64, u32) {
             if sp.ng.dot(wo) > 0.0 && n.dot(wo) < 0.0 {
                 back += 1;
             }
-            if !(s.shading_point(m, &sp, wo, 0.0).ns.dot(wo) > 0.0) {
+            if s.shading_point(m, &sp, wo, 0.0).ns.dot(wo) <= 0.0 || !sp.ng.is_finite() {
                 shaded_back += 1;
             }
         }
