@@ -22,10 +22,12 @@ pub enum Error {
 }
 
 impl Error {
-    /// Exit code: 2 for bad input (scene, assets, flags), 1 for failures while rendering or writing.
+    /// Exit code: 2 for bad input (scene, assets, flags), 1 for failures while rendering or
+    /// writing, 130 (128 + SIGINT) when interrupted.
     #[must_use]
     pub fn exit_code(&self) -> i32 {
         match self {
+            Error::Render(RenderError::Cancelled) => 130,
             Error::Scene(_) | Error::Usage(_) | Error::Render(_) => 2,
             Error::Output(OutputError::UnknownFormat { .. }) => 2,
             Error::Output(_) => 1,

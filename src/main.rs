@@ -226,6 +226,7 @@ fn cmd_render(args: &RenderArgs) -> Result<(), Error> {
         threads: args.threads,
         region,
         progress: !args.quiet && std::io::stderr().is_terminal(),
+        cancel: None,
     };
     let out = render(&prepared.render_scene, &options)?;
     write_image(&out.film, &output, prepared.render_scene.params.exposure)?;
