@@ -19,6 +19,9 @@ pub enum Error {
     /// A command-line value is malformed.
     #[error("{0}")]
     Usage(String),
+    /// The run was interrupted (Ctrl-C); the message says what, if anything, was kept.
+    #[error("{0}")]
+    Interrupted(String),
 }
 
 impl Error {
@@ -27,7 +30,7 @@ impl Error {
     #[must_use]
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Render(RenderError::Cancelled) => 130,
+            Error::Interrupted(_) | Error::Render(RenderError::Cancelled) => 130,
             Error::Scene(_) | Error::Usage(_) | Error::Render(_) => 2,
             Error::Output(OutputError::UnknownFormat { .. }) => 2,
             Error::Output(_) => 1,
