@@ -19,13 +19,18 @@ pub enum Error {
     /// A command-line value is malformed.
     #[error("{0}")]
     Usage(String),
+    /// The run was interrupted (Ctrl-C); the message says what, if anything, was kept.
+    #[error("{0}")]
+    Interrupted(String),
 }
 
 impl Error {
-    /// Exit code: 2 for bad input (scene, assets, flags), 1 for failures while rendering or writing.
+    /// Exit code: 2 for bad input (scene, assets, flags), 1 for failures while rendering or
+    /// writing, 130 (128 + SIGINT) when interrupted.
     #[must_use]
     pub fn exit_code(&self) -> i32 {
         match self {
+            Error::Interrupted(_) | Error::Render(RenderError::Cancelled) => 130,
             Error::Scene(_) | Error::Usage(_) | Error::Render(_) => 2,
             Error::Output(OutputError::UnknownFormat { .. }) => 2,
             Error::Output(_) => 1,

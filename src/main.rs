@@ -3,13 +3,16 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use clap::{Args, Parser, Subcommand};
 
 use caustic::Error;
 use caustic::pipeline::{SceneOverrides, prepare};
 use caustic::render::output::{OutputFormat, write_image};
-use caustic::render::{Region, RenderOptions, render, trace_pixel};
+use caustic::render::{Region, RenderError, RenderJob, RenderOptions, RenderOutput, trace_pixel};
 use caustic::scene::Diagnostic;
 
 /// caustic: a ray tracer driven by RON/TOML scene files.
@@ -23,6 +26,10 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to PNG (sRGB) or EXR (linear float), chosen by the output's extension.
+    ///
+    /// Ctrl-C stops the render and writes nothing (an existing output file is left untouched);
+    /// the exit code is then 130. With `--checkpoint`, the checkpoint file keeps the last
+    /// complete checkpoint.
     Render(RenderArgs),
     /// Parse and validate a scene (and its assets) without rendering; reports every error.
     Check(SceneArgs),
@@ -82,6 +89,30 @@ struct RenderArgs {
     /// Print scene and BVH statistics.
     #[arg(long)]
     stats: bool,
+    /// Render in passes of samples per pixel and save the image so far to FILE (.png or .exr,
+    /// not the output) after a pass once `--checkpoint-every` seconds have passed since the last
+    /// save. Ctrl-C
+    /// leaves the last complete checkpoint there; it is removed once the final image is written.
+    /// The final image is the same, bit for bit, as without checkpoints.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints (0: after every pass).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value = "30",
+        requires = "checkpoint",
+        value_parser = parse_seconds
+    )]
+    checkpoint_every: Duration,
+}
+
+fn parse_seconds(text: &str) -> Result<Duration, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .and_then(|s| Duration::try_from_secs_f64(s).ok())
+        .ok_or_else(|| format!("expected a non-negative number of seconds, found `{text}`"))
 }
 
 #[derive(Args)]
@@ -184,13 +215,125 @@ fn default_output(scene: &Path) -> PathBuf {
     PathBuf::from(format!("{stem}.png"))
 }
 
+/// Ctrl-C (and, on unix, SIGTERM/SIGHUP) for `caustic render`: before the render starts it ends
+/// the process at once (nothing has been written yet); from then on it raises the cancel flag
+/// the render polls, so the run can stop cleanly without writing the output.
+struct Interrupt {
+    rendering: Arc<AtomicBool>,
+    cancel: Arc<AtomicBool>,
+}
+
+impl Interrupt {
+    fn install(quiet: bool) -> Self {
+        let rendering = Arc::new(AtomicBool::new(false));
+        let cancel = Arc::new(AtomicBool::new(false));
+        let (r, c) = (Arc::clone(&rendering), Arc::clone(&cancel));
+        let installed = ctrlc::set_handler(move || {
+            if r.load(Ordering::SeqCst) {
+                c.store(true, Ordering::SeqCst);
+            } else {
+                eprintln!("interrupted: no image written");
+                std::process::exit(130);
+            }
+        });
+        if let Err(e) = installed
+            && !quiet
+        {
+            eprintln!("warning: cannot catch Ctrl-C ({e}); interrupting will not clean up");
+        }
+        Self { rendering, cancel }
+    }
+
+    /// From now on a signal cancels the render instead of ending the process.
+    fn start_rendering(&self) -> Arc<AtomicBool> {
+        self.rendering.store(true, Ordering::SeqCst);
+        Arc::clone(&self.cancel)
+    }
+
+    fn raised(&self) -> bool {
+        self.cancel.load(Ordering::SeqCst)
+    }
+}
+
+/// Where and how often `--checkpoint` saves the image so far.
+struct Checkpoint<'a> {
+    path: &'a Path,
+    every: Duration,
+    exposure: f32,
+}
+
+/// The shortest pass worth scheduling between checkpoints (passes cost a sweep over the tiles).
+const MIN_PASS: Duration = Duration::from_millis(500);
+
+/// Renders in passes, saving a checkpoint after each pass that ends `every` or more after the
+/// last one. The first pass is one sample per pixel; later ones are sized from the measured time
+/// per sample to end near the next checkpoint. Returns the render's result and the samples per
+/// pixel of the last checkpoint written.
+fn render_checkpointed(
+    mut job: RenderJob<'_>,
+    cp: &Checkpoint<'_>,
+) -> (Result<RenderOutput, RenderError>, Option<u32>) {
+    let spp = job.samples_per_pixel();
+    let mut saved = None;
+    let mut last_save = Instant::now();
+    let mut render_time = Duration::ZERO;
+    let mut pass = 1;
+    while job.samples_done() < spp {
+        let t = Instant::now();
+        if let Err(e) = job.render_pass(pass) {
+            return (Err(e), saved);
+        }
+        render_time += t.elapsed();
+        let done = job.samples_done();
+        if done == spp {
+            break;
+        }
+        if last_save.elapsed() >= cp.every {
+            match write_image(&job.snapshot(), cp.path, cp.exposure) {
+                Ok(()) => saved = Some(done),
+                Err(e) => eprintln!("warning: checkpoint not saved: {e}"),
+            }
+            last_save = Instant::now();
+        }
+        let per_sample = render_time.as_secs_f64() / f64::from(done);
+        let target = cp.every.saturating_sub(last_save.elapsed()).max(MIN_PASS);
+        // `as` saturates, and a zero estimate only asks for everything left.
+        pass = ((target.as_secs_f64() / per_sample) as u32).max(1);
+    }
+    (job.finish(), saved)
+}
+
+/// Whether two paths name the same file (lexically after making them absolute, or the same
+/// existing file).
+fn same_file(a: &Path, b: &Path) -> bool {
+    if let (Ok(x), Ok(y)) = (a.canonicalize(), b.canonicalize()) {
+        return x == y;
+    }
+    matches!((std::path::absolute(a), std::path::absolute(b)), (Ok(x), Ok(y)) if x == y)
+}
+
 fn cmd_render(args: &RenderArgs) -> Result<(), Error> {
+    let interrupt = Interrupt::install(args.quiet);
     let output = args
         .output
         .clone()
         .unwrap_or_else(|| default_output(&args.scene.scene));
     // Refuse a bad output name before doing any work.
     OutputFormat::for_path(&output)?;
+    if let Some(cp) = &args.checkpoint {
+        if OutputFormat::for_path(cp).is_err() {
+            return Err(Error::Usage(format!(
+                "error: --checkpoint `{}`: the checkpoint must end in `.png` or `.exr`",
+                cp.display()
+            )));
+        }
+        if same_file(cp, &output) {
+            return Err(Error::Usage(format!(
+                "error: --checkpoint `{}` is the output file; give it a name of its own",
+                cp.display()
+            )));
+        }
+    }
     let region = args.region.as_deref().map(parse_region).transpose()?;
     if args.threads == Some(0) {
         return Err(Error::Usage("error: --threads must be at least 1".into()));
@@ -222,13 +365,55 @@ fn cmd_render(args: &RenderArgs) -> Result<(), Error> {
             s.bvh_time.as_secs_f64()
         );
     }
+    let exposure = prepared.render_scene.params.exposure;
+    let spp = prepared.render_scene.params.samples_per_pixel;
     let options = RenderOptions {
         threads: args.threads,
         region,
         progress: !args.quiet && std::io::stderr().is_terminal(),
+        cancel: Some(interrupt.start_rendering()),
     };
-    let out = render(&prepared.render_scene, &options)?;
-    write_image(&out.film, &output, prepared.render_scene.params.exposure)?;
+    let job = RenderJob::new(&prepared.render_scene, &options)?;
+    let (result, saved) = match &args.checkpoint {
+        None => (job.finish(), None),
+        Some(path) => render_checkpointed(
+            job,
+            &Checkpoint {
+                path,
+                every: args.checkpoint_every,
+                exposure,
+            },
+        ),
+    };
+    let interrupted = || {
+        let kept = match (&args.checkpoint, saved) {
+            (Some(cp), Some(n)) => format!(
+                " to `{}`; `{}` holds the last complete checkpoint ({n} of {spp} samples per pixel)",
+                output.display(),
+                cp.display()
+            ),
+            _ => String::new(),
+        };
+        Error::Interrupted(format!("interrupted: no image written{kept}"))
+    };
+    let out = match result {
+        Err(RenderError::Cancelled) => return Err(interrupted()),
+        other => other?,
+    };
+    // A signal that came after the last tile still means "stop": the output is not written.
+    if interrupt.raised() {
+        return Err(interrupted());
+    }
+    write_image(&out.film, &output, exposure)?;
+    if let (Some(cp), Some(_)) = (&args.checkpoint, saved)
+        && let Err(e) = std::fs::remove_file(cp)
+        && !args.quiet
+    {
+        eprintln!(
+            "warning: cannot remove the checkpoint `{}`: {e}",
+            cp.display()
+        );
+    }
     let st = &out.stats;
     let secs = st.elapsed.as_secs_f64();
     println!(
@@ -236,7 +421,7 @@ fn cmd_render(args: &RenderArgs) -> Result<(), Error> {
         output.display(),
         out.film.width,
         out.film.height,
-        prepared.render_scene.params.samples_per_pixel,
+        spp,
         st.rays,
         secs,
         st.rays as f64 / secs.max(1e-9) / 1e6,

@@ -9,5 +9,5 @@ pub mod whitted;
 
 pub use film::Film;
 pub use tiles::{
-    Region, RenderError, RenderOptions, RenderOutput, RenderStats, render, trace_pixel,
+    Region, RenderError, RenderJob, RenderOptions, RenderOutput, RenderStats, render, trace_pixel,
 };

@@ -1,6 +1,9 @@
 //! The tile scheduler: rayon over 16×16 tiles, each pixel's samples drawn from its own random
 //! stream, so the image is identical for any thread count and tile order.
 
+use std::ops::Range;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
@@ -38,6 +41,9 @@ pub struct RenderOptions {
     pub region: Option<Region>,
     /// Show a progress bar on stderr (only when it is a terminal).
     pub progress: bool,
+    /// Raised by another thread to stop the render early: workers look at it before each pixel
+    /// and between passes, and the render then returns [`RenderError::Cancelled`].
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 /// What a render did.
@@ -64,7 +70,7 @@ pub struct RenderOutput {
     pub stats: RenderStats,
 }
 
-/// Why a render could not start.
+/// Why a render could not start or finish.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     /// The region lies (partly) outside the image.
@@ -79,64 +85,195 @@ pub enum RenderError {
     /// The worker pool could not be created.
     #[error("cannot start {0} render threads: {1}")]
     Threads(usize, String),
+    /// The cancel flag of [`RenderOptions`] was raised; no image is returned.
+    #[error("the render was cancelled")]
+    Cancelled,
 }
 
-/// Renders `scene` (or a region of it).
+/// Renders `scene` (or a region of it) in one pass of all its samples per pixel.
+///
+/// # Errors
+/// [`RenderError::Cancelled`] when `options.cancel` is raised before the last tile is done; the
+/// other variants when the region or thread count is unusable.
 pub fn render(scene: &RenderScene, options: &RenderOptions) -> Result<RenderOutput, RenderError> {
-    let (w, h) = (scene.params.width, scene.params.height);
-    let region = options.region.unwrap_or(Region {
-        x: 0,
-        y: 0,
-        width: w,
-        height: h,
-    });
-    if region.width == 0 || region.height == 0 {
-        return Err(RenderError::EmptyRegion);
+    RenderJob::new(scene, options)?.finish()
+}
+
+/// A render done in passes over sample indices: pass after pass adds samples `[done, done + n)`
+/// to every pixel, in ascending sample order, so the finished film is bit-identical to the
+/// one-pass [`render`] whatever the pass sizes. Between passes the image so far can be read
+/// (for checkpoints), and a cancelled pass leaves the job as it was after the previous one.
+pub struct RenderJob<'a> {
+    scene: &'a RenderScene,
+    region: Region,
+    tiles: Vec<Region>,
+    pool: rayon::ThreadPool,
+    cancel: Option<Arc<AtomicBool>>,
+    progress: ProgressBar,
+    /// Per-pixel radiance sums over the samples done, row-major over the region.
+    sums: Vec<Vec3>,
+    done: u32,
+    stats: RenderStats,
+    start: Instant,
+}
+
+impl std::fmt::Debug for RenderJob<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RenderJob")
+            .field("region", &self.region)
+            .field("samples_done", &self.done)
+            .field("samples_per_pixel", &self.samples_per_pixel())
+            .finish_non_exhaustive()
     }
-    if u64::from(region.x) + u64::from(region.width) > u64::from(w)
-        || u64::from(region.y) + u64::from(region.height) > u64::from(h)
-    {
-        return Err(RenderError::RegionOutside(region, w, h));
-    }
-    let threads = options
-        .threads
-        .unwrap_or_else(rayon::current_num_threads)
-        .max(1);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| RenderError::Threads(threads, e.to_string()))?;
-    let tiles = tile_grid(region);
-    let progress = progress_bar(options.progress, tiles.len() as u64);
-    let start = Instant::now();
-    let results: Vec<(Vec<Vec3>, Counters, u64)> = pool.install(|| {
-        tiles
-            .par_iter()
-            .map(|t| render_tile(scene, t, &progress))
-            .collect()
-    });
-    progress.finish_and_clear();
-    let mut film = Film::new(region.width, region.height);
-    let mut stats = RenderStats {
-        threads,
-        ..Default::default()
-    };
-    for (tile, (pixels, counters, nan)) in tiles.iter().zip(results) {
-        for (i, p) in pixels.into_iter().enumerate() {
-            let (x, y) = (
-                tile.x + i as u32 % tile.width,
-                tile.y + i as u32 / tile.width,
-            );
-            film.pixels[((y - region.y) * region.width + (x - region.x)) as usize] = p;
+}
+
+impl<'a> RenderJob<'a> {
+    /// Checks the options and sets up the worker pool; no samples are taken yet.
+    ///
+    /// # Errors
+    /// When the region is empty or outside the image, or the worker pool cannot start.
+    pub fn new(scene: &'a RenderScene, options: &RenderOptions) -> Result<Self, RenderError> {
+        let (w, h) = (scene.params.width, scene.params.height);
+        let region = options.region.unwrap_or(Region {
+            x: 0,
+            y: 0,
+            width: w,
+            height: h,
+        });
+        if region.width == 0 || region.height == 0 {
+            return Err(RenderError::EmptyRegion);
         }
-        stats.rays += counters.rays;
-        stats.nan_samples += nan;
+        if u64::from(region.x) + u64::from(region.width) > u64::from(w)
+            || u64::from(region.y) + u64::from(region.height) > u64::from(h)
+        {
+            return Err(RenderError::RegionOutside(region, w, h));
+        }
+        let threads = options
+            .threads
+            .unwrap_or_else(rayon::current_num_threads)
+            .max(1);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| RenderError::Threads(threads, e.to_string()))?;
+        let tiles = tile_grid(region);
+        let spp = u64::from(scene.params.samples_per_pixel);
+        let progress = progress_bar(options.progress, tiles.len() as u64 * spp);
+        Ok(Self {
+            scene,
+            region,
+            tiles,
+            pool,
+            cancel: options.cancel.clone(),
+            progress,
+            sums: vec![Vec3::ZERO; region.width as usize * region.height as usize],
+            done: 0,
+            stats: RenderStats {
+                threads,
+                ..Default::default()
+            },
+            start: Instant::now(),
+        })
     }
-    stats.samples = u64::from(region.width)
-        * u64::from(region.height)
-        * u64::from(scene.params.samples_per_pixel);
-    stats.elapsed = start.elapsed();
-    Ok(RenderOutput { film, stats })
+
+    /// Samples per pixel of the finished render.
+    #[must_use]
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.scene.params.samples_per_pixel
+    }
+
+    /// Samples per pixel taken so far (by complete passes).
+    #[must_use]
+    pub fn samples_done(&self) -> u32 {
+        self.done
+    }
+
+    /// Takes the next `n` samples of every pixel (fewer if fewer remain; none is a no-op).
+    ///
+    /// # Errors
+    /// [`RenderError::Cancelled`] when the cancel flag is raised before the pass ends; the job
+    /// then still holds the image of its previous complete pass.
+    pub fn render_pass(&mut self, n: u32) -> Result<(), RenderError> {
+        let end = self.done + n.min(self.samples_per_pixel() - self.done);
+        if self.is_cancelled() {
+            return Err(RenderError::Cancelled);
+        }
+        if end == self.done {
+            return Ok(());
+        }
+        let (scene, region, sums, samples) = (self.scene, self.region, &self.sums, self.done..end);
+        let (progress, cancel) = (&self.progress, self.cancel.as_deref());
+        let results: Option<Vec<TileResult>> = self.pool.install(|| {
+            self.tiles
+                .par_iter()
+                .map(|t| render_tile(scene, t, region, sums, samples.clone(), cancel, progress))
+                .collect()
+        });
+        let Some(results) = results else {
+            return Err(RenderError::Cancelled);
+        };
+        for (tile, r) in self.tiles.iter().zip(results) {
+            for (i, s) in r.sums.into_iter().enumerate() {
+                self.sums[pixel_index(region, tile, i)] = s;
+            }
+            self.stats.rays += r.counters.rays;
+            self.stats.nan_samples += r.nan;
+        }
+        self.done = end;
+        Ok(())
+    }
+
+    /// The image so far: each pixel's sum over the samples done, divided by their number (black
+    /// before the first pass).
+    #[must_use]
+    pub fn snapshot(&self) -> Film {
+        self.film_over(self.done.max(1))
+    }
+
+    /// Takes the remaining samples in one pass and returns the finished film.
+    ///
+    /// # Errors
+    /// As [`RenderJob::render_pass`].
+    pub fn finish(mut self) -> Result<RenderOutput, RenderError> {
+        self.render_pass(self.samples_per_pixel() - self.done)?;
+        self.progress.finish_and_clear();
+        let spp = self.samples_per_pixel();
+        let film = self.film_over(spp);
+        let mut stats = self.stats;
+        stats.samples =
+            u64::from(self.region.width) * u64::from(self.region.height) * u64::from(spp);
+        stats.elapsed = self.start.elapsed();
+        Ok(RenderOutput { film, stats })
+    }
+
+    fn film_over(&self, samples: u32) -> Film {
+        let mut film = Film::new(self.region.width, self.region.height);
+        for (p, s) in film.pixels.iter_mut().zip(&self.sums) {
+            *p = *s / samples as f32;
+        }
+        film
+    }
+
+    fn is_cancelled(&self) -> bool {
+        self.cancel
+            .as_deref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+}
+
+impl Drop for RenderJob<'_> {
+    fn drop(&mut self) {
+        self.progress.finish_and_clear();
+    }
+}
+
+/// Index in the region-sized buffer of pixel `i` (row-major) of `tile`.
+fn pixel_index(region: Region, tile: &Region, i: usize) -> usize {
+    let (x, y) = (
+        tile.x + i as u32 % tile.width,
+        tile.y + i as u32 / tile.width,
+    );
+    ((y - region.y) * region.width + (x - region.x)) as usize
 }
 
 fn tile_grid(r: Region) -> Vec<Region> {
@@ -173,33 +310,55 @@ fn progress_bar(enabled: bool, tiles: u64) -> ProgressBar {
     bar
 }
 
+/// One tile's share of a pass: its pixels' new radiance sums (row-major in the tile) and counts.
+struct TileResult {
+    sums: Vec<Vec3>,
+    counters: Counters,
+    nan: u64,
+}
+
+/// Adds samples `samples` of each pixel of `tile` to its sum so far (taken from `sums`), in
+/// ascending sample order. `None` when `cancel` is raised: it is checked before each pixel, never
+/// per ray.
 fn render_tile(
     scene: &RenderScene,
     tile: &Region,
+    region: Region,
+    sums: &[Vec3],
+    samples: Range<u32>,
+    cancel: Option<&AtomicBool>,
     progress: &ProgressBar,
-) -> (Vec<Vec3>, Counters, u64) {
+) -> Option<TileResult> {
     let integrator = Whitted::new(scene);
-    let spp = scene.params.samples_per_pixel;
     let mut counters = Counters::default();
     let mut nan = 0u64;
-    let mut pixels = Vec::with_capacity((tile.width * tile.height) as usize);
-    for y in tile.y..tile.y + tile.height {
-        for x in tile.x..tile.x + tile.width {
-            let mut sum = Vec3::ZERO;
-            for s in 0..spp {
-                let (ray, mut rng) = camera_sample(scene, x, y, s);
-                let l = integrator.li(ray, &mut rng, &mut counters, None);
-                if l.is_finite() {
-                    sum += l;
-                } else {
-                    nan += 1;
-                }
-            }
-            pixels.push(sum / spp as f32);
+    let mut out = Vec::with_capacity((tile.width * tile.height) as usize);
+    for i in 0..(tile.width * tile.height) as usize {
+        if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            return None;
         }
+        let (x, y) = (
+            tile.x + i as u32 % tile.width,
+            tile.y + i as u32 / tile.width,
+        );
+        let mut sum = sums[pixel_index(region, tile, i)];
+        for s in samples.clone() {
+            let (ray, mut rng) = camera_sample(scene, x, y, s);
+            let l = integrator.li(ray, &mut rng, &mut counters, None);
+            if l.is_finite() {
+                sum += l;
+            } else {
+                nan += 1;
+            }
+        }
+        out.push(sum);
     }
-    progress.inc(1);
-    (pixels, counters, nan)
+    progress.inc(u64::from(samples.end - samples.start));
+    Some(TileResult {
+        sums: out,
+        counters,
+        nan,
+    })
 }
 
 /// The camera ray and random stream of sample `s` of pixel `(x, y)`: stratified jitter on a
