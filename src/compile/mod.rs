@@ -10,10 +10,11 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use crate::accel::BvhStats;
+use crate::render_scene::TextureFilter;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::render_scene::{Camera, Light, ObjectInfo, RenderParams, RenderScene};
 use crate::scene::Diagnostic;
-use crate::scene::schema::{CameraSpec, LightSpec, SceneFile, TextureFilter};
+use crate::scene::schema::{self, CameraSpec, LightSpec, SceneFile};
 
 /// Counts and timings of a compilation, for `--stats`.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -126,7 +127,11 @@ pub fn compile(
         seed: r.seed,
         background: r.background.into(),
         exposure: r.exposure,
-        mipmaps: r.texture_filter == TextureFilter::Trilinear,
+        texture_filter: match r.texture_filter {
+            schema::TextureFilter::Anisotropic => TextureFilter::Anisotropic,
+            schema::TextureFilter::Trilinear => TextureFilter::Trilinear,
+            schema::TextureFilter::Bilinear => TextureFilter::Bilinear,
+        },
     };
     let CameraSpec::Pinhole {
         eye,

@@ -4,9 +4,10 @@
 use glam::{Vec2, Vec3};
 
 use super::texture::Lookup;
-use super::{RenderScene, SurfacePoint};
+use super::{RenderScene, SurfacePoint, TextureFilter};
 use crate::geometry::Frame;
 use crate::shading::{Material, usable_shading_normal};
+use crate::texture::Footprint;
 
 /// Grazing cosines below this are treated as this when sizing footprints (caps the footprint's
 /// elongation at 1000 : 1 instead of dividing by zero).
@@ -59,10 +60,13 @@ impl RenderScene {
                 .into_iter()
                 .flatten()
                 .any(|t| self.textures[t as usize].filtered());
-            let footprint = if filtered && self.params.mipmaps {
-                uv_footprint(width, -wo, sp.ng, sp.dpdu, sp.dpdv)
-            } else {
-                0.0
+            let footprint = match self.params.texture_filter {
+                _ if !filtered => Footprint::POINT,
+                TextureFilter::Anisotropic => uv_footprint(width, -wo, sp.ng, sp.dpdu, sp.dpdv),
+                TextureFilter::Trilinear => {
+                    Footprint::isotropic(uv_footprint(width, -wo, sp.ng, sp.dpdu, sp.dpdv).width())
+                }
+                TextureFilter::Bilinear => Footprint::POINT,
             };
             let lookup = Lookup {
                 p: sp.p,
@@ -86,15 +90,16 @@ impl RenderScene {
     }
 }
 
-/// The width in uv units of the footprint of a ray cone `width` wide arriving along `dir` at a
-/// surface with normal `ng` and derivatives `dpdu`, `dpdv`: the larger uv extent of the
-/// footprint ellipse (minor axis `width` across the ray, major axis `width / |cos θ|` along
-/// it), so lookups blur rather than alias. 0 when `width` is 0 or the parameterisation is
-/// degenerate.
+/// The footprint in uv of a ray cone `width` wide arriving along `dir` at a surface with
+/// normal `ng` and derivatives `dpdu`, `dpdv`. On the surface the footprint is an ellipse with
+/// axes `width` across the ray and `width / |cos θ|` along it; both axes are mapped to uv (they
+/// stay conjugate diameters), the longer becomes `major` and the width across it is the
+/// parallelogram's area over `|major|`. [`Footprint::POINT`] when `width` is 0 or the
+/// parameterisation is degenerate.
 #[must_use]
-pub fn uv_footprint(width: f32, dir: Vec3, ng: Vec3, dpdu: Vec3, dpdv: Vec3) -> f32 {
+pub fn uv_footprint(width: f32, dir: Vec3, ng: Vec3, dpdu: Vec3, dpdv: Vec3) -> Footprint {
     if !(width > 0.0) {
-        return 0.0;
+        return Footprint::POINT;
     }
     let d = dir.normalize_or_zero();
     let cos = d.dot(ng).abs().max(MIN_FOOTPRINT_COS);
@@ -110,17 +115,32 @@ pub fn uv_footprint(width: f32, dir: Vec3, ng: Vec3, dpdu: Vec3, dpdv: Vec3) -> 
     let (a, b, c) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
     let det = a * c - b * b;
     if !(det > 0.0) {
-        return 0.0;
+        return Footprint::POINT;
     }
     let to_uv = |v: Vec3| {
         let (x, y) = (v.dot(dpdu), v.dot(dpdv));
         Vec2::new(c * x - b * y, a * y - b * x) / det
     };
-    let w = to_uv(major)
-        .abs()
-        .max_element()
-        .max(to_uv(minor).abs().max_element());
-    if w.is_finite() { w } else { 0.0 }
+    let (m1, m2) = (to_uv(major), to_uv(minor));
+    let (long, short) = if m1.length_squared() >= m2.length_squared() {
+        (m1, m2)
+    } else {
+        (m2, m1)
+    };
+    let len = long.length();
+    let f = Footprint {
+        major: long,
+        minor: if len > 0.0 {
+            long.perp_dot(short).abs() / len
+        } else {
+            0.0
+        },
+    };
+    if f.major.is_finite() && f.minor.is_finite() {
+        f
+    } else {
+        Footprint::POINT
+    }
 }
 
 #[cfg(test)]
@@ -131,23 +151,36 @@ mod tests {
     fn footprint_of_a_head_on_cone_is_its_width_over_the_uv_scale() {
         // A plane with 1 uv unit = 4 world units along both axes.
         let (du, dv) = (Vec3::X * 4.0, Vec3::Y * 4.0);
-        let w = uv_footprint(0.02, -Vec3::Z, Vec3::Z, du, dv);
-        assert!((w - 0.005).abs() < 1e-7, "{w}");
-        assert_eq!(uv_footprint(0.0, -Vec3::Z, Vec3::Z, du, dv), 0.0);
+        let f = uv_footprint(0.02, -Vec3::Z, Vec3::Z, du, dv);
+        assert!(
+            (f.width() - 0.005).abs() < 1e-7 && (f.minor - 0.005).abs() < 1e-7,
+            "{f:?}"
+        );
+        assert_eq!(
+            uv_footprint(0.0, -Vec3::Z, Vec3::Z, du, dv),
+            Footprint::POINT
+        );
     }
 
     #[test]
     fn grazing_cones_stretch_along_the_ray_and_stay_finite() {
         let (du, dv) = (Vec3::X, Vec3::Y);
-        // 60° from the normal, travelling along +x: the major axis 1/cos 60° = 2× longer in u.
+        // 60° from the normal, travelling along +x: the major axis 1/cos 60° = 2× longer, in u.
         let dir = Vec3::new(60f32.to_radians().sin(), 0.0, -60f32.to_radians().cos());
-        let w = uv_footprint(0.01, dir, Vec3::Z, du, dv);
-        assert!((w - 0.02).abs() < 1e-6, "{w}");
+        let f = uv_footprint(0.01, dir, Vec3::Z, du, dv);
+        assert!(
+            (f.major.x.abs() - 0.02).abs() < 1e-6 && f.major.y.abs() < 1e-7,
+            "{f:?}"
+        );
+        assert!((f.minor - 0.01).abs() < 1e-6, "{f:?}");
         // Exactly tangent: capped, finite.
-        let w = uv_footprint(0.01, Vec3::X, Vec3::Z, du, dv);
-        assert!(w.is_finite() && (w - 10.0).abs() < 1e-3, "{w}");
+        let f = uv_footprint(0.01, Vec3::X, Vec3::Z, du, dv);
+        assert!(
+            f.major.is_finite() && (f.width() - 10.0).abs() < 1e-3,
+            "{f:?}"
+        );
         // Skewed parameterisation (dpdv not orthogonal to dpdu): solved exactly.
-        let w = uv_footprint(1.0, -Vec3::Z, Vec3::Z, Vec3::X, Vec3::new(1.0, 1.0, 0.0));
-        assert!(w.is_finite() && w > 0.99, "{w}");
+        let f = uv_footprint(1.0, -Vec3::Z, Vec3::Z, Vec3::X, Vec3::new(1.0, 1.0, 0.0));
+        assert!(f.width().is_finite() && f.width() > 0.99, "{f:?}");
     }
 }

@@ -37,8 +37,19 @@ pub struct RenderParams {
     pub background: Vec3,
     /// Radiance scale applied when writing 8-bit images.
     pub exposure: f32,
-    /// Filter image textures with mipmaps at the pixel's footprint (else level 0, bilinear).
-    pub mipmaps: bool,
+    /// How image textures are filtered.
+    pub texture_filter: TextureFilter,
+}
+
+/// How image textures are filtered (see the scene schema's `texture_filter`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TextureFilter {
+    /// Several trilinear lookups along the footprint's long axis.
+    Anisotropic,
+    /// One trilinear lookup covering the whole footprint.
+    Trilinear,
+    /// Level 0 only, bilinear (aliases; for comparison).
+    Bilinear,
 }
 
 /// A named scene object, for diagnostics and ray-tree dumps.

@@ -4,7 +4,8 @@
 use glam::{Vec2, Vec3};
 
 use crate::texture::{
-    BitmapTexture, HeightMap, Marble, Noise, Ripples, perturb_normal, perturb_normal_by_gradient,
+    BitmapTexture, Footprint, HeightMap, Marble, Noise, Ripples, perturb_normal,
+    perturb_normal_by_gradient,
 };
 
 /// Where a procedural texture is evaluated.
@@ -91,8 +92,8 @@ pub struct Lookup {
     pub p: Vec3,
     /// Texture coordinates.
     pub uv: Vec2,
-    /// Width of the pixel's footprint in uv units (0: sharpest).
-    pub footprint: f32,
+    /// The pixel's footprint in uv units ([`Footprint::POINT`]: sharpest).
+    pub footprint: Footprint,
 }
 
 #[inline]
@@ -109,7 +110,7 @@ impl Texture {
     #[must_use]
     pub fn color(&self, l: &Lookup) -> Vec3 {
         match self {
-            Texture::Bitmap(b) => b.eval(l.uv, l.footprint),
+            Texture::Bitmap(b) => b.eval(l.uv, &l.footprint),
             Texture::Marble {
                 marble, mapping, ..
             } => marble.eval(at(*mapping, l)),
@@ -117,7 +118,7 @@ impl Texture {
                 let (v, _) = n.value_and_gradient(at(n.mapping, l), false);
                 n.low.lerp(n.high, v)
             }
-            Texture::HeightMap(h) => Vec3::splat(h.height(l.uv, l.footprint)),
+            Texture::HeightMap(h) => Vec3::splat(h.height(l.uv, l.footprint.width())),
             Texture::Ripple(r) => Vec3::splat(r.height(l.uv)),
         }
     }
@@ -131,7 +132,7 @@ impl Texture {
             Mapping::Uv => perturb_normal(n, dpdu, dpdv, g.x, g.y),
         };
         match self {
-            Texture::HeightMap(h) => h.perturb(n, dpdu, dpdv, l.uv, l.footprint),
+            Texture::HeightMap(h) => h.perturb(n, dpdu, dpdv, l.uv, l.footprint.width()),
             Texture::Ripple(r) => r.perturb(n, dpdu, dpdv, l.uv),
             Texture::Marble {
                 marble,

@@ -78,7 +78,7 @@ impl Default for RenderSettings {
             background: [0.0; 3],
             exposure: 1.0,
             integrator: IntegratorKind::Whitted,
-            texture_filter: TextureFilter::Trilinear,
+            texture_filter: TextureFilter::Anisotropic,
         }
     }
 }
@@ -93,8 +93,12 @@ pub enum IntegratorKind {
 /// How image textures (bitmaps and height maps) are filtered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 pub enum TextureFilter {
-    /// Mipmapped: bilinear in the two pyramid levels that match the pixel's footprint on the
-    /// surface (tracked through mirrors and refraction), blended linearly. No shimmer or moiré.
+    /// Mipmapped over the pixel's footprint on the surface (tracked through mirrors and
+    /// refraction): up to 16 trilinear lookups along the footprint's long axis, each at the
+    /// level of its width. No shimmer or moiré, and sharp at grazing angles.
+    Anisotropic,
+    /// Mipmapped: one trilinear lookup at the level of the footprint's longest extent. No
+    /// shimmer or moiré, but blurry at grazing angles.
     Trilinear,
     /// Bilinear lookups in the full-resolution image only: sharp, but distant or grazing
     /// textures alias (for comparison and debugging).

@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
+use super::footprint::{Footprint, lookup_anisotropic};
 use super::mipmap::MipMap;
 
 /// A colour image repeated `tile` times per axis over the surface's uv square, looked up with
@@ -26,14 +27,13 @@ impl BitmapTexture {
         }
     }
 
-    /// Linear RGB at surface coordinates `uv`; `footprint` is the pixel's width in surface uv
-    /// units (before tiling). Texture coordinates are `uv × tile`, and the footprint is scaled by
-    /// the larger of `|tile.x|`, `|tile.y|` (blurring rather than aliasing along the other axis).
+    /// Linear RGB at surface coordinates `uv`, filtered over the pixel's `footprint` (in
+    /// surface uv units, before tiling) with [`lookup_anisotropic`]. Texture coordinates are
+    /// `uv × tile`.
     #[inline]
     #[must_use]
-    pub fn eval(&self, uv: Vec2, footprint: f32) -> Vec3 {
-        self.mip
-            .lookup(uv * self.tile, footprint * self.tile.abs().max_element())
+    pub fn eval(&self, uv: Vec2, footprint: &Footprint) -> Vec3 {
+        lookup_anisotropic(&self.mip, uv * self.tile, &footprint.tiled(self.tile))
     }
 }
 
@@ -55,18 +55,20 @@ mod tests {
             (11.0, Vec3::Y),
         ] {
             assert!(
-                t.eval(Vec2::new(u / 12.0, 0.5), 0.0).distance(c) < 1e-6,
+                t.eval(Vec2::new(u / 12.0, 0.5), &Footprint::POINT)
+                    .distance(c)
+                    < 1e-6,
                 "{u}"
             );
         }
         // A footprint of 1/6 surface uv is 1/2 texture uv: level log2(0.5 · 2) = 0. A footprint
         // of 1/3 is 1 texture uv: level 1, the 1×1 mean.
         assert!(
-            t.eval(Vec2::new(1.0 / 12.0, 0.5), 1.0 / 6.0)
+            t.eval(Vec2::new(1.0 / 12.0, 0.5), &Footprint::isotropic(1.0 / 6.0))
                 .distance(Vec3::X)
                 < 1e-6
         );
-        let mean = t.eval(Vec2::new(1.0 / 12.0, 0.5), 1.0 / 3.0);
+        let mean = t.eval(Vec2::new(1.0 / 12.0, 0.5), &Footprint::isotropic(1.0 / 3.0));
         assert!(mean.distance(Vec3::new(0.5, 0.5, 0.0)) < 1e-6, "{mean}");
     }
 }

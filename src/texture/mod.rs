@@ -13,6 +13,7 @@
 pub mod bitmap;
 pub mod bump;
 pub mod error;
+pub mod footprint;
 pub mod marble;
 pub mod mipmap;
 pub mod noise;
@@ -21,6 +22,7 @@ pub mod ripple;
 pub use bitmap::BitmapTexture;
 pub use bump::{HeightMap, perturb_normal, perturb_normal_by_gradient};
 pub use error::TextureError;
+pub use footprint::{Footprint, lookup_anisotropic};
 pub use marble::Marble;
 pub use mipmap::{GreyMipMap, MipMap, Texel, srgb_to_linear};
 pub use noise::Noise;

@@ -61,7 +61,7 @@ fn back_facing(s: &RenderScene) -> (f64, u32) {
             let l = Lookup {
                 p: sp.p,
                 uv: sp.uv,
-                footprint: 0.0,
+                footprint: caustic::texture::Footprint::POINT,
             };
             let n = s.textures[t as usize].bump(sp.ns, sp.dpdu, sp.dpdv, &l);
             let wo = -ray.dir;
