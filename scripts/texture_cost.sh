@@ -3,11 +3,12 @@
 # scenes/texture_map.ron with their textures, and with textures swapped for constant colours
 # (via --set), interleaving the variants round-robin so machine load affects all alike, and
 # prints the median render time of each and its ratio to the untextured baseline.
-# Usage: scripts/texture_cost.sh [runs] [extra caustic flags, e.g. --threads 1]
+# Usage: scripts/texture_cost.sh [runs] [extra caustic flags; default --spp 16]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-7}
 shift $(( $# > 0 ? 1 : 0 ))
+if [ $# -eq 0 ]; then set -- --spp 16; fi
 cargo build --release --quiet
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
@@ -22,7 +23,8 @@ variants=(
   "noise: everything|scenes/noise.ron|"
   "texture_map: no textures|scenes/texture_map.ron|materials.floor.color=$grey materials.tiled.color=$grey materials.tiled_ball.color=$grey"
   "texture_map: bitmaps, bilinear|scenes/texture_map.ron|render.texture_filter=\"Bilinear\""
-  "texture_map: bitmaps, trilinear|scenes/texture_map.ron|"
+  "texture_map: bitmaps, trilinear|scenes/texture_map.ron|render.texture_filter=\"Trilinear\""
+  "texture_map: bitmaps, anisotropic|scenes/texture_map.ron|"
 )
 
 for i in $(seq "$runs"); do
