@@ -385,3 +385,45 @@ fn texture_lookups_are_deterministic_across_thread_counts() {
     .0;
     assert_eq!(one.pixels, two.pixels);
 }
+
+#[test]
+fn only_used_textures_are_loaded_and_each_image_once() {
+    let wood = common::root().join("assets/hardwood.png");
+    let text = format!(
+        r#"Scene(
+            camera: Pinhole(eye: (0, 0, 5), look_at: (0, 0, 0), fov_y: 30),
+            textures: {{
+                "a": Bitmap(file: "{w}", tile: (2, 2)),
+                "b": Bitmap(file: "{w}", tile: (8, 8)),
+                "c": HeightMap(file: "{w}", depth: 0.01),
+                "missing": Bitmap(file: "no/such/file.png"),
+                "for_unused_material": Bitmap(file: "no/such/other.png"),
+            }},
+            materials: {{
+                "m1": (color: "a", bump: "c"),
+                "m2": (color: "b"),
+                "unused": (color: "for_unused_material"),
+            }},
+            lights: [Point(position: (0, 0, 5), power: (10, 10, 10))],
+            nodes: [Quad(material: "m1"), Sphere(material: "m2", center: (2, 0, 0))],
+        )"#,
+        w = wood.display()
+    );
+    let src = caustic::scene::SourceFile::new(Path::new("inline.ron"), text).expect("ron");
+    let file = src.parse().expect("parses");
+    let diags = caustic::scene::validate::validate(&file);
+    assert!(!diags.iter().any(|d| d.is_error()), "{diags:?}");
+    // The never-referenced texture is reported, the unused material's texture is not loaded.
+    assert!(
+        diags
+            .iter()
+            .any(|d| d.to_string().contains("texture `missing` is never used")),
+        "{diags:?}"
+    );
+    let (scene, stats) = caustic::compile::compile(&file, Path::new(".")).expect("compiles");
+    assert_eq!(stats.textures, 3, "a, b and c are used");
+    // hardwood.png decoded once as colour (shared by a and b) and once as grey (c).
+    assert_eq!(stats.images_loaded, 2);
+    assert_eq!(scene.textures.len(), 3);
+    assert_eq!(scene.materials.len(), 2);
+}
