@@ -136,8 +136,11 @@ fn toml_error(src: &SourceFile, e: &toml::de::Error, path: String) -> Diagnostic
     };
     let mut diag = parse_unknown_name(&msg).unwrap_or_else(|| Diagnostic::error("", msg.clone()));
     if let Some(field) = unknown_key(&diag) {
-        diag.path = if path.is_empty() {
+        // serde_path_to_error's path may already end with the unknown key itself.
+        diag.path = if path.is_empty() || path == field {
             field
+        } else if path.ends_with(&format!(".{field}")) {
+            path
         } else {
             format!("{path}.{field}")
         };
