@@ -301,12 +301,13 @@ impl Whitted<'_> {
     fn transmittance(&self, shadow: &Ray, counters: &mut Counters) -> Vec3 {
         counters.rays += 1;
         let scene = self.scene;
+        // Most shadow rays are either unblocked or blocked by an opaque scene: the any-hit
+        // query settles them; only blocked rays in scenes with transmitters look closer.
+        if !scene.geometry.occluded(shadow) {
+            return Vec3::ONE;
+        }
         if !self.transmissive {
-            return if scene.geometry.occluded(shadow) {
-                Vec3::ZERO
-            } else {
-                Vec3::ONE
-            };
+            return Vec3::ZERO;
         }
         let end = shadow.origin + shadow.dir * shadow.t_max;
         let mut ray = *shadow;
