@@ -64,6 +64,10 @@ impl MaterialTable {
             [m.diffuse, m.reflect, m.transmit],
             m.ior,
         );
+        let filtered = [color_texture, bump]
+            .into_iter()
+            .flatten()
+            .any(|t| self.textures.list[t as usize].filtered());
         let i = self.list.len() as u32;
         self.list.push((
             name.to_string(),
@@ -71,6 +75,7 @@ impl MaterialTable {
                 bsdf,
                 color_texture,
                 bump,
+                filtered,
             },
         ));
         self.index.insert(name.to_string(), i);

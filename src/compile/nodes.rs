@@ -206,8 +206,8 @@ impl Flattener<'_> {
 /// Texture coordinates for a triangle of a mesh without `vt`: box (tri-planar) projection in
 /// object space. The triangle is projected along the axis its normal is closest to and the two
 /// remaining object-space coordinates are the uv, in object units (a texture with `tile: (1, 1)`
-/// repeats once per object unit), oriented so images appear upright on the side faces (v
-/// grows downwards with y). Continuous within each group of faces facing the same axis; seams
+/// repeats once per object unit), oriented like the faces of a `Cube` node: upright on the side
+/// faces (v grows downwards with y), the top's image top towards −z, the bottom's towards +z. Continuous within each group of faces facing the same axis; seams
 /// where the dominant axis changes, as with any box mapping.
 fn box_projection(p: [Vec3; 3]) -> [Vec2; 3] {
     let n = (p[1] - p[0]).cross(p[2] - p[0]);
@@ -216,7 +216,7 @@ fn box_projection(p: [Vec3; 3]) -> [Vec2; 3] {
         if a.x >= a.y && a.x >= a.z {
             Vec2::new(q.z * -n.x.signum(), -q.y)
         } else if a.y >= a.z {
-            Vec2::new(q.x, q.z)
+            Vec2::new(q.x, q.z * n.y.signum())
         } else {
             Vec2::new(q.x * n.z.signum(), -q.y)
         }

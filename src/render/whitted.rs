@@ -28,7 +28,7 @@ pub struct Whitted<'a> {
     transmissive: bool,
 }
 
-/// Most transmitting surfaces a shadow ray passes through before it counts as blocked.
+/// Most transmitting surfaces a shadow ray crosses; beyond them the rest is taken as clear.
 const MAX_SHADOW_CROSSINGS: u32 = 64;
 
 /// A ray to trace and how it contributes.
@@ -326,7 +326,7 @@ impl Whitted<'_> {
             }
             let wo = -ray.dir.normalize();
             let s = scene.shading_point(material, &sp, wo, 0.0);
-            t *= s.bsdf.straight_transmittance(s.ns.dot(wo), s.entering);
+            t *= s.bsdf.straight_transmittance(s.ns.dot(wo));
             if t.max_element() <= 0.0 {
                 return Vec3::ZERO;
             }
@@ -338,7 +338,8 @@ impl Whitted<'_> {
             };
             counters.rays += 1;
         }
-        Vec3::ZERO
+        // Still crossing surfaces after the limit: keep what has come through so far.
+        t
     }
 }
 

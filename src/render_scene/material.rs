@@ -23,6 +23,8 @@ pub struct SurfaceMaterial {
     pub color_texture: Option<u32>,
     /// Texture perturbing the shading normal, as an index into `RenderScene::textures`.
     pub bump: Option<u32>,
+    /// Some texture of this material is an image, so lookups need the pixel's footprint.
+    pub filtered: bool,
 }
 
 /// The BSDF and frame at one hit, as seen from the outgoing direction `wo`.
@@ -56,12 +58,8 @@ impl RenderScene {
         let mut bsdf = material.bsdf;
         let mut ns = sp.ns;
         if material.color_texture.is_some() || material.bump.is_some() {
-            let filtered = [material.color_texture, material.bump]
-                .into_iter()
-                .flatten()
-                .any(|t| self.textures[t as usize].filtered());
             let footprint = match self.params.texture_filter {
-                _ if !filtered => Footprint::POINT,
+                _ if !material.filtered => Footprint::POINT,
                 TextureFilter::Anisotropic => uv_footprint(width, -wo, sp.ng, sp.dpdu, sp.dpdv),
                 TextureFilter::Trilinear => {
                     Footprint::isotropic(uv_footprint(width, -wo, sp.ng, sp.dpdu, sp.dpdv).width())

@@ -135,7 +135,7 @@ impl Geometry {
 
 impl Geometry {
     /// How strongly the surface curves at a hit, in 1/length (0 for flat faces): 1/r for a
-    /// sphere, 1/(shortest semi-axis) for an ellipsoid, and for a smooth-shaded triangle the
+    /// sphere, longest / shortest² semi-axis (its largest) for an ellipsoid, and for a smooth-shaded triangle the
     /// largest change of vertex normal per unit length along its edges. Used to widen texture
     /// footprints seen in curved mirrors and lenses.
     #[must_use]
@@ -143,13 +143,13 @@ impl Geometry {
         let k = match hit.prim.kind() {
             PrimKind::Sphere => 1.0 / self.spheres[hit.prim.index()].radius,
             PrimKind::Ellipsoid => {
+                // The largest curvature of an ellipsoid, at the ends of its longest axis:
+                // longest / shortest².
                 let m = self.ellipsoids[hit.prim.index()].world_from_object.matrix3;
-                let shortest = m
-                    .x_axis
-                    .length()
-                    .min(m.y_axis.length())
-                    .min(m.z_axis.length());
-                (1.0 / shortest) as f32
+                let axes = [m.x_axis.length(), m.y_axis.length(), m.z_axis.length()];
+                let shortest = axes.iter().copied().fold(f64::INFINITY, f64::min);
+                let longest = axes.iter().copied().fold(0.0, f64::max);
+                (longest / (shortest * shortest)) as f32
             }
             PrimKind::Triangle => {
                 let i = hit.prim.index();

@@ -20,6 +20,13 @@ pub const MAX_DEPTH: u32 = 1024;
 pub const MAX_NESTING: usize = 64;
 /// Most noise octaves accepted (each halves the feature size; 24 reach below f32 precision).
 pub const MAX_OCTAVES: u32 = 24;
+/// Highest frequency (per world or uv unit) the finest octave of a noise or marble texture may
+/// reach: finer detail than a millionth of a unit is never visible, and far beyond it the
+/// noise lattice runs out of f32 precision.
+pub const MAX_NOISE_FREQUENCY: f32 = 1e6;
+/// Largest marble turbulence (radians of phase).
+pub const MAX_TURBULENCE: f32 = 1e4;
+
 /// Most ripple centres per texture.
 pub const MAX_RIPPLE_CENTERS: usize = 256;
 
@@ -330,6 +337,16 @@ impl<'a> Validator<'a> {
                 );
             }
         };
+        let finest = |v: &mut Self, field: &str, f: f32, o: u32| {
+            let top = f64::from(f.abs()) * 2f64.powi(o.max(1) as i32 - 1);
+            // Too many octaves is its own error.
+            if f.is_finite() && o <= MAX_OCTAVES && top > f64::from(MAX_NOISE_FREQUENCY) {
+                v.err(
+                    &format!("{path}.{field}"),
+                    format!("with {o} octaves the finest octave has frequency {top:.3e} per unit, above the limit of {MAX_NOISE_FREQUENCY:e}"),
+                );
+            }
+        };
         let octaves = |v: &mut Self, o: u32| {
             if o > MAX_OCTAVES {
                 v.err(
@@ -369,9 +386,19 @@ impl<'a> Validator<'a> {
                     ScaleSpec::Uniform(u) => [*u; 3],
                     ScaleSpec::PerAxis(v) => *v,
                 };
-                self.finite3(&format!("{path}.frequency"), f);
+                if self.finite3(&format!("{path}.frequency"), f) {
+                    let top = f.iter().fold(0.0f32, |a, x| a.max(x.abs()));
+                    finest(self, "frequency", top, *o);
+                }
                 octaves(self, *o);
-                self.finite(&format!("{path}.turbulence"), *turbulence);
+                if self.finite(&format!("{path}.turbulence"), *turbulence)
+                    && turbulence.abs() > MAX_TURBULENCE
+                {
+                    self.err(
+                        &format!("{path}.turbulence"),
+                        format!("must be within ±{MAX_TURBULENCE}, found {turbulence:e}"),
+                    );
+                }
                 self.finite(&format!("{path}.depth"), *depth);
             }
             TextureSpec::Noise {
@@ -385,6 +412,7 @@ impl<'a> Validator<'a> {
                 self.unit_rgb(&format!("{path}.low"), *low, "low");
                 self.unit_rgb(&format!("{path}.high"), *high, "high");
                 self.positive(&format!("{path}.frequency"), *frequency, "frequency");
+                finest(self, "frequency", *frequency, *o);
                 octaves(self, *o);
                 if *o == 0 {
                     self.err(

@@ -102,18 +102,20 @@ impl Material {
 
     /// The fraction of light that crosses the surface in a straight line, for shadow rays of
     /// integrators that do not follow refraction (Whitted): the dielectric part's Fresnel
-    /// transmittance, tinted by `color`. `cos` is the cosine between the crossing direction and
-    /// the shading normal on its side, `entering` whether it crosses from outside to inside.
-    /// Exact for `ior == 1` (the refracted ray is the straight one); for other indices it ignores
-    /// the bending, so the light that glass focuses (caustics) needs photon mapping instead.
+    /// transmittance, tinted by `color`, at the angle `acos(cos)` to the normal. It is evaluated
+    /// as seen from the outside whichever way the ray crosses: light leaving through a surface
+    /// left the refracted angle, and by reciprocity its transmittance equals that of entering at
+    /// the outside angle, so a slab crossed at θ transmits exactly T(θ)² (and never totally
+    /// reflects). Exact for `ior == 1` (the refracted ray is the straight one); for other
+    /// indices it ignores the bending, so the light that glass focuses (caustics) needs photon
+    /// mapping instead.
     #[inline]
     #[must_use]
-    pub fn straight_transmittance(&self, cos: f32, entering: bool) -> Vec3 {
+    pub fn straight_transmittance(&self, cos: f32) -> Vec3 {
         if self.transmit == 0.0 {
             return Vec3::ZERO;
         }
-        let eta = if entering { 1.0 / self.ior } else { self.ior };
-        self.color * (self.transmit * (1.0 - fresnel_dielectric(cos, eta)))
+        self.color * (self.transmit * (1.0 - fresnel_dielectric(cos, 1.0 / self.ior)))
     }
 
     /// The mirror and dielectric lobes at a point. `n` is the shading normal and `ng` the

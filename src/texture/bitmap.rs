@@ -61,8 +61,9 @@ mod tests {
                 "{u}"
             );
         }
-        // A footprint of 1/6 surface uv is 1/2 texture uv: level log2(0.5 · 2) = 0. A footprint
-        // of 1/3 is 1 texture uv: level 1, the 1×1 mean.
+        // With a uniform tile (3, 3) a round footprint stays round: 1/6 surface uv is 1/2
+        // texture uv, level log2(0.5 · 2) = 0; 1/3 is 1 texture uv, level 1, the 1×1 mean.
+        let t = BitmapTexture::new(t.mip.clone(), Vec2::splat(3.0));
         assert!(
             t.eval(Vec2::new(1.0 / 12.0, 0.5), &Footprint::isotropic(1.0 / 6.0))
                 .distance(Vec3::X)
@@ -70,5 +71,13 @@ mod tests {
         );
         let mean = t.eval(Vec2::new(1.0 / 12.0, 0.5), &Footprint::isotropic(1.0 / 3.0));
         assert!(mean.distance(Vec3::new(0.5, 0.5, 0.0)) < 1e-6, "{mean}");
+        // With tile (3, 1) the same round footprint is 3× longer in u than in v: filtered
+        // along u (probes spread over half the image), so no longer the red texel alone.
+        let stretched = BitmapTexture::new(t.mip.clone(), Vec2::new(3.0, 1.0));
+        let c = stretched.eval(Vec2::new(1.0 / 12.0, 0.5), &Footprint::isotropic(1.0 / 6.0));
+        assert!(
+            c.x > 0.6 && c.y > 0.1 && (c.x + c.y - 1.0).abs() < 1e-5,
+            "{c}"
+        );
     }
 }

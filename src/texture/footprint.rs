@@ -43,13 +43,35 @@ impl Footprint {
         self.major.length().max(self.minor)
     }
 
-    /// The footprint in the coordinates of a texture repeated `tile` times per axis.
+    /// The footprint in the coordinates of a texture repeated `tile` times per axis: both of
+    /// its axes (`major` and the width across it) are scaled per axis, and the longer of the
+    /// two becomes the new long axis (a non-uniform tile can turn a footprint's short side into
+    /// its long one).
     #[inline]
     #[must_use]
     pub fn tiled(&self, tile: Vec2) -> Self {
+        let len = self.major.length();
+        if !(len > 0.0) {
+            return Self {
+                major: Vec2::new(self.minor * tile.x.abs(), 0.0),
+                minor: self.minor * tile.abs().min_element(),
+            };
+        }
+        let a = self.major * tile;
+        let b = self.major.perp() * (self.minor / len) * tile;
+        let (long, short) = if a.length_squared() >= b.length_squared() {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let long_len = long.length();
         Self {
-            major: self.major * tile,
-            minor: self.minor * tile.abs().max_element(),
+            major: long,
+            minor: if long_len > 0.0 {
+                long.perp_dot(short).abs() / long_len
+            } else {
+                0.0
+            },
         }
     }
 }
@@ -136,12 +158,29 @@ mod tests {
 
     #[test]
     fn tiling_scales_the_footprint_per_axis() {
+        // Uniform tiling scales everything.
         let f = Footprint {
             major: Vec2::new(0.1, 0.2),
             minor: 0.05,
         }
-        .tiled(Vec2::new(2.0, 4.0));
-        assert_eq!(f.major, Vec2::new(0.2, 0.8));
-        assert_eq!(f.minor, 0.2);
+        .tiled(Vec2::splat(4.0));
+        assert!(f.major.distance(Vec2::new(0.4, 0.8)) < 1e-6 && (f.minor - 0.2).abs() < 1e-6);
+        // A round footprint under tile (1, 16) becomes long in v and stays thin in u.
+        let f = Footprint::isotropic(0.01).tiled(Vec2::new(1.0, 16.0));
+        assert!((f.major.length() - 0.16).abs() < 1e-6, "{f:?}");
+        assert!(f.major.x.abs() < 1e-7, "{f:?}");
+        assert!((f.minor - 0.01).abs() < 1e-6, "{f:?}");
+        // Area is scaled by the tile's determinant: |major| · minor.
+        let g = Footprint {
+            major: Vec2::new(0.03, 0.04),
+            minor: 0.01,
+        };
+        let t = g.tiled(Vec2::new(3.0, 0.5));
+        let area = |f: &Footprint| f.major.length() * f.minor;
+        assert!((area(&t) - area(&g) * 1.5).abs() < 1e-7, "{t:?}");
+        assert_eq!(
+            Footprint::POINT.tiled(Vec2::new(2.0, 3.0)),
+            Footprint::POINT
+        );
     }
 }

@@ -74,8 +74,10 @@ impl Noise {
 
     #[inline]
     fn gradient_at(&self, x: i32, y: i32, z: i32) -> Vec3 {
-        let p = |i: i32| self.perm[(i & 255) as usize] as i32;
-        GRADIENTS[(p(p(p(x) + y) + z) & 15) as usize]
+        // Only the low 8 bits of each sum matter, so wrapping keeps any lattice index valid
+        // (huge coordinates saturate to i32::MAX on the cast) without changing the result.
+        let p = |i: i32| i32::from(self.perm[(i & 255) as usize]);
+        GRADIENTS[(p(p(p(x).wrapping_add(y)).wrapping_add(z)) & 15) as usize]
     }
 
     /// Lattice cell of `p`, position in it, and the eight corner gradients (x fastest).
@@ -250,6 +252,17 @@ mod tests {
         assert!(hi - lo > 0.8, "fbm barely varies: [{lo}, {hi}]");
         assert!(mean.abs() < 0.03, "mean {mean}");
         assert!(tmax < 2.0 && tmax > 0.4, "{tmax}");
+    }
+
+    #[test]
+    fn huge_coordinates_give_finite_values_without_overflow() {
+        let n = Noise::new(5);
+        for p in [Vec3::splat(1e33), Vec3::new(3e9, -3e9, 1e20)] {
+            assert!(n.noise(p).is_finite(), "{p}");
+            assert!(n.fbm(p, 4).is_finite(), "{p}");
+        }
+        // The largest finite coordinates still give a finite single octave (2× them would not).
+        assert!(n.noise(Vec3::new(f32::MAX, f32::MIN, 0.5)).is_finite());
     }
 
     #[test]

@@ -220,3 +220,48 @@ fn a_ball_half_under_water_is_lit_and_seen_through_the_surface() {
     eprintln!("{red} of {through_top} pixels seen through the water top show the lit ball");
     assert!(red >= 20, "{red}");
 }
+
+/// A 2 cm glass pane (ior 1.5) between a floor and its light, lit by a point light at `angle` from vertical:
+/// the floor's brightness under the pane relative to the open floor.
+fn pane_transmission(angle: f32) -> f32 {
+    let (s, c) = angle.to_radians().sin_cos();
+    let light = Vec3::new(-8.0 * s, 8.0 * c, 0.0);
+    let render = |pane: &str| {
+        let sc = scene(&format!(
+            r#"Scene(
+                render: (width: 16, height: 16, samples_per_pixel: 1),
+                camera: Pinhole(eye: (0, 0.5, 0.001), look_at: (0, 0, 0), fov_y: 10),
+                materials: {{ "floor": (color: (0.5, 0.5, 0.5)), "glass": (color: (1, 1, 1), diffuse: 0, transmit: 1, ior: 1.5) }},
+                lights: [Point(position: ({}, {}, {}), power: (1000, 1000, 1000))],
+                nodes: [
+                    Quad(material: "floor", size: (40, 40), transform: [RotateX(-90)]),
+                    {pane}
+                ],
+            )"#,
+            light.x, light.y, light.z
+        ));
+        let out = caustic::render::render(&sc, &caustic::render::RenderOptions::default())
+            .expect("renders");
+        out.film.get(8, 8).x
+    };
+    // The pane (20 × 20, 2 cm thick) hangs at height 1, above the camera (0.5), so the camera
+    // sees the floor directly and only the shadow rays cross the pane.
+    let covered = render(
+        r#"Cube(material: "glass", size: 1, transform: [Scale((20, 0.02, 20)), Translate(0, 1.0, 0)]),"#,
+    );
+    let open = render("");
+    covered / open
+}
+
+/// Whitted shadow rays cross a glass pane in a straight line with the Fresnel transmittance of
+/// both faces, never totally reflected on the way out: T(θ)² at any angle.
+#[test]
+fn a_glass_pane_passes_its_fresnel_transmittance_at_steep_and_shallow_angles() {
+    use caustic::shading::optics::fresnel_dielectric;
+    for angle in [0.0f32, 30.0, 44.0, 50.0, 60.0, 75.0] {
+        let t = 1.0 - fresnel_dielectric(angle.to_radians().cos(), 1.0 / 1.5);
+        let got = pane_transmission(angle);
+        eprintln!("pane at {angle}°: {got:.4} (T² = {:.4})", t * t);
+        assert!((got - t * t).abs() < 2e-3, "{angle}°: {got} vs {}", t * t);
+    }
+}
