@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Render-time cost of each texture kind (issue #3): renders scenes/noise.ron and
-# scenes/texture_map.ron with their textures, and with textures swapped for constant colours
-# (via --set), interleaving the variants round-robin so machine load affects all alike, and
-# prints the median render time of each and its ratio to the untextured baseline.
+# Render-time cost of each texture kind (issue #3): renders scenes/noise.ron,
+# scenes/texture_map.ron, scenes/bump_map.ron and scenes/water.ron with their textures, and
+# with textures swapped for constant colours or bumps removed (via --set), interleaving the
+# variants round-robin so machine load affects all alike, and prints the median render time of
+# each and its ratio to the scene's untextured baseline.
 # Usage: scripts/texture_cost.sh [runs] [extra caustic flags; default --spp 16]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,6 +26,11 @@ variants=(
   "texture_map: bitmaps, bilinear|scenes/texture_map.ron|render.texture_filter=\"Bilinear\""
   "texture_map: bitmaps, trilinear|scenes/texture_map.ron|render.texture_filter=\"Trilinear\""
   "texture_map: bitmaps, anisotropic|scenes/texture_map.ron|"
+  "bump_map: no bumps|scenes/bump_map.ron|materials.wall.bump=null materials.ball.bump=null materials.cube.bump=null materials.hammered_mirror.bump=null"
+  "bump_map: height-map bumps only|scenes/bump_map.ron|materials.hammered_mirror.bump=null"
+  "bump_map: everything|scenes/bump_map.ron|"
+  "water: no ripples|scenes/water.ron|materials.water.bump=null"
+  "water: ripples|scenes/water.ron|"
 )
 
 for i in $(seq "$runs"); do
@@ -44,5 +50,5 @@ for k in "${!variants[@]}"; do
     | awk -v name="$name" '{a[NR]=$1} END {printf "%-40s %7.3f s\n", name, a[int((NR+1)/2)]}'
 done | awk '
   { n = $0; sub(/ +[0-9.]+ s$/, "", n); t = $(NF-1)
-    split(n, p, ":"); if (p[2] ~ /no textures/) base[p[1]] = t
+    split(n, p, ":"); if (p[2] ~ /^ no /) base[p[1]] = t
     printf "%s  (%.2fx)\n", $0, (p[1] in base) ? t / base[p[1]] : 1 }'
