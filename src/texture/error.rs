@@ -21,6 +21,23 @@ pub enum TextureError {
         /// Texels supplied.
         got: usize,
     },
+    /// The image's header claims a size over the texture limits
+    /// ([`MAX_IMAGE_SIDE`](super::mipmap::MAX_IMAGE_SIDE) per side,
+    /// [`MAX_IMAGE_BYTES`](super::mipmap::MAX_IMAGE_BYTES) to load); nothing was allocated for it.
+    #[error(
+        "image is {width}x{height} pixels: too large for a texture (at most {max_side} pixels per side and {limit_mib} MiB to load; this one needs {needed_mib} MiB)",
+        max_side = super::mipmap::MAX_IMAGE_SIDE,
+        limit_mib = super::mipmap::MAX_IMAGE_BYTES >> 20,
+        needed_mib = needed.div_ceil(1 << 20),
+    )]
+    TooLarge {
+        /// Width in pixels, from the header.
+        width: u32,
+        /// Height in pixels, from the header.
+        height: u32,
+        /// Bytes loading it would take: decoded image, float conversion and pyramid.
+        needed: u64,
+    },
     /// The image file could not be read or decoded.
     #[error("cannot load texture image: {0}")]
     Image(#[from] image::ImageError),

@@ -6,10 +6,12 @@
 //! period 1 on both axes (repeat), so `u = 1.0` is `u = 0.0` and `u = −0.25` is `u = 0.75`.
 //! Meshes whose `v` points up (OBJ, OpenGL) need `v ↦ 1 − v` at the call site.
 
+use std::io::{BufRead, Cursor, Seek};
 use std::ops::{Add, Mul};
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
+use image::{DynamicImage, ImageDecoder, ImageReader, Limits};
 
 use super::error::TextureError;
 
@@ -38,6 +40,78 @@ pub struct MipMap<T = Vec3> {
 
 /// A single-channel pyramid, for height maps.
 pub type GreyMipMap = MipMap<f32>;
+
+/// Largest image side, in pixels, that [`MipMap::open`], [`MipMap::from_bytes`] and their grey
+/// twins accept.
+pub const MAX_IMAGE_SIDE: u32 = 16_384;
+
+/// Most memory, in bytes, that decoding one image file into a pyramid may take: the decoded image
+/// plus, per pixel, twice the texel size (the float conversion and then the pyramid, which is at
+/// most 4/3 of level 0 plus a half-level of scratch). It is checked against the file's header
+/// before any pixel buffer is allocated, and is also the `image` decoders' own allocation limit.
+///
+/// 1 GiB admits colour images up to about 6300 × 6300 (8-bit RGB needs 27 bytes per pixel) and
+/// grey ones up to about 10900 × 10900 (9 bytes per pixel).
+pub const MAX_IMAGE_BYTES: u64 = 1 << 30;
+
+/// Magnitude to which decoded float texels (EXR) are clamped, the largest half-float: values
+/// beyond it mean nothing as a reflectance or a height, and keeping texels well inside `f32`
+/// keeps every filtered lookup finite. NaN texels read as 0.
+pub const MAX_TEXEL: f32 = 65_504.0;
+
+/// A decoded channel value made safe to filter: NaN → 0, clamped to ±[`MAX_TEXEL`].
+#[inline]
+fn sanitize(v: f32) -> f32 {
+    if v.is_nan() {
+        0.0
+    } else {
+        v.clamp(-MAX_TEXEL, MAX_TEXEL)
+    }
+}
+
+/// Decodes an image under the texture limits ([`MAX_IMAGE_SIDE`], [`MAX_IMAGE_BYTES`] with
+/// `texel_bytes` bytes per texel in the final pyramid), reading only the header before refusing
+/// an image that is too large.
+fn decode_limited<R: BufRead + Seek>(
+    mut reader: ImageReader<R>,
+    texel_bytes: u64,
+) -> Result<DynamicImage, TextureError> {
+    let mut limits = Limits::default();
+    limits.max_alloc = Some(MAX_IMAGE_BYTES);
+    reader.limits(limits.clone());
+    let mut decoder = reader.into_decoder()?;
+    let (width, height) = decoder.dimensions();
+    let pixels = u64::from(width) * u64::from(height);
+    let needed = decoder
+        .total_bytes()
+        .saturating_add(pixels.saturating_mul(2 * texel_bytes));
+    if width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE || needed > MAX_IMAGE_BYTES {
+        return Err(TextureError::TooLarge {
+            width,
+            height,
+            needed,
+        });
+    }
+    // The strict side limits too, for decoders that honour them while decoding.
+    limits.max_image_width = Some(MAX_IMAGE_SIDE);
+    limits.max_image_height = Some(MAX_IMAGE_SIDE);
+    decoder.set_limits(limits)?;
+    Ok(DynamicImage::from_decoder(decoder)?)
+}
+
+/// An `ImageReader` over the file at `path`, format from the extension (as `image::open`).
+fn file_reader(
+    path: &Path,
+) -> Result<ImageReader<std::io::BufReader<std::fs::File>>, TextureError> {
+    Ok(ImageReader::open(path).map_err(image::ImageError::IoError)?)
+}
+
+/// An `ImageReader` over in-memory file contents, format guessed from the leading bytes.
+fn bytes_reader(bytes: &[u8]) -> Result<ImageReader<Cursor<&[u8]>>, TextureError> {
+    Ok(ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(image::ImageError::IoError)?)
+}
 
 /// The sRGB decoding curve: an encoded value in [0, 1] to linear.
 #[inline]
@@ -166,51 +240,101 @@ impl<T: Texel> MipMap<T> {
 impl MipMap<Vec3> {
     /// A colour pyramid from an image's RGB channels (alpha is ignored). With `srgb`, 8/16-bit
     /// values are decoded from sRGB to linear (what PNG/JPEG colour textures need); without, they
-    /// are taken as linear (float images such as EXR, or data textures).
+    /// are taken as linear (float images such as EXR, or data textures). Float channels are
+    /// clamped to ±[`MAX_TEXEL`], NaN to 0.
     ///
     /// # Errors
     /// [`TextureError::Empty`] for a zero-sized image.
-    pub fn from_image(img: &image::DynamicImage, srgb: bool) -> Result<Self, TextureError> {
-        let rgb = img.to_rgb32f();
-        let (w, h) = rgb.dimensions();
-        let texels = rgb
-            .pixels()
-            .map(|p| {
-                let c = Vec3::from_array(p.0);
-                if srgb { c.map(srgb_to_linear) } else { c }
-            })
-            .collect();
-        Self::new(w, h, texels)
+    pub fn from_image(img: &DynamicImage, srgb: bool) -> Result<Self, TextureError> {
+        Self::from_rgb32f(img.to_rgb32f(), srgb)
     }
 
-    /// [`from_image`](Self::from_image) of the file at `path` (PNG, JPEG or EXR).
+    /// [`from_image`](Self::from_image) of the file at `path` (PNG, JPEG or EXR, chosen by the
+    /// extension), decoded under the texture limits ([`MAX_IMAGE_SIDE`], [`MAX_IMAGE_BYTES`]).
     ///
     /// # Errors
-    /// [`TextureError::Image`] when the file cannot be read or decoded, or as `from_image`.
+    /// [`TextureError::Image`] when the file cannot be read or decoded,
+    /// [`TextureError::TooLarge`] when its header claims a size over the limits, or as
+    /// `from_image`.
     pub fn open(path: &Path, srgb: bool) -> Result<Self, TextureError> {
-        Self::from_image(&image::open(path)?, srgb)
+        Self::decode(file_reader(path)?, srgb)
+    }
+
+    /// [`open`](Self::open) of a file's contents already in memory, the format recognised from
+    /// the leading bytes (PNG, JPEG or EXR): the same decoding, limits and conversion.
+    ///
+    /// # Errors
+    /// As [`open`](Self::open); an unrecognised format is a [`TextureError::Image`].
+    pub fn from_bytes(bytes: &[u8], srgb: bool) -> Result<Self, TextureError> {
+        Self::decode(bytes_reader(bytes)?, srgb)
+    }
+
+    fn decode<R: BufRead + Seek>(reader: ImageReader<R>, srgb: bool) -> Result<Self, TextureError> {
+        let img = decode_limited(reader, size_of::<Vec3>() as u64)?;
+        // Owned conversion: the decoded image is freed before the pyramid is built.
+        Self::from_rgb32f(img.into_rgb32f(), srgb)
+    }
+
+    fn from_rgb32f(rgb: image::Rgb32FImage, srgb: bool) -> Result<Self, TextureError> {
+        let (w, h) = rgb.dimensions();
+        let mut raw = rgb.into_raw();
+        for v in &mut raw {
+            *v = sanitize(if srgb { srgb_to_linear(*v) } else { *v });
+        }
+        let texels = raw.chunks_exact(3).map(Vec3::from_slice).collect();
+        drop(raw);
+        Self::new(w, h, texels)
     }
 }
 
 impl MipMap<f32> {
     /// A grey pyramid of the image's **raw** grey values in [0, 1] (for 8/16-bit images), with no
     /// sRGB decoding: heights are data, and a grey ramp in the file stays a linear ramp. Colour
-    /// images are reduced to the `image` crate's Rec. 709 luma of the stored values.
+    /// images are reduced to the `image` crate's Rec. 709 luma of the stored values. Float values
+    /// are clamped to ±[`MAX_TEXEL`], NaN to 0.
     ///
     /// # Errors
     /// [`TextureError::Empty`] for a zero-sized image.
-    pub fn from_image_grey(img: &image::DynamicImage) -> Result<Self, TextureError> {
-        let grey = img.to_luma32f();
-        let (w, h) = grey.dimensions();
-        Self::new(w, h, grey.into_raw())
+    pub fn from_image_grey(img: &DynamicImage) -> Result<Self, TextureError> {
+        Self::from_luma32f(img.to_luma32f())
     }
 
-    /// [`from_image_grey`](Self::from_image_grey) of the file at `path`.
+    /// [`from_image_grey`](Self::from_image_grey) of the file at `path`, decoded under the
+    /// texture limits as [`MipMap::open`].
     ///
     /// # Errors
-    /// [`TextureError::Image`] when the file cannot be read or decoded, or as `from_image_grey`.
+    /// [`TextureError::Image`] when the file cannot be read or decoded,
+    /// [`TextureError::TooLarge`] when its header claims a size over the limits, or as
+    /// `from_image_grey`.
     pub fn open_grey(path: &Path) -> Result<Self, TextureError> {
-        Self::from_image_grey(&image::open(path)?)
+        Self::decode_grey(file_reader(path)?)
+    }
+
+    /// [`open_grey`](Self::open_grey) of a file's contents already in memory, the format
+    /// recognised from the leading bytes.
+    ///
+    /// # Errors
+    /// As [`open_grey`](Self::open_grey); an unrecognised format is a [`TextureError::Image`].
+    pub fn from_bytes_grey(bytes: &[u8]) -> Result<Self, TextureError> {
+        Self::decode_grey(bytes_reader(bytes)?)
+    }
+
+    fn decode_grey<R: BufRead + Seek>(reader: ImageReader<R>) -> Result<Self, TextureError> {
+        let img = decode_limited(reader, size_of::<f32>() as u64)?;
+        let grey = img.to_luma32f();
+        drop(img);
+        Self::from_luma32f(grey)
+    }
+
+    fn from_luma32f(
+        grey: image::ImageBuffer<image::Luma<f32>, Vec<f32>>,
+    ) -> Result<Self, TextureError> {
+        let (w, h) = grey.dimensions();
+        let mut raw = grey.into_raw();
+        for v in &mut raw {
+            *v = sanitize(*v);
+        }
+        Self::new(w, h, raw)
     }
 }
 
@@ -313,6 +437,153 @@ mod tests {
             m.bilinear(0, Vec2::new(f32::NAN, f32::INFINITY))
                 .is_finite()
         );
+    }
+
+    /// CRC-32 (PNG's chunk checksum), bitwise.
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in bytes {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 == 1 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+
+    /// A valid 1×1 RGB PNG whose IHDR is rewritten to claim `width × height` (CRC fixed up).
+    fn png_claiming(width: u32, height: u32) -> Vec<u8> {
+        let img = image::DynamicImage::ImageRgb8(image::RgbImage::new(1, 1));
+        let mut png = Vec::new();
+        img.write_to(&mut Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        // Signature (8), IHDR length (4), "IHDR" (4), width, height, 5 more bytes, CRC.
+        assert_eq!(&png[12..16], b"IHDR");
+        png[16..20].copy_from_slice(&width.to_be_bytes());
+        png[20..24].copy_from_slice(&height.to_be_bytes());
+        let crc = crc32(&png[12..29]);
+        png[29..33].copy_from_slice(&crc.to_be_bytes());
+        png
+    }
+
+    #[test]
+    fn from_bytes_decodes_like_open() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/");
+        for (file, srgb) in [("tiles_color.png", true), ("hardwood.png", false)] {
+            let path = Path::new(dir).join(file);
+            let bytes = std::fs::read(&path).unwrap();
+            assert_eq!(
+                MipMap::from_bytes(&bytes, srgb).unwrap(),
+                MipMap::open(&path, srgb).unwrap()
+            );
+        }
+        let path = Path::new(dir).join("tiles_height.png");
+        let bytes = std::fs::read(&path).unwrap();
+        let grey = MipMap::from_bytes_grey(&bytes).unwrap();
+        assert_eq!(grey, MipMap::open_grey(&path).unwrap());
+        assert_eq!((grey.width(), grey.height()), (128, 128));
+        // The header rewrite keeps a 1×1 PNG decodable.
+        assert_eq!(
+            MipMap::from_bytes(&png_claiming(1, 1), true)
+                .unwrap()
+                .levels(),
+            1
+        );
+        // Not an image, or a truncated one: decoding errors, not panics.
+        for bad in [&b"not an image"[..], &bytes[..bytes.len() / 2], &[]] {
+            assert!(matches!(
+                MipMap::from_bytes(bad, true),
+                Err(TextureError::Image(_))
+            ));
+            assert!(matches!(
+                MipMap::from_bytes_grey(bad),
+                Err(TextureError::Image(_))
+            ));
+        }
+    }
+
+    #[test]
+    fn a_header_claiming_a_gigantic_image_is_refused_before_decoding() {
+        // 100000 × 100000 RGB would be 30 GB decoded and 270 GB with the pyramid.
+        let png = png_claiming(100_000, 100_000);
+        let err = MipMap::from_bytes(&png, true).unwrap_err();
+        let TextureError::TooLarge {
+            width,
+            height,
+            needed,
+        } = err
+        else {
+            panic!("{err:?}")
+        };
+        assert_eq!((width, height), (100_000, 100_000));
+        assert_eq!(needed, 100_000u64 * 100_000 * (3 + 24));
+        assert_eq!(
+            err.to_string(),
+            "image is 100000x100000 pixels: too large for a texture (at most 16384 pixels per \
+             side and 1024 MiB to load; this one needs 257493 MiB)"
+        );
+        assert!(matches!(
+            MipMap::from_bytes_grey(&png),
+            Err(TextureError::TooLarge { .. })
+        ));
+        // Through a file too, as the renderer loads it.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.png");
+        std::fs::write(&path, &png).unwrap();
+        assert!(matches!(
+            MipMap::open(&path, true),
+            Err(TextureError::TooLarge { .. })
+        ));
+        assert!(matches!(
+            MipMap::open_grey(&path),
+            Err(TextureError::TooLarge { .. })
+        ));
+        // A side over 16384 is refused even when the pixel count is small.
+        assert!(matches!(
+            MipMap::from_bytes_grey(&png_claiming(MAX_IMAGE_SIDE + 1, 1)),
+            Err(TextureError::TooLarge {
+                width: 16_385,
+                height: 1,
+                ..
+            })
+        ));
+        // Within the limits, the size is accepted and the (missing) data is the error.
+        assert!(matches!(
+            MipMap::from_bytes(&png_claiming(MAX_IMAGE_SIDE, 2), true),
+            Err(TextureError::Image(_))
+        ));
+    }
+
+    #[test]
+    fn non_finite_float_texels_are_sanitised() {
+        let img = image::DynamicImage::ImageRgb32F(
+            image::Rgb32FImage::from_raw(
+                2,
+                1,
+                vec![f32::NAN, f32::INFINITY, -f32::INFINITY, 0.5, 1e30, -2.0],
+            )
+            .unwrap(),
+        );
+        let mut exr = Vec::new();
+        img.write_to(&mut Cursor::new(&mut exr), image::ImageFormat::OpenExr)
+            .unwrap();
+        for m in [
+            MipMap::from_image(&img, false).unwrap(),
+            MipMap::from_bytes(&exr, false).unwrap(),
+        ] {
+            assert_eq!(m.texel(0, 0, 0), Vec3::new(0.0, MAX_TEXEL, -MAX_TEXEL));
+            assert_eq!(m.texel(0, 1, 0), Vec3::new(0.5, MAX_TEXEL, -2.0));
+            assert!(m.lookup(Vec2::new(0.5, 0.5), 0.7).is_finite());
+        }
+        let g = MipMap::from_bytes_grey(&exr).unwrap();
+        assert!(g.texel(0, 0, 0).is_finite() && g.texel(0, 1, 0).is_finite());
+        // sRGB decoding of huge or negative float values stays finite too.
+        let m = MipMap::from_bytes(&exr, true).unwrap();
+        assert!((0..2).all(|i| m.texel(0, i, 0).is_finite()));
     }
 
     #[test]
