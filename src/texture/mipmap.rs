@@ -50,9 +50,9 @@ pub const MAX_IMAGE_SIDE: u32 = 16_384;
 /// most 4/3 of level 0 plus a half-level of scratch). It is checked against the file's header
 /// before any pixel buffer is allocated, and is also the `image` decoders' own allocation limit.
 ///
-/// 1 GiB admits colour images up to about 6300 × 6300 (8-bit RGB needs 27 bytes per pixel) and
-/// grey ones up to about 10900 × 10900 (9 bytes per pixel).
-pub const MAX_IMAGE_BYTES: u64 = 1 << 30;
+/// 4 GiB admits 8-bit colour images up to about 12600 × 12600 (27 bytes per pixel, so 8K
+/// textures load) and grey ones up to the side limit (9 bytes per pixel).
+pub const MAX_IMAGE_BYTES: u64 = 4 << 30;
 
 /// Magnitude to which decoded float texels (EXR) are clamped, the largest half-float: values
 /// beyond it mean nothing as a reflectance or a height, and keeping texels well inside `f32`
@@ -524,7 +524,7 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "image is 100000x100000 pixels: too large for a texture (at most 16384 pixels per \
-             side and 1024 MiB to load; this one needs 257493 MiB)"
+             side and 4096 MiB to load; this one needs 257493 MiB)"
         );
         assert!(matches!(
             MipMap::from_bytes_grey(&png),
