@@ -26,6 +26,8 @@ pub struct Whitted<'a> {
     pixel_spread: f32,
     /// Some material transmits, so shadow rays must look for what they pass through.
     transmissive: bool,
+    /// Per object: it stops shadow rays outright (no transmitting part, or an emitter).
+    opaque: Vec<bool>,
 }
 
 /// Most transmitting surfaces a shadow ray crosses; beyond them the rest is taken as clear.
@@ -75,6 +77,14 @@ impl<'a> Whitted<'a> {
             scene,
             pixel_spread: scene.pixel_spread(),
             transmissive: scene.materials.iter().any(|m| m.bsdf.transmit > 0.0),
+            opaque: scene
+                .objects
+                .iter()
+                .map(|o| {
+                    o.material
+                        .is_none_or(|m| scene.materials[m as usize].bsdf.transmit == 0.0)
+                })
+                .collect(),
         }
     }
 
@@ -301,12 +311,16 @@ impl Whitted<'_> {
     fn transmittance(&self, shadow: &Ray, counters: &mut Counters) -> Vec3 {
         counters.rays += 1;
         let scene = self.scene;
-        // Most shadow rays are either unblocked or blocked by an opaque scene: the any-hit
-        // query settles them; only blocked rays in scenes with transmitters look closer.
+        // Most shadow rays are unblocked, or blocked by something opaque: any-hit queries
+        // settle them; only rays that meet nothing but transmitters walk their crossings.
         if !scene.geometry.occluded(shadow) {
             return Vec3::ONE;
         }
-        if !self.transmissive {
+        if !self.transmissive
+            || scene.geometry.occluded_by(shadow, |prim| {
+                self.opaque[scene.geometry.object_of(prim) as usize]
+            })
+        {
             return Vec3::ZERO;
         }
         let end = shadow.origin + shadow.dir * shadow.t_max;

@@ -276,6 +276,40 @@ impl Geometry {
         })
     }
 
+    /// True if some primitive for which `counts` is true blocks `ray` within
+    /// `(0, ray.t_max)`; hits on the others are ignored (e.g. shadow rays looking only for
+    /// opaque blockers).
+    #[inline]
+    #[must_use]
+    pub fn occluded_by(&self, ray: &Ray, counts: impl Fn(PrimRef) -> bool) -> bool {
+        if !ray.is_valid() {
+            return false;
+        }
+        let tri_ray = TriRay::new(ray);
+        match tri_ray.dominant_axis() {
+            0 => self.occluded_by_k::<0>(ray, &tri_ray, &counts),
+            1 => self.occluded_by_k::<1>(ray, &tri_ray, &counts),
+            _ => self.occluded_by_k::<2>(ray, &tri_ray, &counts),
+        }
+    }
+
+    #[inline(always)]
+    fn occluded_by_k<const KZ: usize>(
+        &self,
+        ray: &Ray,
+        tri_ray: &TriRay,
+        counts: &impl Fn(PrimRef) -> bool,
+    ) -> bool {
+        let box_ray = RayBoxTest::new(ray.origin, ray.dir);
+        self.bvh.any(&box_ray, ray.t_max, |slot, t_max| {
+            let prim = self.slots[slot as usize];
+            counts(prim)
+                && self
+                    .intersect_prim::<KZ>(prim, tri_ray, ray, t_max)
+                    .is_some()
+        })
+    }
+
     #[inline(always)]
     fn intersect_prim<const KZ: usize>(
         &self,
