@@ -342,16 +342,25 @@ fn ripple_normals_equal_the_normalised_gradient_of_the_height_function() {
 /// A hardwood floor seen at a grazing angle, small, with `filter` and `spp`.
 fn grazing_floor(filter: &str, spp: u32, eye_x: f32) -> Film {
     let wood = common::root().join("assets/hardwood.png");
+    grazing(
+        &format!(r#"Bitmap(file: "{}", tile: (24, 24))"#, wood.display()),
+        filter,
+        spp,
+        eye_x,
+    )
+}
+
+/// A floor coloured by `texture` seen at a grazing angle, small, with `filter` and `spp`.
+fn grazing(texture: &str, filter: &str, spp: u32, eye_x: f32) -> Film {
     let s = common::scene_from_text(&format!(
         r#"Scene(
             render: (width: 96, height: 48, samples_per_pixel: {spp}, seed: 1, texture_filter: {filter}),
             camera: Pinhole(eye: ({eye_x}, 0.35, 4), look_at: ({eye_x}, 0.1, -20), fov_y: 30),
-            textures: {{ "wood": Bitmap(file: "{}", tile: (24, 24)) }},
+            textures: {{ "wood": {texture} }},
             materials: {{ "floor": (color: "wood") }},
             lights: [Point(position: (0, 30, 0), power: (40000, 40000, 40000))],
             nodes: [Quad(material: "floor", size: (60, 60), transform: [RotateX(-90), Translate(0, 0, -26)])],
-        )"#,
-        wood.display()
+        )"#
     ));
     render(
         &s,
@@ -401,6 +410,45 @@ fn mipmaps_remove_the_aliasing_of_a_grazing_floor() {
         s_ani < 0.5 * s_bil,
         "anisotropic shimmer {s_ani} vs {s_bil}"
     );
+}
+
+/// Procedural noise is filtered too: octaves finer than the footprint are left out (fBm) or
+/// replaced by their mean (turbulence), so at 1 spp a fine-grained noise floor is closer to the
+/// converged image and shimmers less than with every octave evaluated (`Bilinear` turns all
+/// footprints off).
+#[test]
+fn noise_octaves_finer_than_the_footprint_are_filtered_out() {
+    // (texture, required error ratio): marble's sine veins themselves are not prefiltered,
+    // only its turbulence, so its error improves little (its shimmer does).
+    for (texture, error_ratio) in [
+        ("Noise(frequency: 6, octaves: 8, seed: 3)", 0.8),
+        (
+            "Noise(frequency: 6, octaves: 8, turbulence: true, seed: 3)",
+            0.8,
+        ),
+        (
+            "Marble(base: (0.9, 0.9, 0.85), vein: (0.2, 0.2, 0.25), frequency: (8, 4, 4), octaves: 8, turbulence: 3)",
+            1.0,
+        ),
+    ] {
+        let reference = grazing(texture, "Bilinear", 256, 0.0);
+        let step = 0.25 * 2.0 * (15f32.to_radians().tan()) / 48.0 * 4.0;
+        let measure = |filter: &str| {
+            let img = grazing(texture, filter, 1, 0.0);
+            (
+                rmse(&img, &reference),
+                rmse(&img, &grazing(texture, filter, 1, step)),
+            )
+        };
+        let (e_raw, s_raw) = measure("Bilinear");
+        let (e_f, s_f) = measure("Anisotropic");
+        eprintln!("{texture}: error {e_raw:.5} -> {e_f:.5}, shimmer {s_raw:.5} -> {s_f:.5}");
+        assert!(
+            e_f < error_ratio * e_raw,
+            "{texture}: error {e_f} vs {e_raw}"
+        );
+        assert!(s_f < 0.8 * s_raw, "{texture}: shimmer {s_f} vs {s_raw}");
+    }
 }
 
 #[test]

@@ -70,6 +70,11 @@ impl RenderScene {
                 p: sp.p,
                 uv: sp.uv,
                 footprint,
+                width: if self.params.texture_filter == TextureFilter::Bilinear {
+                    0.0
+                } else {
+                    width
+                },
             };
             if let Some(t) = material.bump {
                 ns = self.textures[t as usize].bump(ns, sp.dpdu, sp.dpdv, &lookup);

@@ -3,6 +3,7 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::texture::noise::octaves_for;
 use crate::texture::{
     BitmapTexture, Footprint, HeightMap, Marble, Noise, Ripples, perturb_normal,
     perturb_normal_by_gradient,
@@ -41,19 +42,26 @@ pub struct NoiseTexture {
 impl NoiseTexture {
     /// The value in [0, 1] at texture-space point `q` and its gradient with respect to `q`:
     /// turbulence as is, fBm mapped by `½ + ½·fbm`; both clamped to [0, 1] (the gradient is not).
-    fn value_and_gradient(&self, q: Vec3, want_gradient: bool) -> (f32, Vec3) {
+    /// Octaves finer than a footprint `width` (in the units of `q`) are left out (fBm, mean 0)
+    /// or replaced by their mean (turbulence).
+    fn value_and_gradient(&self, q: Vec3, width: f32, want_gradient: bool) -> (f32, Vec3) {
         let q = q * self.frequency;
+        let resolved = octaves_for(width * self.frequency, self.octaves);
         if self.turbulence {
             let (v, g) = if want_gradient {
-                self.noise.turbulence_with_gradient(q, self.octaves)
+                self.noise
+                    .turbulence_with_gradient_octaves(q, self.octaves, resolved)
             } else {
-                (self.noise.turbulence(q, self.octaves), Vec3::ZERO)
+                (
+                    self.noise.turbulence_octaves(q, self.octaves, resolved),
+                    Vec3::ZERO,
+                )
             };
             (v.clamp(0.0, 1.0), g * self.frequency)
         } else {
-            let v = 0.5 + 0.5 * self.noise.fbm(q, self.octaves);
+            let v = 0.5 + 0.5 * self.noise.fbm_octaves(q, resolved);
             let g = if want_gradient {
-                self.noise.fbm_gradient(q, self.octaves) * (0.5 * self.frequency)
+                self.noise.fbm_gradient_octaves(q, resolved) * (0.5 * self.frequency)
             } else {
                 Vec3::ZERO
             };
@@ -94,13 +102,17 @@ pub struct Lookup {
     pub uv: Vec2,
     /// The pixel's footprint in uv units ([`Footprint::POINT`]: sharpest).
     pub footprint: Footprint,
+    /// The pixel's footprint width in world units across the ray (0: sharpest), for solid
+    /// textures.
+    pub width: f32,
 }
 
+/// Where a procedural texture is evaluated, and the footprint's width in those units.
 #[inline]
-fn at(mapping: Mapping, l: &Lookup) -> Vec3 {
+fn at(mapping: Mapping, l: &Lookup) -> (Vec3, f32) {
     match mapping {
-        Mapping::Solid => l.p,
-        Mapping::Uv => Vec3::new(l.uv.x, l.uv.y, 0.0),
+        Mapping::Solid => (l.p, l.width),
+        Mapping::Uv => (Vec3::new(l.uv.x, l.uv.y, 0.0), l.footprint.width()),
     }
 }
 
@@ -113,9 +125,13 @@ impl Texture {
             Texture::Bitmap(b) => b.eval(l.uv, &l.footprint),
             Texture::Marble {
                 marble, mapping, ..
-            } => marble.eval(at(*mapping, l)),
+            } => {
+                let (q, w) = at(*mapping, l);
+                marble.eval_filtered(q, w)
+            }
             Texture::Noise(n) => {
-                let (v, _) = n.value_and_gradient(at(n.mapping, l), false);
+                let (q, w) = at(n.mapping, l);
+                let (v, _) = n.value_and_gradient(q, w, false);
                 n.low.lerp(n.high, v)
             }
             Texture::HeightMap(h) => Vec3::splat(h.height(l.uv, l.footprint.width())),
@@ -142,16 +158,18 @@ impl Texture {
                 if *depth == 0.0 {
                     return n;
                 }
+                let (q, w) = at(*mapping, l);
                 by_gradient(
                     *mapping,
-                    marble.vein_weight_gradient(at(*mapping, l)) * *depth,
+                    marble.vein_weight_gradient_filtered(q, w) * *depth,
                 )
             }
             Texture::Noise(t) => {
                 if t.depth == 0.0 {
                     return n;
                 }
-                let (_, g) = t.value_and_gradient(at(t.mapping, l), true);
+                let (q, w) = at(t.mapping, l);
+                let (_, g) = t.value_and_gradient(q, w, true);
                 by_gradient(t.mapping, g * t.depth)
             }
             Texture::Bitmap(_) => n,

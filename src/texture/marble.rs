@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use super::noise::Noise;
+use super::noise::{Noise, octaves_for};
 
 /// Marble veins as a solid texture: with `q = p ⊙ scale`,
 ///
@@ -69,14 +69,35 @@ impl Marble {
     #[inline]
     #[must_use]
     pub fn eval(&self, p: Vec3) -> Vec3 {
-        self.base.lerp(self.vein, self.vein_weight(p))
+        self.eval_filtered(p, 0.0)
+    }
+
+    /// Colour at `p` seen through a footprint `width` units wide: turbulence octaves finer than
+    /// the footprint are replaced by their mean (see `Noise::turbulence_octaves`). Equal to
+    /// [`eval`](Self::eval) for width 0.
+    #[inline]
+    #[must_use]
+    pub fn eval_filtered(&self, p: Vec3, width: f32) -> Vec3 {
+        self.base.lerp(
+            self.vein,
+            self.vein_weight_resolved(p, self.resolved(width)),
+        )
+    }
+
+    /// Turbulence octaves resolved by a footprint `width` units wide.
+    fn resolved(&self, width: f32) -> f32 {
+        octaves_for(width * self.scale.abs().max_element(), self.octaves)
     }
 
     /// Vein weight `w` at `p`, in [0, 1]; also a height for bump mapping.
     #[must_use]
     pub fn vein_weight(&self, p: Vec3) -> f32 {
+        self.vein_weight_resolved(p, self.octaves as f32)
+    }
+
+    fn vein_weight_resolved(&self, p: Vec3, resolved: f32) -> f32 {
         let q = p * self.scale;
-        let phi = q.x + self.turbulence * self.noise.turbulence(q, self.octaves);
+        let phi = q.x + self.turbulence * self.noise.turbulence_octaves(q, self.octaves, resolved);
         ramp(1.0 - phi.sin().abs()).0
     }
 
@@ -85,8 +106,17 @@ impl Marble {
     /// `perturb_normal_by_gradient` to emboss the veins.
     #[must_use]
     pub fn vein_weight_gradient(&self, p: Vec3) -> Vec3 {
+        self.vein_weight_gradient_filtered(p, 0.0)
+    }
+
+    /// [`vein_weight_gradient`](Self::vein_weight_gradient) with the octaves finer than a
+    /// footprint `width` units wide replaced by their (constant) mean.
+    #[must_use]
+    pub fn vein_weight_gradient_filtered(&self, p: Vec3, width: f32) -> Vec3 {
         let q = p * self.scale;
-        let (t, dt) = self.noise.turbulence_with_gradient(q, self.octaves);
+        let (t, dt) =
+            self.noise
+                .turbulence_with_gradient_octaves(q, self.octaves, self.resolved(width));
         let phi = q.x + self.turbulence * t;
         let dphi = (Vec3::X + dt * self.turbulence) * self.scale;
         let (s, c) = phi.sin_cos();

@@ -141,9 +141,18 @@ impl Noise {
     /// Fractal Brownian motion: `Σ_{i<octaves} 0.5^i · noise(2^i p + i·shift)`; |fbm| < 2 · max|noise|.
     #[must_use]
     pub fn fbm(&self, p: Vec3, octaves: u32) -> f32 {
+        self.fbm_octaves(p, octaves as f32)
+    }
+
+    /// [`fbm`](Self::fbm) over a possibly fractional number of octaves: octave `i` is weighted
+    /// by `clamp(octaves − i, 0, 1)`, so detail fades in continuously as `octaves` grows (see
+    /// [`octaves_for`]). Identical to `fbm` for whole numbers.
+    #[must_use]
+    pub fn fbm_octaves(&self, p: Vec3, octaves: f32) -> f32 {
         let (mut sum, mut amp, mut freq) = (0.0, 1.0, 1.0);
-        for i in 0..octaves {
-            sum += amp * self.noise(p * freq + OCTAVE_SHIFT * i as f32);
+        for i in 0..octaves.ceil().max(0.0) as u32 {
+            let w = (octaves - i as f32).min(1.0);
+            sum += amp * w * self.noise(p * freq + OCTAVE_SHIFT * i as f32);
             amp *= 0.5;
             freq *= 2.0;
         }
@@ -154,10 +163,17 @@ impl Noise {
     /// `perturb_normal_by_gradient`).
     #[must_use]
     pub fn fbm_gradient(&self, p: Vec3, octaves: u32) -> Vec3 {
+        self.fbm_gradient_octaves(p, octaves as f32)
+    }
+
+    /// Exact gradient of [`fbm_octaves`](Self::fbm_octaves).
+    #[must_use]
+    pub fn fbm_gradient_octaves(&self, p: Vec3, octaves: f32) -> Vec3 {
         let (mut grad, mut amp, mut freq) = (Vec3::ZERO, 1.0, 1.0);
-        for i in 0..octaves {
+        for i in 0..octaves.ceil().max(0.0) as u32 {
+            let w = (octaves - i as f32).min(1.0);
             let (_, g) = self.noise_with_gradient(p * freq + OCTAVE_SHIFT * i as f32);
-            grad += g * (amp * freq);
+            grad += g * (amp * w * freq);
             amp *= 0.5;
             freq *= 2.0;
         }
@@ -167,9 +183,25 @@ impl Noise {
     /// Turbulence: `Σ_{i<octaves} 0.5^i · |noise(2^i p + i·shift)|`, ≥ 0.
     #[must_use]
     pub fn turbulence(&self, p: Vec3, octaves: u32) -> f32 {
+        self.turbulence_octaves(p, octaves, octaves as f32)
+    }
+
+    /// Turbulence of `octaves` octaves of which only the first `resolved` (possibly fractional)
+    /// are evaluated: octave `i` is `w·|noise| + (1 − w)·MEAN_ABS_NOISE` with
+    /// `w = clamp(resolved − i, 0, 1)`, so octaves too fine to see are replaced by their mean
+    /// rather than dropped (the sum keeps its average brightness). Identical to `turbulence`
+    /// when `resolved ≥ octaves`.
+    #[must_use]
+    pub fn turbulence_octaves(&self, p: Vec3, octaves: u32, resolved: f32) -> f32 {
         let (mut sum, mut amp, mut freq) = (0.0, 1.0, 1.0);
         for i in 0..octaves {
-            sum += amp * self.noise(p * freq + OCTAVE_SHIFT * i as f32).abs();
+            let w = (resolved - i as f32).clamp(0.0, 1.0);
+            let v = if w > 0.0 {
+                self.noise(p * freq + OCTAVE_SHIFT * i as f32).abs()
+            } else {
+                0.0
+            };
+            sum += amp * (w * v + (1.0 - w) * MEAN_ABS_NOISE);
             amp *= 0.5;
             freq *= 2.0;
         }
@@ -180,16 +212,49 @@ impl Noise {
     /// a crease and the one-sided gradient of the positive side is returned).
     #[must_use]
     pub fn turbulence_with_gradient(&self, p: Vec3, octaves: u32) -> (f32, Vec3) {
+        self.turbulence_with_gradient_octaves(p, octaves, octaves as f32)
+    }
+
+    /// [`turbulence_octaves`](Self::turbulence_octaves) and its gradient (unresolved octaves
+    /// are constant, so they add none).
+    #[must_use]
+    pub fn turbulence_with_gradient_octaves(
+        &self,
+        p: Vec3,
+        octaves: u32,
+        resolved: f32,
+    ) -> (f32, Vec3) {
         let (mut sum, mut grad, mut amp, mut freq) = (0.0, Vec3::ZERO, 1.0, 1.0);
         for i in 0..octaves {
-            let (v, g) = self.noise_with_gradient(p * freq + OCTAVE_SHIFT * i as f32);
-            sum += amp * v.abs();
-            grad += g * (amp * freq * if v < 0.0 { -1.0 } else { 1.0 });
+            let w = (resolved - i as f32).clamp(0.0, 1.0);
+            if w > 0.0 {
+                let (v, g) = self.noise_with_gradient(p * freq + OCTAVE_SHIFT * i as f32);
+                sum += amp * (w * v.abs() + (1.0 - w) * MEAN_ABS_NOISE);
+                grad += g * (amp * w * freq * if v < 0.0 { -1.0 } else { 1.0 });
+            } else {
+                sum += amp * MEAN_ABS_NOISE;
+            }
             amp *= 0.5;
             freq *= 2.0;
         }
         (sum, grad)
     }
+}
+
+/// The mean of `|noise|` over space (measured: see the tests), what an unresolved turbulence
+/// octave averages to.
+pub const MEAN_ABS_NOISE: f32 = 0.22;
+
+/// How many octaves of a fractal sum whose first octave has features about 1 unit wide (the
+/// lattice spacing) can be resolved by a pixel footprint `width` units wide: octave `i` (features
+/// `2^−i` wide) is kept while `2^i · width ≤ ¼` and fades out by `2^i · width = ½` (Nyquist).
+/// Returns `max` for a zero (or non-finite) width; never less than 0.
+#[must_use]
+pub fn octaves_for(width: f32, max: u32) -> f32 {
+    if !(width > 0.0) || !width.is_finite() {
+        return max as f32;
+    }
+    ((0.5 / width).log2()).clamp(0.0, max as f32)
 }
 
 #[cfg(test)]
@@ -252,6 +317,51 @@ mod tests {
         assert!(hi - lo > 0.8, "fbm barely varies: [{lo}, {hi}]");
         assert!(mean.abs() < 0.03, "mean {mean}");
         assert!(tmax < 2.0 && tmax > 0.4, "{tmax}");
+    }
+
+    #[test]
+    fn fractional_octaves_fade_detail_in_continuously_and_whole_ones_are_exact() {
+        let n = Noise::new(9);
+        let mut rng = Rng::new(7, 7);
+        let (mut abs_sum, mut count) = (0.0f64, 0u32);
+        for _ in 0..20_000 {
+            let p = point(&mut rng, 40.0);
+            abs_sum += f64::from(n.noise(p).abs());
+            count += 1;
+            // Whole numbers of octaves are bit-identical to the plain sums.
+            assert_eq!(n.fbm_octaves(p, 5.0).to_bits(), n.fbm(p, 5).to_bits());
+            assert_eq!(
+                n.turbulence_octaves(p, 5, 5.0).to_bits(),
+                n.turbulence(p, 5).to_bits()
+            );
+            // Continuity: half an octave lies between its neighbours' values.
+            let (a, m, b) = (
+                n.fbm_octaves(p, 2.0),
+                n.fbm_octaves(p, 2.5),
+                n.fbm_octaves(p, 3.0),
+            );
+            assert!((m - (a + b) / 2.0).abs() < 1e-5, "{a} {m} {b}");
+        }
+        // The constant that replaces unresolved turbulence octaves is the measured mean |noise|.
+        let mean = abs_sum / f64::from(count);
+        assert!(
+            (mean - f64::from(MEAN_ABS_NOISE)).abs() < 0.01,
+            "mean |noise| {mean}"
+        );
+        // Unresolved octaves keep turbulence's average: 0 resolved of 6 is the mean of 6.
+        let mut rng = Rng::new(8, 8);
+        let (mut full, mut none) = (0.0f64, 0.0f64);
+        for _ in 0..20_000 {
+            let p = point(&mut rng, 40.0);
+            full += f64::from(n.turbulence(p, 6));
+            none += f64::from(n.turbulence_octaves(p, 6, 0.0));
+        }
+        assert!(((full - none) / full).abs() < 0.03, "{full} vs {none}");
+        // Footprints: zero keeps all octaves; a footprint of 1/8 keeps 2 (log2 4).
+        assert_eq!(octaves_for(0.0, 6), 6.0);
+        assert_eq!(octaves_for(0.125, 6), 2.0);
+        assert_eq!(octaves_for(10.0, 6), 0.0);
+        assert_eq!(octaves_for(f32::NAN, 6), 6.0);
     }
 
     #[test]

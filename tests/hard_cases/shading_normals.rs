@@ -64,6 +64,7 @@ fn back_facing(s: &RenderScene) -> (f64, u32) {
                 p: sp.p,
                 uv: sp.uv,
                 footprint: caustic::texture::Footprint::POINT,
+                width: 0.0,
             };
             let n = s.textures[t as usize].bump(sp.ns, sp.dpdu, sp.dpdv, &l);
             let wo = -ray.dir;
@@ -174,6 +175,7 @@ fn rippled_and_bumped_specular_rays_leave_on_the_correct_side() {
                     p: sp.p,
                     uv: sp.uv,
                     footprint: caustic::texture::Footprint::POINT,
+                    width: 0.0,
                 };
                 let raw =
                     s.textures[m.bump.expect("bump") as usize].bump(sp.ns, sp.dpdu, sp.dpdv, &l);
