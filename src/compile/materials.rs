@@ -1,6 +1,7 @@
 //! Materials and the textures they use, compiled on first use so nothing unused is loaded.
 
 use std::collections::{BTreeMap, HashMap};
+use std::hash::Hash;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -9,9 +10,11 @@ use glam::{Vec2, Vec3};
 use crate::render_scene::texture::{Mapping as RenderMapping, NoiseTexture};
 use crate::render_scene::{SurfaceMaterial, Texture};
 use crate::scene::Diagnostic;
-use crate::scene::schema::{ColorSpec, Mapping, ScaleSpec, SceneFile, TextureSpec};
+use crate::scene::schema::{ColorSpec, Mapping, SceneFile, TextureSpec};
 use crate::shading::Material;
-use crate::texture::{BitmapTexture, GreyMipMap, HeightMap, Marble, MipMap, Noise, Ripples};
+use crate::texture::{
+    BitmapTexture, GreyMipMap, HeightMap, Marble, MipMap, Noise, Ripples, TextureError,
+};
 
 /// Materials resolved on first use, so unused ones (and their textures) are not compiled.
 #[derive(Default)]
@@ -135,48 +138,28 @@ impl TextureTable {
         base_dir: &Path,
         at: &str,
     ) -> Result<Texture, Box<Diagnostic>> {
-        let file_error =
-            |file: &str, e: crate::texture::TextureError| {
-                Box::new(Diagnostic::error(
-                format!("{at}.file"),
-                format!(
-                    "cannot load image `{}`: {}",
-                    base_dir.join(file).display(),
-                    image_error_text(&e)
-                ),
-            )
-            .with_help(
-                "textures must be PNG, JPEG or EXR files; paths are relative to the scene file",
-            ))
-            };
+        let load_error = |file: &str, e| file_error(at, base_dir, file, &e);
         Ok(match spec {
             TextureSpec::Bitmap { file, tile, srgb } => {
                 let path = base_dir.join(file);
-                let key = (path.clone(), *srgb);
-                let mip = match self.colour_images.get(&key) {
-                    Some(m) => Arc::clone(m),
-                    None => {
-                        let m =
-                            Arc::new(MipMap::open(&path, *srgb).map_err(|e| file_error(file, e))?);
-                        self.images_loaded += 1;
-                        self.colour_images.insert(key, Arc::clone(&m));
-                        m
-                    }
-                };
+                let mip = cached(
+                    &mut self.colour_images,
+                    &mut self.images_loaded,
+                    (path.clone(), *srgb),
+                    || MipMap::open(&path, *srgb),
+                )
+                .map_err(|e| load_error(file, e))?;
                 Texture::Bitmap(BitmapTexture::new(mip, Vec2::from(*tile)))
             }
             TextureSpec::HeightMap { file, depth, tile } => {
                 let path = base_dir.join(file);
-                let mip = match self.grey_images.get(&path) {
-                    Some(m) => Arc::clone(m),
-                    None => {
-                        let m =
-                            Arc::new(MipMap::open_grey(&path).map_err(|e| file_error(file, e))?);
-                        self.images_loaded += 1;
-                        self.grey_images.insert(path, Arc::clone(&m));
-                        m
-                    }
-                };
+                let mip = cached(
+                    &mut self.grey_images,
+                    &mut self.images_loaded,
+                    path.clone(),
+                    || MipMap::open_grey(&path),
+                )
+                .map_err(|e| load_error(file, e))?;
                 Texture::HeightMap(HeightMap::new(mip, *depth, Vec2::from(*tile)))
             }
             TextureSpec::Marble {
@@ -188,24 +171,18 @@ impl TextureTable {
                 seed,
                 depth,
                 mapping,
-            } => {
-                let scale = match *frequency {
-                    ScaleSpec::Uniform(f) => Vec3::splat(f),
-                    ScaleSpec::PerAxis(v) => Vec3::from(v),
-                };
-                Texture::Marble {
-                    marble: Marble::new(
-                        scale,
-                        *octaves,
-                        *turbulence,
-                        Vec3::from(*base),
-                        Vec3::from(*vein),
-                        *seed,
-                    ),
-                    depth: *depth,
-                    mapping: render_mapping(*mapping),
-                }
-            }
+            } => Texture::Marble {
+                marble: Marble::new(
+                    Vec3::from(frequency.factors()),
+                    *octaves,
+                    *turbulence,
+                    Vec3::from(*base),
+                    Vec3::from(*vein),
+                    *seed,
+                ),
+                depth: *depth,
+                mapping: render_mapping(*mapping),
+            },
             TextureSpec::Noise {
                 low,
                 high,
@@ -240,6 +217,37 @@ impl TextureTable {
     }
 }
 
+/// The pyramid cached under `key`, or `load`ed (and counted in `loaded`) on first use.
+fn cached<K: Eq + Hash, T>(
+    cache: &mut HashMap<K, Arc<T>>,
+    loaded: &mut usize,
+    key: K,
+    load: impl FnOnce() -> Result<T, TextureError>,
+) -> Result<Arc<T>, TextureError> {
+    if let Some(m) = cache.get(&key) {
+        return Ok(Arc::clone(m));
+    }
+    let m = Arc::new(load()?);
+    *loaded += 1;
+    cache.insert(key, Arc::clone(&m));
+    Ok(m)
+}
+
+/// The diagnostic for an image file of texture `at` that cannot be loaded.
+fn file_error(at: &str, base_dir: &Path, file: &str, e: &TextureError) -> Box<Diagnostic> {
+    Box::new(
+        Diagnostic::error(
+            format!("{at}.file"),
+            format!(
+                "cannot load image `{}`: {}",
+                base_dir.join(file).display(),
+                image_error_text(e)
+            ),
+        )
+        .with_help("textures must be PNG, JPEG or EXR files; paths are relative to the scene file"),
+    )
+}
+
 fn render_mapping(m: Mapping) -> RenderMapping {
     match m {
         Mapping::Solid => RenderMapping::Solid,
@@ -248,10 +256,10 @@ fn render_mapping(m: Mapping) -> RenderMapping {
 }
 
 /// A texture error as a sentence without the redundant "cannot load texture image" prefix.
-fn image_error_text(e: &crate::texture::TextureError) -> String {
+fn image_error_text(e: &TextureError) -> String {
     match e {
-        crate::texture::TextureError::Image(image::ImageError::IoError(io)) => io.to_string(),
-        crate::texture::TextureError::Image(img) => img.to_string(),
+        TextureError::Image(image::ImageError::IoError(io)) => io.to_string(),
+        TextureError::Image(img) => img.to_string(),
         other => other.to_string(),
     }
 }

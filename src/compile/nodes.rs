@@ -12,7 +12,7 @@ use crate::render_scene::geometry::{
     EllipsoidPrim, GeometryBuilder, MAX_PRIMS_PER_KIND, SpherePrim, TriAttrs,
 };
 use crate::scene::Diagnostic;
-use crate::scene::schema::{NodeSpec, ScaleSpec, SceneFile, TransformStep};
+use crate::scene::schema::{NodeSpec, SceneFile, TransformStep};
 
 pub(super) struct Flattener<'a> {
     pub scene: &'a SceneFile,
@@ -35,12 +35,7 @@ pub(crate) fn transform_of(steps: &[TransformStep]) -> DAffine3 {
             TransformStep::RotateX(a) => DAffine3::from_rotation_x(f64::from(a).to_radians()),
             TransformStep::RotateY(a) => DAffine3::from_rotation_y(f64::from(a).to_radians()),
             TransformStep::RotateZ(a) => DAffine3::from_rotation_z(f64::from(a).to_radians()),
-            TransformStep::Scale(ScaleSpec::Uniform(s)) => {
-                DAffine3::from_scale(DVec3::splat(s.into()))
-            }
-            TransformStep::Scale(ScaleSpec::PerAxis([x, y, z])) => {
-                DAffine3::from_scale(DVec3::new(x.into(), y.into(), z.into()))
-            }
+            TransformStep::Scale(s) => DAffine3::from_scale(Vec3::from(s.factors()).as_dvec3()),
         };
         m * acc
     })

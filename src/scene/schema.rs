@@ -519,6 +519,17 @@ pub enum ScaleSpec {
     PerAxis(Vec3Spec),
 }
 
+impl ScaleSpec {
+    /// The factor per axis.
+    #[must_use]
+    pub fn factors(&self) -> Vec3Spec {
+        match *self {
+            ScaleSpec::Uniform(s) => [s; 3],
+            ScaleSpec::PerAxis(v) => v,
+        }
+    }
+}
+
 /// Deserialises a map, rejecting a key given twice (RON maps would otherwise keep the last one).
 fn unique_keys<'de, D: serde::Deserializer<'de>, V: Deserialize<'de>>(
     d: D,

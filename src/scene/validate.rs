@@ -4,7 +4,7 @@ use std::collections::BTreeSet;
 
 use super::diagnostic::{Diagnostic, did_you_mean, quoted_list};
 use super::schema::{
-    CameraSpec, ColorSpec, LightSpec, MaterialSpec, NodeSpec, RenderSettings, ScaleSpec, SceneFile,
+    CameraSpec, ColorSpec, LightSpec, MaterialSpec, NodeSpec, RenderSettings, SceneFile,
     TextureSpec, TransformStep,
 };
 
@@ -382,10 +382,7 @@ impl<'a> Validator<'a> {
             } => {
                 self.unit_rgb(&format!("{path}.base"), *base, "base");
                 self.unit_rgb(&format!("{path}.vein"), *vein, "vein");
-                let f = match frequency {
-                    ScaleSpec::Uniform(u) => [*u; 3],
-                    ScaleSpec::PerAxis(v) => *v,
-                };
+                let f = frequency.factors();
                 if self.finite3(&format!("{path}.frequency"), f) {
                     let top = f.iter().fold(0.0f32, |a, x| a.max(x.abs()));
                     finest(self, "frequency", top, *o);
@@ -597,10 +594,7 @@ impl<'a> Validator<'a> {
                 self.finite(path, *a);
             }
             TransformStep::Scale(s) => {
-                let v = match s {
-                    ScaleSpec::Uniform(u) => [*u; 3],
-                    ScaleSpec::PerAxis(v) => *v,
-                };
+                let v = s.factors();
                 if self.finite3(path, v) && v.contains(&0.0) {
                     self.out.push(
                         Diagnostic::error(
