@@ -44,12 +44,21 @@ const RIPPLES: &str =
 const TILES: &str =
     r#""t": HeightMap(file: "assets/tiles_height.png", depth: 0.05, tile: (40, 40))"#;
 
-/// Over the primary rays hitting bumped surfaces: the fraction whose raw perturbed normal faces
-/// away from the viewer although the geometric normal faces it (the case the remedy exists
-/// for), and how many of the normals actually shaded with still face away (must be none).
-fn back_facing(s: &RenderScene) -> (f64, u32) {
+/// One primary ray per pixel of `s` that hits a bumped surface: what `visit` is given.
+struct BumpedHit<'a> {
+    /// Direction towards the camera.
+    wo: Vec3,
+    /// The surface point.
+    sp: caustic::render_scene::SurfacePoint,
+    /// Its material.
+    material: &'a caustic::render_scene::SurfaceMaterial,
+    /// The raw bumped normal (outward), before the shading-normal rule.
+    raw: Vec3,
+}
+
+/// Calls `visit` for every pixel-centre primary ray of `s` that hits a bumped surface.
+fn for_each_bumped_hit(s: &RenderScene, mut visit: impl FnMut(&BumpedHit)) {
     let (w, h) = (s.params.width, s.params.height);
-    let (mut hits, mut back, mut shaded_back) = (0u32, 0u32, 0u32);
     for y in 0..h {
         for x in 0..w {
             let ray = s.camera.ray(x as f32 + 0.5, y as f32 + 0.5, w, h);
@@ -57,26 +66,40 @@ fn back_facing(s: &RenderScene) -> (f64, u32) {
                 continue;
             };
             let sp = s.geometry.surface(&ray, &hit);
-            let m =
+            let material =
                 &s.materials[s.objects[sp.object as usize].material.expect("material") as usize];
-            let Some(t) = m.bump else { continue };
+            let Some(t) = material.bump else { continue };
             let l = Lookup {
                 p: sp.p,
                 uv: sp.uv,
                 footprint: caustic::texture::Footprint::POINT,
                 width: 0.0,
             };
-            let n = s.textures[t as usize].bump(sp.ns, sp.dpdu, sp.dpdv, &l);
-            let wo = -ray.dir;
-            hits += 1;
-            if sp.ng.dot(wo) > 0.0 && n.dot(wo) < 0.0 {
-                back += 1;
-            }
-            if s.shading_point(m, &sp, wo, 0.0).ns.dot(wo) <= 0.0 || !sp.ng.is_finite() {
-                shaded_back += 1;
-            }
+            let raw = s.textures[t as usize].bump(sp.ns, sp.dpdu, sp.dpdv, &l);
+            visit(&BumpedHit {
+                wo: -ray.dir,
+                sp,
+                material,
+                raw,
+            });
         }
     }
+}
+
+/// Over the primary rays hitting bumped surfaces: the fraction whose raw perturbed normal faces
+/// away from the viewer although the geometric normal faces it (the case the remedy exists
+/// for), and how many of the normals actually shaded with still face away (must be none).
+fn back_facing(s: &RenderScene) -> (f64, u32) {
+    let (mut hits, mut back, mut shaded_back) = (0u32, 0u32, 0u32);
+    for_each_bumped_hit(s, |b| {
+        hits += 1;
+        if b.sp.ng.dot(b.wo) > 0.0 && b.raw.dot(b.wo) < 0.0 {
+            back += 1;
+        }
+        if s.shading_point(b.material, &b.sp, b.wo, 0.0).ns.dot(b.wo) <= 0.0 {
+            shaded_back += 1;
+        }
+    });
     (f64::from(back) / f64::from(hits.max(1)), shaded_back)
 }
 
@@ -147,48 +170,26 @@ fn rippled_and_bumped_specular_rays_leave_on_the_correct_side() {
         ),
     ] {
         let s = grazing(material, textures);
-        let (w, h) = (s.params.width, s.params.height);
         let (mut rays, mut raw_wrong, mut wrong) = (0u32, 0u32, 0u32);
-        for y in 0..h {
-            for x in 0..w {
-                let ray = s.camera.ray(x as f32 + 0.5, y as f32 + 0.5, w, h);
-                let Some(hit) = s.geometry.intersect(&ray) else {
-                    continue;
-                };
-                let sp = s.geometry.surface(&ray, &hit);
-                let m = &s.materials[s.objects[sp.object as usize].material.expect("m") as usize];
-                if m.bump.is_none() {
-                    continue;
-                }
-                let wo = -ray.dir;
-                let sh = s.shading_point(m, &sp, wo, 0.0);
-                let lobes = sh.bsdf.delta_lobes(wo, sh.ns, sh.ng, sh.entering);
-                rays += 1;
-                if lobes.reflect_dir.dot(sh.ng) <= 0.0 {
-                    wrong += 1;
-                }
-                if lobes.refract.is_some_and(|(t, _)| t.dot(sh.ng) >= 0.0) {
-                    wrong += 1;
-                }
-                // What the raw perturbed normal alone would have done.
-                let l = Lookup {
-                    p: sp.p,
-                    uv: sp.uv,
-                    footprint: caustic::texture::Footprint::POINT,
-                    width: 0.0,
-                };
-                let raw =
-                    s.textures[m.bump.expect("bump") as usize].bump(sp.ns, sp.dpdu, sp.dpdv, &l);
-                let raw = if sh.entering { raw } else { -raw };
-                let raw_bad = reflect(wo, raw).dot(sh.ng) <= 0.0
-                    || (sh.bsdf.transmit > 0.0
-                        && refract(wo, raw, 1.0 / sh.bsdf.ior)
-                            .is_some_and(|t| t.dot(sh.ng) >= 0.0));
-                if raw_bad {
-                    raw_wrong += 1;
-                }
+        for_each_bumped_hit(&s, |b| {
+            let sh = s.shading_point(b.material, &b.sp, b.wo, 0.0);
+            let lobes = sh.bsdf.delta_lobes(b.wo, sh.ns, sh.ng, sh.entering);
+            rays += 1;
+            if lobes.reflect_dir.dot(sh.ng) <= 0.0 {
+                wrong += 1;
             }
-        }
+            if lobes.refract.is_some_and(|(t, _)| t.dot(sh.ng) >= 0.0) {
+                wrong += 1;
+            }
+            // What the raw perturbed normal alone would have done.
+            let raw = if sh.entering { b.raw } else { -b.raw };
+            let raw_bad = reflect(b.wo, raw).dot(sh.ng) <= 0.0
+                || (sh.bsdf.transmit > 0.0
+                    && refract(b.wo, raw, 1.0 / sh.bsdf.ior).is_some_and(|t| t.dot(sh.ng) >= 0.0));
+            if raw_bad {
+                raw_wrong += 1;
+            }
+        });
         eprintln!(
             "{name}: {rays} rays, raw normals would send {raw_wrong} the wrong way, shaded: {wrong}"
         );
