@@ -94,20 +94,21 @@ fn a_quad_shows_its_image_upright_and_unmirrored() {
     }
 }
 
+/// (outward normal, the viewer's right, the viewer's up) of each cube face seen from outside:
+/// side faces upright, the top with the image's top towards −z, the bottom with it towards +z.
+const CUBE_FACES: [(Vec3, Vec3, Vec3); 6] = [
+    (Vec3::Z, Vec3::X, Vec3::Y),
+    (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
+    (Vec3::X, Vec3::NEG_Z, Vec3::Y),
+    (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+    (Vec3::Y, Vec3::X, Vec3::NEG_Z),
+    (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+];
+
 #[test]
 fn every_cube_face_shows_its_image_upright_from_outside() {
     let s = quadrant_scene("Cube(material: \"m\", size: 2)");
-    // (viewer direction, the viewer's right, up): each face seen from outside.
-    let faces = [
-        (Vec3::Z, Vec3::X, Vec3::Y),
-        (-Vec3::Z, -Vec3::X, Vec3::Y),
-        (Vec3::X, -Vec3::Z, Vec3::Y),
-        (-Vec3::X, Vec3::Z, Vec3::Y),
-        // Top: seen from above with the image's top towards −z; bottom: from below, top +z.
-        (Vec3::Y, Vec3::X, -Vec3::Z),
-        (-Vec3::Y, Vec3::X, Vec3::Z),
-    ];
-    for (out, right, up) in faces {
+    for (out, right, up) in CUBE_FACES {
         for (a, b, want) in [
             (-0.5, 0.5, RED),
             (0.5, 0.5, GREEN),
@@ -211,14 +212,7 @@ fn box_projected_uvs_are_oriented_like_cube_faces_on_all_six_sides() {
         let hit = s.geometry.intersect(&ray).expect("hits");
         s.geometry.surface(&ray, &hit).uv
     };
-    for (out, right, up) in [
-        (Vec3::Z, Vec3::X, Vec3::Y),
-        (-Vec3::Z, -Vec3::X, Vec3::Y),
-        (Vec3::X, -Vec3::Z, Vec3::Y),
-        (-Vec3::X, Vec3::Z, Vec3::Y),
-        (Vec3::Y, Vec3::X, -Vec3::Z),
-        (-Vec3::Y, Vec3::X, Vec3::Z),
-    ] {
+    for (out, right, up) in CUBE_FACES {
         let c = out + right * 0.1 + up * 0.1;
         let (a, r, u) = (
             uv_at(c, out),
