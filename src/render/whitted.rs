@@ -26,8 +26,6 @@ pub struct Whitted<'a> {
     pixel_spread: f32,
     /// Some material transmits, so shadow rays must look for what they pass through.
     transmissive: bool,
-    /// Per object: it stops shadow rays outright (no transmitting part, or an emitter).
-    opaque: Vec<bool>,
 }
 
 /// Most transmitting surfaces a shadow ray crosses; beyond them the rest is taken as clear.
@@ -77,14 +75,6 @@ impl<'a> Whitted<'a> {
             scene,
             pixel_spread: scene.pixel_spread(),
             transmissive: scene.materials.iter().any(|m| m.bsdf.transmit > 0.0),
-            opaque: scene
-                .objects
-                .iter()
-                .map(|o| {
-                    o.material
-                        .is_none_or(|m| scene.materials[m as usize].bsdf.transmit == 0.0)
-                })
-                .collect(),
         }
     }
 
@@ -318,7 +308,7 @@ impl Whitted<'_> {
         }
         if !self.transmissive
             || scene.geometry.occluded_by(shadow, |prim| {
-                self.opaque[scene.geometry.object_of(prim) as usize]
+                scene.is_opaque(scene.geometry.object_of(prim))
             })
         {
             return Vec3::ZERO;
@@ -330,14 +320,12 @@ impl Whitted<'_> {
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 return t;
             };
-            let sp = scene.geometry.surface(&ray, &hit);
-            let Some(m) = scene.objects[sp.object as usize].material else {
-                return Vec3::ZERO;
+            let object = scene.geometry.object_of(hit.prim);
+            let material = match scene.objects[object as usize].material {
+                Some(m) if !scene.is_opaque(object) => &scene.materials[m as usize],
+                _ => return Vec3::ZERO,
             };
-            let material = &scene.materials[m as usize];
-            if material.bsdf.transmit == 0.0 {
-                return Vec3::ZERO;
-            }
+            let sp = scene.geometry.surface(&ray, &hit);
             let wo = -ray.dir.normalize();
             let s = scene.shading_point(material, &sp, wo, 0.0);
             t *= s.bsdf.straight_transmittance(s.ns.dot(wo));

@@ -85,6 +85,15 @@ pub struct RenderScene {
 }
 
 impl RenderScene {
+    /// True if object `object` lets no light through (no transmitting part, or an emitter).
+    #[inline]
+    #[must_use]
+    pub fn is_opaque(&self, object: u32) -> bool {
+        self.objects[object as usize]
+            .material
+            .is_none_or(|m| self.materials[m as usize].bsdf.transmit == 0.0)
+    }
+
     /// The angle one camera sample's footprint subtends: the pixel's angular size, shrunk by
     /// `1/√spp` (down to ⅛) since samples are spread over the pixel. The ray cones that size
     /// texture footprints start from this.
