@@ -2,7 +2,7 @@
 //! cancel flag stops a render without a film, and Ctrl-C on `caustic render` writes nothing but
 //! the last complete checkpoint.
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -2,7 +2,7 @@
 //! `examples/gen_assets` generates (compared as decoded pixels, so PNG encoder changes do not
 //! matter), and they have the properties the renderer's tests rely on.
 
-#[path = "../examples/gen_assets/images.rs"]
+#[path = "../../examples/gen_assets/images.rs"]
 mod images;
 
 use image::{DynamicImage, GrayImage, RgbImage};

@@ -1,6 +1,6 @@
 //! The bad-scene corpus: every `.ron`/`.toml` file in `tests/bad_scenes/` is an invalid scene that
 //! `caustic check` must refuse with exit code 2 and a useful message (never a panic). The message
-//! of each is snapshotted in `tests/snapshots/bad_scenes/`, and the file's first line (a comment
+//! of each is snapshotted in `tests/it/snapshots/bad_scenes/`, and the file's first line (a comment
 //! saying what is wrong and what the message must name) is stored with the snapshot, so a
 //! reviewer sees the expectation next to the actual output.
 //!

@@ -1,7 +1,7 @@
 //! The command line: schema freshness, checks of every shipped scene, overrides, output safety,
 //! debug-pixel, exit codes.
 
-mod common;
+use crate::common;
 
 use common::{caustic, root};
 

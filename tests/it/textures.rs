@@ -2,7 +2,7 @@
 //! lookups at known places on every primitive, bump normals against analytic tilts, ripple
 //! normals against the height function, and mipmapping against aliasing.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

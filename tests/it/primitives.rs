@@ -1,7 +1,7 @@
 //! Primitives as compiled from scene files: transforms baked correctly (non-uniform scale of a
 //! sphere, rotated cubes, mirrored transforms keep outward normals), hits at the right distance.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -1,7 +1,7 @@
 //! Closest-hit and any-hit queries agree on every ray (same primitives, same intervals), and
 //! both agree with brute force over all primitives.
 
-mod common;
+use crate::common;
 
 use caustic::geometry::Ray;
 use caustic::pipeline::{SceneOverrides, prepare};

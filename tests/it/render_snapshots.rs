@@ -1,8 +1,8 @@
 //! Every scene in `scenes/` rendered small and compared byte for byte with its reviewed PNG
-//! snapshot (`tests/snapshots/render_snapshots__*.snap` + `.png`): any pixel change fails and
+//! snapshot (`tests/it/snapshots/it__render_snapshots__*.snap` + `.png`): any pixel change fails and
 //! leaves the new image beside the old one for review (`cargo insta review`).
 
-mod common;
+use crate::common;
 
 use caustic::render::RenderOptions;
 use caustic::render::output::encode;

@@ -1,7 +1,7 @@
 //! Same scene, seed and flags give the same bytes: for any thread count, for a crop versus the
 //! full frame, and for the RON and TOML spellings of one scene.
 
-mod common;
+use crate::common;
 
 use caustic::render::{Region, RenderOptions};
 

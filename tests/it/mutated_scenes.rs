@@ -1,7 +1,7 @@
 //! Robustness of the front end: randomly mutated versions of every shipped scene go through
 //! parse → validate → compile without a panic (they may, of course, be rejected).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
