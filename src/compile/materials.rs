@@ -11,7 +11,7 @@ use crate::render_scene::texture::{Mapping as RenderMapping, NoiseTexture};
 use crate::render_scene::{SurfaceMaterial, Texture};
 use crate::scene::Diagnostic;
 use crate::scene::schema::{ColorSpec, Mapping, SceneFile, TextureSpec};
-use crate::shading::Material;
+use crate::shading::Bsdf;
 use crate::texture::{
     BitmapTexture, GreyMipMap, HeightMap, Marble, MipMap, Noise, Ripples, TextureError,
 };
@@ -60,7 +60,7 @@ impl MaterialTable {
                 errors,
             )
         });
-        let bsdf = Material::new(
+        let bsdf = Bsdf::new(
             color,
             Vec3::from(m.specular),
             m.shininess,

@@ -10,9 +10,10 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use crate::accel::BvhStats;
-use crate::render_scene::TextureFilter;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::render_scene::{Camera, Light, ObjectInfo, RenderParams, RenderScene};
+use crate::render_scene::{IntegratorKind, TextureFilter};
+use crate::sampling::SamplerKind;
 use crate::scene::Diagnostic;
 use crate::scene::schema::{self, CameraSpec, LightSpec, SceneFile};
 
@@ -127,6 +128,15 @@ pub fn compile(
         seed: r.seed,
         background: r.background.into(),
         exposure: r.exposure,
+        integrator: match r.integrator {
+            schema::IntegratorKind::Whitted => IntegratorKind::Whitted,
+            schema::IntegratorKind::Path => IntegratorKind::Path,
+        },
+        sampler: match r.sampler {
+            schema::SamplerKind::Independent => SamplerKind::Independent,
+            schema::SamplerKind::Sobol => SamplerKind::Sobol,
+        },
+        diffuse_depth: r.diffuse_depth.unwrap_or(u32::MAX),
         texture_filter: match r.texture_filter {
             schema::TextureFilter::Anisotropic => TextureFilter::Anisotropic,
             schema::TextureFilter::Trilinear => TextureFilter::Trilinear,

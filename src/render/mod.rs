@@ -3,11 +3,12 @@
 pub mod film;
 pub mod metrics;
 pub mod output;
+pub mod pixel_sums;
+pub mod progressive;
 pub mod tiles;
-pub mod trace_log;
-pub mod whitted;
 
 pub use film::Film;
+pub use pixel_sums::PixelSums;
 pub use tiles::{
     Region, RenderError, RenderJob, RenderOptions, RenderOutput, RenderStats, render, trace_pixel,
 };

@@ -11,11 +11,11 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use super::Film;
-use super::trace_log::TraceLog;
-use super::whitted::{Counters, Whitted};
+use super::pixel_sums::PixelSums;
 use crate::geometry::Ray;
+use crate::integrators::{Counters, Integrator, TraceLog};
 use crate::render_scene::RenderScene;
-use crate::sampling::Rng;
+use crate::sampling::Sampler;
 
 const TILE: u32 = 16;
 
@@ -44,6 +44,10 @@ pub struct RenderOptions {
     /// Raised by another thread to stop the render early: workers look at it before each pixel
     /// and between passes, and the render then returns [`RenderError::Cancelled`].
     pub cancel: Option<Arc<AtomicBool>>,
+    /// Take only these sample indices of every pixel (`None`: `0..samples_per_pixel`). Renders
+    /// of disjoint ranges merge ([`crate::render::PixelSums::merge`]) into exactly the render
+    /// of their union.
+    pub samples: Option<Range<u32>>,
 }
 
 /// What a render did.
@@ -64,8 +68,10 @@ pub struct RenderStats {
 /// A rendered film with its statistics.
 #[derive(Debug, Clone)]
 pub struct RenderOutput {
-    /// The (possibly cropped) image.
+    /// The (possibly cropped) image: each pixel's mean.
     pub film: Film,
+    /// The per-pixel sums, squares and counts the image was made from (mergeable).
+    pub sums: PixelSums,
     /// Counters and timing.
     pub stats: RenderStats,
 }
@@ -85,6 +91,9 @@ pub enum RenderError {
     /// The worker pool could not be created.
     #[error("cannot start {0} render threads: {1}")]
     Threads(usize, String),
+    /// The sample range is empty-ended or beyond the scene's samples per pixel.
+    #[error("sample range {0}..{1} is not within the scene's {2} samples per pixel")]
+    SampleRange(u32, u32, u32),
     /// The cancel flag of [`RenderOptions`] was raised; no image is returned.
     #[error("the render was cancelled")]
     Cancelled,
@@ -105,14 +114,20 @@ pub fn render(scene: &RenderScene, options: &RenderOptions) -> Result<RenderOutp
 /// (for checkpoints), and a cancelled pass leaves the job as it was after the previous one.
 pub struct RenderJob<'a> {
     scene: &'a RenderScene,
+    integrator: Integrator<'a>,
     region: Region,
     tiles: Vec<Region>,
     pool: rayon::ThreadPool,
     cancel: Option<Arc<AtomicBool>>,
     progress: ProgressBar,
-    /// Per-pixel radiance sums over the samples done, row-major over the region.
-    sums: Vec<Vec3>,
+    /// Per-pixel sample statistics over the samples done, row-major over the region.
+    sums: PixelSums,
+    /// First sample index this job takes.
+    first: u32,
+    /// Samples `first..done` are in `sums`.
     done: u32,
+    /// One past the last sample index this job takes.
+    end: u32,
     stats: RenderStats,
     start: Instant,
 }
@@ -157,17 +172,31 @@ impl<'a> RenderJob<'a> {
             .build()
             .map_err(|e| RenderError::Threads(threads, e.to_string()))?;
         let tiles = tile_grid(region);
-        let spp = u64::from(scene.params.samples_per_pixel);
+        let range = options
+            .samples
+            .clone()
+            .unwrap_or(0..scene.params.samples_per_pixel);
+        if range.end > scene.params.samples_per_pixel || range.start > range.end {
+            return Err(RenderError::SampleRange(
+                range.start,
+                range.end,
+                scene.params.samples_per_pixel,
+            ));
+        }
+        let spp = u64::from(range.end - range.start);
         let progress = progress_bar(options.progress, tiles.len() as u64 * spp);
         Ok(Self {
             scene,
+            integrator: Integrator::prepare(scene),
             region,
             tiles,
             pool,
             cancel: options.cancel.clone(),
             progress,
-            sums: vec![Vec3::ZERO; region.width as usize * region.height as usize],
-            done: 0,
+            sums: PixelSums::new(region.width, region.height),
+            first: range.start,
+            done: range.start,
+            end: range.end,
             stats: RenderStats {
                 threads,
                 ..Default::default()
@@ -176,13 +205,14 @@ impl<'a> RenderJob<'a> {
         })
     }
 
-    /// Samples per pixel of the finished render.
+    /// One past the last sample index of the finished render (its samples per pixel when it
+    /// starts at 0).
     #[must_use]
     pub fn samples_per_pixel(&self) -> u32 {
-        self.scene.params.samples_per_pixel
+        self.end
     }
 
-    /// Samples per pixel taken so far (by complete passes).
+    /// One past the last sample index taken so far (by complete passes).
     #[must_use]
     pub fn samples_done(&self) -> u32 {
         self.done
@@ -201,20 +231,24 @@ impl<'a> RenderJob<'a> {
         if end == self.done {
             return Ok(());
         }
-        let (scene, region, sums, samples) = (self.scene, self.region, &self.sums, self.done..end);
+        let (integrator, region, samples) = (&self.integrator, self.region, self.done..end);
         let (progress, cancel) = (&self.progress, self.cancel.as_deref());
         let results: Option<Vec<TileResult>> = self.pool.install(|| {
             self.tiles
                 .par_iter()
-                .map(|t| render_tile(scene, t, region, sums, samples.clone(), cancel, progress))
+                .map(|t| {
+                    let samples = samples.clone();
+                    render_tile(self.scene, integrator, t, samples, cancel, progress)
+                })
                 .collect()
         });
         let Some(results) = results else {
             return Err(RenderError::Cancelled);
         };
         for (tile, r) in self.tiles.iter().zip(results) {
-            for (i, s) in r.sums.into_iter().enumerate() {
-                self.sums[pixel_index(region, tile, i)] = s;
+            for i in 0..(tile.width * tile.height) as usize {
+                self.sums
+                    .add_pixel(pixel_index(region, tile, i), &r.sums, i);
             }
             self.stats.rays += r.counters.rays;
             self.stats.nan_samples += r.nan;
@@ -223,11 +257,17 @@ impl<'a> RenderJob<'a> {
         Ok(())
     }
 
-    /// The image so far: each pixel's sum over the samples done, divided by their number (black
-    /// before the first pass).
+    /// The image so far: each pixel's mean over the samples done (black before the first
+    /// pass).
     #[must_use]
     pub fn snapshot(&self) -> Film {
-        self.film_over(self.done.max(1))
+        self.sums.to_film()
+    }
+
+    /// The per-pixel statistics so far.
+    #[must_use]
+    pub fn sums(&self) -> &PixelSums {
+        &self.sums
     }
 
     /// Takes the remaining samples in one pass and returns the finished film.
@@ -237,21 +277,24 @@ impl<'a> RenderJob<'a> {
     pub fn finish(mut self) -> Result<RenderOutput, RenderError> {
         self.render_pass(self.samples_per_pixel() - self.done)?;
         self.progress.finish_and_clear();
-        let spp = self.samples_per_pixel();
-        let film = self.film_over(spp);
-        let mut stats = self.stats;
-        stats.samples =
-            u64::from(self.region.width) * u64::from(self.region.height) * u64::from(spp);
-        stats.elapsed = self.start.elapsed();
-        Ok(RenderOutput { film, stats })
+        Ok(self.output())
     }
 
-    fn film_over(&self, samples: u32) -> Film {
-        let mut film = Film::new(self.region.width, self.region.height);
-        for (p, s) in film.pixels.iter_mut().zip(&self.sums) {
-            *p = *s / samples as f32;
+    /// The image and statistics of the samples done so far (for a render stopped early by a
+    /// time budget: every pixel has the same number of samples).
+    #[must_use]
+    pub fn output(&self) -> RenderOutput {
+        self.progress.finish_and_clear();
+        let mut stats = self.stats;
+        stats.samples = u64::from(self.region.width)
+            * u64::from(self.region.height)
+            * u64::from(self.done - self.first);
+        stats.elapsed = self.start.elapsed();
+        RenderOutput {
+            film: self.sums.to_film(),
+            sums: self.sums.clone(),
+            stats,
         }
-        film
     }
 
     fn is_cancelled(&self) -> bool {
@@ -310,29 +353,32 @@ fn progress_bar(enabled: bool, tiles: u64) -> ProgressBar {
     bar
 }
 
-/// One tile's share of a pass: its pixels' new radiance sums (row-major in the tile) and counts.
+/// One tile's share of a pass: its pixels' statistics over the pass (row-major in the tile) and
+/// counters.
 struct TileResult {
-    sums: Vec<Vec3>,
+    sums: PixelSums,
     counters: Counters,
     nan: u64,
 }
 
-/// Adds samples `samples` of each pixel of `tile` to its sum so far (taken from `sums`), in
-/// ascending sample order. `None` when `cancel` is raised: it is checked before each pixel, never
-/// per ray.
+/// Takes samples `samples` of each pixel of `tile`. `None` when `cancel` is raised: it is
+/// checked before each pixel, never per ray.
 fn render_tile(
     scene: &RenderScene,
+    integrator: &Integrator,
     tile: &Region,
-    region: Region,
-    sums: &[Vec3],
     samples: Range<u32>,
     cancel: Option<&AtomicBool>,
     progress: &ProgressBar,
 ) -> Option<TileResult> {
-    let integrator = Whitted::new(scene);
+    let mut sampler = Sampler::new(
+        scene.params.sampler,
+        scene.params.seed,
+        scene.params.samples_per_pixel,
+    );
     let mut counters = Counters::default();
     let mut nan = 0u64;
-    let mut out = Vec::with_capacity((tile.width * tile.height) as usize);
+    let mut out = PixelSums::new(tile.width, tile.height);
     for i in 0..(tile.width * tile.height) as usize {
         if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
             return None;
@@ -341,17 +387,15 @@ fn render_tile(
             tile.x + i as u32 % tile.width,
             tile.y + i as u32 / tile.width,
         );
-        let mut sum = sums[pixel_index(region, tile, i)];
         for s in samples.clone() {
-            let (ray, mut rng) = camera_sample(scene, x, y, s);
-            let l = integrator.li(ray, &mut rng, &mut counters, None);
+            let ray = camera_sample(scene, &mut sampler, x, y, s);
+            let l = integrator.li(ray, &mut sampler, &mut counters, None);
             if l.is_finite() {
-                sum += l;
+                out.add(i, l);
             } else {
                 nan += 1;
             }
         }
-        out.push(sum);
     }
     progress.inc(u64::from(samples.end - samples.start));
     Some(TileResult {
@@ -361,17 +405,15 @@ fn render_tile(
     })
 }
 
-/// The camera ray and random stream of sample `s` of pixel `(x, y)`: stratified jitter on a
-/// ⌈√spp⌉-column grid over the pixel.
-fn camera_sample(scene: &RenderScene, x: u32, y: u32, s: u32) -> (Ray, Rng) {
+/// Starts `sampler` on sample `s` of pixel `(x, y)` and returns its camera ray through the
+/// position in the pixel the sampler's first two dimensions give.
+fn camera_sample(scene: &RenderScene, sampler: &mut Sampler, x: u32, y: u32, s: u32) -> Ray {
     let p = &scene.params;
-    let mut rng = Rng::for_pixel_sample(p.seed, x, y, s);
-    let cols = (f64::from(p.samples_per_pixel).sqrt().ceil() as u32).max(1);
-    let rows = p.samples_per_pixel.div_ceil(cols);
-    let (jx, jy) = rng.next_2d();
-    let fx = x as f32 + ((s % cols) as f32 + jx) / cols as f32;
-    let fy = y as f32 + ((s / cols) as f32 + jy) / rows as f32;
-    (scene.camera.ray(fx, fy, p.width, p.height), rng)
+    sampler.start_pixel_sample(x, y, s);
+    let (jx, jy) = sampler.pixel_2d();
+    scene
+        .camera
+        .ray(x as f32 + jx, y as f32 + jy, p.width, p.height)
 }
 
 /// Traces sample `sample` of pixel `(x, y)` exactly as the renderer does, recording its ray tree.
@@ -385,8 +427,10 @@ pub fn trace_pixel(
     if x >= p.width || y >= p.height {
         return Err(RenderError::PixelOutside(x, y, p.width, p.height));
     }
-    let (ray, mut rng) = camera_sample(scene, x, y, sample);
+    let mut sampler = Sampler::new(p.sampler, p.seed, p.samples_per_pixel);
+    let ray = camera_sample(scene, &mut sampler, x, y, sample);
     let mut log = TraceLog::default();
-    let l = Whitted::new(scene).li(ray, &mut rng, &mut Counters::default(), Some(&mut log));
+    let integrator = Integrator::prepare(scene);
+    let l = integrator.li(ray, &mut sampler, &mut Counters::default(), Some(&mut log));
     Ok((log, l))
 }

@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use super::texture::Lookup;
 use super::{RenderScene, SurfacePoint, TextureFilter};
 use crate::geometry::Frame;
-use crate::shading::{Material, usable_shading_normal};
+use crate::shading::{Bsdf, usable_shading_normal};
 use crate::texture::Footprint;
 
 /// Grazing cosines below this are treated as this when sizing footprints (caps the footprint's
@@ -18,7 +18,7 @@ const MIN_FOOTPRINT_COS: f32 = 1e-3;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfaceMaterial {
     /// The BSDF; its `color` is used when `color_texture` is `None`.
-    pub bsdf: Material,
+    pub bsdf: Bsdf,
     /// Texture giving the colour, as an index into `RenderScene::textures`.
     pub color_texture: Option<u32>,
     /// Texture perturbing the shading normal, as an index into `RenderScene::textures`.
@@ -31,7 +31,7 @@ pub struct SurfaceMaterial {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadingPoint {
     /// The BSDF with textures applied.
-    pub bsdf: Material,
+    pub bsdf: Bsdf,
     /// Unit geometric normal on the side of `wo`.
     pub ng: Vec3,
     /// Unit shading normal on the side of `wo`, bumped and made usable

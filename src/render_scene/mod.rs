@@ -3,18 +3,22 @@
 pub mod camera;
 pub mod geometry;
 pub mod light;
+pub mod light_sampler;
 pub mod material;
 pub mod surface;
 pub mod texture;
 
 pub use camera::Camera;
 pub use geometry::{Geometry, Hit, PrimRef};
-pub use light::Light;
+pub use light::{EmissionSample, Light, LightSample};
+pub use light_sampler::LightSampler;
 pub use material::{ShadingPoint, SurfaceMaterial};
 pub use surface::SurfacePoint;
 pub use texture::Texture;
 
 use glam::Vec3;
+
+use crate::sampling::SamplerKind;
 
 /// Rendering parameters after command-line overrides.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,8 +41,23 @@ pub struct RenderParams {
     pub background: Vec3,
     /// Radiance scale applied when writing 8-bit images.
     pub exposure: f32,
+    /// Which integrator renders the image.
+    pub integrator: IntegratorKind,
+    /// Where integrators draw random numbers from.
+    pub sampler: SamplerKind,
+    /// Path tracing: most non-delta bounces per path (`u32::MAX`: only `max_depth` limits).
+    pub diffuse_depth: u32,
     /// How image textures are filtered.
     pub texture_filter: TextureFilter,
+}
+
+/// Which light-transport algorithm renders the image (see the scene schema's `integrator`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IntegratorKind {
+    /// Recursive ray tracing (`integrators::Whitted`).
+    Whitted,
+    /// Path tracing (`integrators::PathTracer`).
+    Path,
 }
 
 /// How image textures are filtered (see the scene schema's `texture_filter`).

@@ -1,6 +1,9 @@
 //! Deterministic random streams and the warps that turn uniform numbers into directions.
 
+pub mod alias;
 pub mod rng;
+pub mod sampler;
 pub mod warp;
 
 pub use rng::Rng;
+pub use sampler::{Sampler, SamplerKind};

@@ -61,6 +61,12 @@ pub struct RenderSettings {
     pub exposure: f32,
     /// Light-transport algorithm.
     pub integrator: IntegratorKind,
+    /// Where the integrators' random numbers come from.
+    pub sampler: SamplerKind,
+    /// Path tracing: most diffuse or glossy bounces a path may make (unset: up to `max_depth`);
+    /// 0 keeps only direct light and mirror/glass chains (Whitted's light transport).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diffuse_depth: Option<u32>,
     /// How image textures are filtered.
     pub texture_filter: TextureFilter,
 }
@@ -78,6 +84,8 @@ impl Default for RenderSettings {
             background: [0.0; 3],
             exposure: 1.0,
             integrator: IntegratorKind::Whitted,
+            sampler: SamplerKind::Sobol,
+            diffuse_depth: None,
             texture_filter: TextureFilter::Anisotropic,
         }
     }
@@ -88,6 +96,19 @@ impl Default for RenderSettings {
 pub enum IntegratorKind {
     /// Recursive (Whitted) ray tracing: direct light with shadow rays, mirror and refraction.
     Whitted,
+    /// Path tracing with next-event estimation and multiple importance sampling: unbiased
+    /// global illumination, the reference the other integrators are checked against.
+    Path,
+}
+
+/// Which sequence the integrators draw their random numbers from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub enum SamplerKind {
+    /// Independent uniform random numbers per pixel sample.
+    Independent,
+    /// Owen-scrambled Sobol points (Burley 2020): stratified in every pair of dimensions, lower
+    /// error at the same sample count.
+    Sobol,
 }
 
 /// How image textures (bitmaps and height maps) are filtered.

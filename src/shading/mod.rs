@@ -1,8 +1,10 @@
 //! The one material model shared by every integrator, and the optics it is built from.
 
-pub mod material;
+pub mod bsdf;
 pub mod normals;
 pub mod optics;
 
-pub use material::Material;
+pub use bsdf::{
+    Bsdf, BsdfSample, DeltaLobes, ShadingFrame, TransportMode, shading_normal_correction,
+};
 pub use normals::usable_shading_normal;

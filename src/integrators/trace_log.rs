@@ -11,6 +11,8 @@ pub enum RayKind {
     Reflect,
     /// Refracted through a dielectric.
     Refract,
+    /// Sampled from the diffuse or glossy part (path tracing).
+    Scatter,
 }
 
 /// What a traced ray hit.

@@ -3,24 +3,17 @@
 
 use glam::Vec3;
 
+use super::Counters;
+use super::shadow::{RayCone, shadow_ray};
 use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog, TraceNode};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{Light, RenderScene, ShadingPoint, SurfacePoint};
-use crate::sampling::Rng;
-use crate::shading::Material;
-
-/// Fraction of a shadow ray's length left unchecked at the light end.
-const SHADOW_EPSILON: f32 = 1e-4;
-
-/// Per-worker counters, summed after rendering.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Counters {
-    /// Rays traced (camera, specular and shadow).
-    pub rays: u64,
-}
+use crate::sampling::Sampler;
+use crate::shading::Bsdf;
 
 /// The Whitted-style integrator over a compiled scene.
+#[derive(Debug)]
 pub struct Whitted<'a> {
     scene: &'a RenderScene,
     pixel_spread: f32,
@@ -40,33 +33,6 @@ struct Path {
     cone: RayCone,
 }
 
-/// The pixel footprint carried along a path as a cone (Akenine-Möller et al., "Texture Level of
-/// Detail Strategies for Real-Time Ray Tracing", Ray Tracing Gems ch. 20): its width at the
-/// ray's origin and how fast it grows per unit distance. Sizes texture filters at every hit,
-/// including those seen in mirrors and through glass.
-#[derive(Debug, Clone, Copy)]
-struct RayCone {
-    width: f32,
-    spread: f32,
-}
-
-impl RayCone {
-    /// The cone leaving a hit at `t` (in ray-parameter units of `ray`) after a specular event at
-    /// a surface of curvature `curvature`, bending rays by `bend` times the curvature (2 for a
-    /// mirror, about |1 − 1/η| for refraction; taken as 1, conservatively).
-    fn bounce(self, ray: &Ray, t: f32, curvature: f32, bend: f32) -> Self {
-        let width = self.width_at(ray, t);
-        Self {
-            width,
-            spread: self.spread + bend * curvature * width,
-        }
-    }
-
-    fn width_at(self, ray: &Ray, t: f32) -> f32 {
-        self.width + self.spread * t * ray.dir.length()
-    }
-}
-
 impl<'a> Whitted<'a> {
     /// An integrator for `scene`.
     #[must_use]
@@ -82,7 +48,7 @@ impl<'a> Whitted<'a> {
     pub fn li(
         &self,
         ray: Ray,
-        rng: &mut Rng,
+        rng: &mut Sampler,
         counters: &mut Counters,
         log: Option<&mut TraceLog>,
     ) -> Vec3 {
@@ -91,10 +57,7 @@ impl<'a> Whitted<'a> {
             depth: 0,
             weight: Vec3::ONE,
             kind: RayKind::Camera,
-            cone: RayCone {
-                width: 0.0,
-                spread: self.pixel_spread,
-            },
+            cone: RayCone::camera(self.pixel_spread),
         };
         self.trace(path, rng, counters, log, None)
     }
@@ -102,7 +65,7 @@ impl<'a> Whitted<'a> {
     fn trace(
         &self,
         path: Path,
-        rng: &mut Rng,
+        rng: &mut Sampler,
         counters: &mut Counters,
         mut log: Option<&mut TraceLog>,
         parent: Option<usize>,
@@ -119,7 +82,7 @@ impl<'a> Whitted<'a> {
     fn shade(
         &self,
         path: &Path,
-        rng: &mut Rng,
+        rng: &mut Sampler,
         counters: &mut Counters,
         mut log: Option<&mut TraceLog>,
         me: Option<usize>,
@@ -223,11 +186,11 @@ impl<'a> Whitted<'a> {
     fn direct(
         &self,
         sp: &SurfacePoint,
-        material: &Material,
+        material: &Bsdf,
         wo: Vec3,
         ng: Vec3,
         ns: Vec3,
-        rng: &mut Rng,
+        rng: &mut Sampler,
         counters: &mut Counters,
         mut log: Option<&mut TraceLog>,
         me: Option<usize>,
@@ -241,30 +204,19 @@ impl<'a> Whitted<'a> {
             let mut sum = Vec3::ZERO;
             for _ in 0..n {
                 let u = rng.next_2d();
-                let Some(ls) = light.sample(sp.p, u) else {
+                let Some(ls) = light.sample_li(sp.p, u) else {
                     continue;
                 };
                 let cos_s = ns.dot(ls.wi);
                 if cos_s <= 0.0 || ng.dot(ls.wi) <= 0.0 {
                     continue;
                 }
-                let f = material.eval(wo, ls.wi, ns);
+                let f = material.f(wo, ls.wi, ns);
                 if f == Vec3::ZERO {
                     continue;
                 }
-                // Leaving a smooth mesh outward: start from the smooth surface (shadow terminator).
-                let start = if ng.dot(sp.ng) > 0.0 {
-                    sp.p_outside
-                } else {
-                    sp.p
-                };
-                let origin = offset_ray_origin(start, sp.p_error, ng, ls.wi);
                 // Aim at the sampled light point itself, stopping just short of it.
-                let shadow = Ray {
-                    origin,
-                    dir: ls.point - origin,
-                    t_max: 1.0 - SHADOW_EPSILON,
-                };
+                let shadow = shadow_ray(sp, ng, ls.point);
                 let transmittance = self.transmittance(&shadow, counters);
                 let occluded = transmittance == Vec3::ZERO;
                 let c = f * ls.weight * cos_s * transmittance;
@@ -297,7 +249,7 @@ impl<'a> Whitted<'a> {
 impl Whitted<'_> {
     /// How much of the light travelling along `shadow` (up to its `t_max`) arrives: 0 when an
     /// opaque surface is in the way, else the product of the straight-line transmittances of
-    /// the dielectric surfaces crossed (`Material::straight_transmittance`).
+    /// the dielectric surfaces crossed (`Bsdf::straight_transmittance`).
     fn transmittance(&self, shadow: &Ray, counters: &mut Counters) -> Vec3 {
         counters.rays += 1;
         let scene = self.scene;
@@ -328,7 +280,7 @@ impl Whitted<'_> {
             let sp = scene.geometry.surface(&ray, &hit);
             let wo = -ray.dir.normalize();
             let s = scene.shading_point(material, &sp, wo, 0.0);
-            t *= s.bsdf.straight_transmittance(s.ns.dot(wo));
+            t *= s.bsdf.straight_transmittance(s.ns.dot(wo), s.entering);
             if t.max_element() <= 0.0 {
                 return Vec3::ZERO;
             }

@@ -1,0 +1,137 @@
+//! Commands of the `caustic` binary and the arguments they share.
+
+mod check;
+mod compare;
+mod debug_pixel;
+mod render;
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use caustic::Error;
+use caustic::pipeline::SceneOverrides;
+use caustic::scene::Diagnostic;
+
+/// caustic: a ray tracer driven by RON/TOML scene files.
+#[derive(Parser)]
+#[command(name = "caustic", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to PNG (sRGB) or EXR (linear float), chosen by the output's extension.
+    ///
+    /// Ctrl-C stops the render and writes nothing (an existing output file is left untouched);
+    /// the exit code is then 130. With `--checkpoint`, the checkpoint file keeps the last
+    /// complete checkpoint.
+    Render(render::RenderArgs),
+    /// Parse and validate a scene (and its assets) without rendering; reports every error.
+    Check(SceneArgs),
+    /// Print the JSON Schema of the scene format.
+    Schema,
+    /// Trace one sample of one pixel and print its ray tree.
+    DebugPixel(debug_pixel::DebugPixelArgs),
+    /// Compare an image with a reference (PNG or EXR): RMSE, relative MSE, max difference, bias.
+    Compare(compare::CompareArgs),
+}
+
+/// Runs one command.
+pub fn run(cli: Cli) -> Result<(), Error> {
+    match cli.command {
+        Command::Render(args) => render::run(&args),
+        Command::Check(args) => check::run(&args),
+        Command::Schema => {
+            print!("{}", caustic::scene::schema::json_schema());
+            Ok(())
+        }
+        Command::DebugPixel(args) => debug_pixel::run(&args),
+        Command::Compare(args) => compare::run(&args),
+    }
+}
+
+/// Light-transport algorithms, as named on the command line.
+#[derive(Clone, Copy, ValueEnum)]
+enum IntegratorArg {
+    /// Recursive ray tracing: direct light, mirrors and refraction.
+    Whitted,
+    /// Path tracing with next-event estimation and MIS (unbiased global illumination).
+    Path,
+}
+
+/// Samplers, as named on the command line.
+#[derive(Clone, Copy, ValueEnum)]
+enum SamplerArg {
+    /// Independent uniform random numbers.
+    Independent,
+    /// Owen-scrambled Sobol points.
+    Sobol,
+}
+
+/// The scene and the overrides every command that loads one takes.
+#[derive(Args)]
+pub struct SceneArgs {
+    /// Scene file (.ron or .toml).
+    scene: PathBuf,
+    /// Override a scene value, e.g. `--set camera.fov_y=35` (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    sets: Vec<String>,
+    /// Image width in pixels.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Samples per pixel.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Maximum path depth (bounces; for Whitted, specular recursion depth).
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Seed of the random streams.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Light-transport algorithm (the scene's `render.integrator`).
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorArg>,
+    /// Random-number sampler (the scene's `render.sampler`).
+    #[arg(long, value_enum)]
+    sampler: Option<SamplerArg>,
+}
+
+impl SceneArgs {
+    fn overrides(&self) -> SceneOverrides {
+        let mut sets = self.sets.clone();
+        if let Some(i) = self.integrator {
+            let name = match i {
+                IntegratorArg::Whitted => "Whitted",
+                IntegratorArg::Path => "Path",
+            };
+            sets.push(format!("render.integrator={name}"));
+        }
+        if let Some(s) = self.sampler {
+            let name = match s {
+                SamplerArg::Independent => "Independent",
+                SamplerArg::Sobol => "Sobol",
+            };
+            sets.push(format!("render.sampler={name}"));
+        }
+        SceneOverrides {
+            sets,
+            width: self.width,
+            height: self.height,
+            samples_per_pixel: self.spp,
+            max_depth: self.max_depth,
+            seed: self.seed,
+        }
+    }
+}
+
+fn print_warnings(warnings: &[Diagnostic]) {
+    for w in warnings {
+        eprint!("{w}");
+    }
+}

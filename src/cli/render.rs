@@ -1,0 +1,341 @@
+//! `caustic render`: render a scene to an image, in passes (checkpoints, time budgets), with
+//! Ctrl-C handling and atomic output.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use clap::Args;
+
+use caustic::Error;
+use caustic::pipeline::prepare;
+use caustic::render::output::{OutputFormat, write_image};
+use caustic::render::progressive::{CheckpointPlan, PassPlan, render_in_passes};
+use caustic::render::{Region, RenderError, RenderJob, RenderOptions};
+
+use super::{SceneArgs, print_warnings};
+
+/// Samples per pixel a `--time` render may reach when `--spp` is not given.
+const BUDGET_SPP_CAP: u32 = 1 << 20;
+
+/// Arguments of `caustic render`.
+#[derive(Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output image (.png, .exr, or .part for the mergeable film of per-pixel sums); default:
+    /// the scene's name with .png in the current directory.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Render only the crop X,Y,W,H (pixels from the top-left); its pixels equal the full render's.
+    #[arg(long, value_name = "X,Y,W,H")]
+    region: Option<String>,
+    /// No progress bar and no warnings.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Print scene and BVH statistics.
+    #[arg(long)]
+    stats: bool,
+    /// Render for this long (e.g. `30s`, `2m`, `1.5h`, or seconds), in passes of samples per
+    /// pixel, then write the image; the summary says how many samples per pixel it reached.
+    /// `--spp`, if given, still caps the samples.
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
+    time: Option<Duration>,
+    /// Render in passes of samples per pixel and save the image so far to FILE (.png or .exr,
+    /// not the output) after a pass once `--checkpoint-every` seconds have passed since the last
+    /// save. Ctrl-C
+    /// leaves the last complete checkpoint there; it is removed once the final image is written.
+    /// The final image is the same, bit for bit, as without checkpoints.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints (0: after every pass).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value = "30",
+        requires = "checkpoint",
+        value_parser = parse_seconds
+    )]
+    checkpoint_every: Duration,
+}
+
+fn parse_seconds(text: &str) -> Result<Duration, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .and_then(|s| Duration::try_from_secs_f64(s).ok())
+        .ok_or_else(|| format!("expected a non-negative number of seconds, found `{text}`"))
+}
+
+/// A duration such as `30s`, `2m`, `1.5h`, `250ms` or a bare number of seconds; positive.
+fn parse_duration(text: &str) -> Result<Duration, String> {
+    let t = text.trim();
+    let (number, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
+        Some(i) => t.split_at(i),
+        None => (t, "s"),
+    };
+    let scale = match unit {
+        "ms" => 1e-3,
+        "s" => 1.0,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        _ => f64::NAN,
+    };
+    number
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .map(|n| n * scale)
+        .filter(|s| *s > 0.0)
+        .and_then(|s| Duration::try_from_secs_f64(s).ok())
+        .ok_or_else(|| {
+            format!("expected a positive duration such as `30s`, `2m` or `1.5h`, found `{text}`")
+        })
+}
+
+fn parse_region(text: &str) -> Result<Region, Error> {
+    let parts: Vec<Result<u32, _>> = text.split(',').map(|p| p.trim().parse::<u32>()).collect();
+    match parts.as_slice() {
+        [Ok(x), Ok(y), Ok(w), Ok(h)] => Ok(Region {
+            x: *x,
+            y: *y,
+            width: *w,
+            height: *h,
+        }),
+        _ => Err(Error::Usage(format!(
+            "error: --region `{text}`: expected four non-negative integers X,Y,W,H, e.g. `--region 64,64,128,128`"
+        ))),
+    }
+}
+
+fn default_output(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from(format!("{stem}.png"))
+}
+
+/// Whether `path` asks for the mergeable film (`.part`).
+fn is_part(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("part"))
+}
+
+/// Ctrl-C (and, on unix, SIGTERM/SIGHUP) for `caustic render`: before the render starts it ends
+/// the process at once (nothing has been written yet); from then on it raises the cancel flag
+/// the render polls, so the run can stop cleanly without writing the output.
+struct Interrupt {
+    rendering: Arc<AtomicBool>,
+    cancel: Arc<AtomicBool>,
+}
+
+impl Interrupt {
+    fn install(quiet: bool) -> Self {
+        let rendering = Arc::new(AtomicBool::new(false));
+        let cancel = Arc::new(AtomicBool::new(false));
+        let (r, c) = (Arc::clone(&rendering), Arc::clone(&cancel));
+        let installed = ctrlc::set_handler(move || {
+            if r.load(Ordering::SeqCst) {
+                c.store(true, Ordering::SeqCst);
+            } else {
+                eprintln!("interrupted: no image written");
+                std::process::exit(130);
+            }
+        });
+        if let Err(e) = installed
+            && !quiet
+        {
+            eprintln!("warning: cannot catch Ctrl-C ({e}); interrupting will not clean up");
+        }
+        Self { rendering, cancel }
+    }
+
+    /// From now on a signal cancels the render instead of ending the process.
+    fn start_rendering(&self) -> Arc<AtomicBool> {
+        self.rendering.store(true, Ordering::SeqCst);
+        Arc::clone(&self.cancel)
+    }
+
+    fn raised(&self) -> bool {
+        self.cancel.load(Ordering::SeqCst)
+    }
+}
+
+/// Whether two paths name the same file (lexically after making them absolute, or the same
+/// existing file).
+fn same_file(a: &Path, b: &Path) -> bool {
+    if let (Ok(x), Ok(y)) = (a.canonicalize(), b.canonicalize()) {
+        return x == y;
+    }
+    matches!((std::path::absolute(a), std::path::absolute(b)), (Ok(x), Ok(y)) if x == y)
+}
+
+/// Renders the scene and writes the image (or the mergeable film).
+pub fn run(args: &RenderArgs) -> Result<(), Error> {
+    let interrupt = Interrupt::install(args.quiet);
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&args.scene.scene));
+    // Refuse a bad output name before doing any work.
+    if !is_part(&output) {
+        OutputFormat::for_path(&output)?;
+    }
+    if let Some(cp) = &args.checkpoint {
+        if OutputFormat::for_path(cp).is_err() {
+            return Err(Error::Usage(format!(
+                "error: --checkpoint `{}`: the checkpoint must end in `.png` or `.exr`",
+                cp.display()
+            )));
+        }
+        if same_file(cp, &output) {
+            return Err(Error::Usage(format!(
+                "error: --checkpoint `{}` is the output file; give it a name of its own",
+                cp.display()
+            )));
+        }
+    }
+    let region = args.region.as_deref().map(parse_region).transpose()?;
+    if args.threads == Some(0) {
+        return Err(Error::Usage("error: --threads must be at least 1".into()));
+    }
+    let mut overrides = args.scene.overrides();
+    if args.time.is_some() && overrides.samples_per_pixel.is_none() {
+        overrides.samples_per_pixel = Some(BUDGET_SPP_CAP);
+    }
+    let prepared = prepare(&args.scene.scene, &overrides)?;
+    if !args.quiet {
+        print_warnings(&prepared.warnings);
+    }
+    if args.stats {
+        print_stats(&prepared.stats);
+    }
+    let exposure = prepared.render_scene.params.exposure;
+    let spp = prepared.render_scene.params.samples_per_pixel;
+    let terminal = !args.quiet && std::io::stderr().is_terminal();
+    let options = RenderOptions {
+        threads: args.threads,
+        region,
+        progress: terminal && args.time.is_none(),
+        cancel: Some(interrupt.start_rendering()),
+        ..RenderOptions::default()
+    };
+    let job = RenderJob::new(&prepared.render_scene, &options)?;
+    let plan = PassPlan {
+        checkpoint: args.checkpoint.as_deref().map(|path| CheckpointPlan {
+            path,
+            every: args.checkpoint_every,
+            exposure,
+        }),
+        time_budget: args.time,
+        progress: terminal,
+    };
+    let outcome = render_in_passes(job, &plan);
+    let saved = outcome.checkpoint_spp;
+    let interrupted = || {
+        let kept = match (&args.checkpoint, saved) {
+            (Some(cp), Some(n)) => format!(
+                " to `{}`; `{}` holds the last complete checkpoint ({n} of {spp} samples per pixel)",
+                output.display(),
+                cp.display()
+            ),
+            _ => String::new(),
+        };
+        Error::Interrupted(format!("interrupted: no image written{kept}"))
+    };
+    let out = match outcome.result {
+        Err(RenderError::Cancelled) => return Err(interrupted()),
+        other => other?,
+    };
+    // A signal that came after the last tile still means "stop": the output is not written.
+    if interrupt.raised() {
+        return Err(interrupted());
+    }
+    if is_part(&output) {
+        let meta = format!(
+            "scene={}\nspp={}\n",
+            args.scene.scene.display(),
+            out.stats.samples / u64::from(out.film.width * out.film.height).max(1)
+        );
+        out.sums.write(&output, &meta)?;
+    } else {
+        write_image(&out.film, &output, exposure)?;
+    }
+    if let (Some(cp), Some(_)) = (&args.checkpoint, saved)
+        && let Err(e) = std::fs::remove_file(cp)
+        && !args.quiet
+    {
+        eprintln!(
+            "warning: cannot remove the checkpoint `{}`: {e}",
+            cp.display()
+        );
+    }
+    let st = &out.stats;
+    let secs = st.elapsed.as_secs_f64();
+    let reached = st.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1);
+    println!(
+        "{}: {}×{}, {} spp, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
+        output.display(),
+        out.film.width,
+        out.film.height,
+        reached,
+        st.rays,
+        secs,
+        st.rays as f64 / secs.max(1e-9) / 1e6,
+        st.threads,
+        if st.threads == 1 { "" } else { "s" }
+    );
+    if st.nan_samples > 0 {
+        eprintln!(
+            "warning: {} samples were NaN or infinite and were dropped",
+            st.nan_samples
+        );
+    }
+    Ok(())
+}
+
+fn print_stats(s: &caustic::compile::CompileStats) {
+    eprintln!(
+        "scene: {} triangles ({} degenerate dropped), {} spheres, {} ellipsoids, {} materials, {} lights, {} OBJ files",
+        s.triangles,
+        s.degenerate_triangles,
+        s.spheres,
+        s.ellipsoids,
+        s.materials,
+        s.lights,
+        s.meshes_loaded
+    );
+    eprintln!(
+        "bvh: {} nodes, {} leaves, depth {}, max leaf {}, SAH cost {:.2}; flatten {:.3} s, build {:.3} s",
+        s.bvh.nodes,
+        s.bvh.leaves,
+        s.bvh.max_depth,
+        s.bvh.max_leaf_size,
+        s.bvh.sah_cost,
+        s.flatten_time.as_secs_f64(),
+        s.bvh_time.as_secs_f64()
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_parse_with_units_and_refuse_nonsense() {
+        assert_eq!(parse_duration("30s"), Ok(Duration::from_secs(30)));
+        assert_eq!(parse_duration("2m"), Ok(Duration::from_secs(120)));
+        assert_eq!(parse_duration("1.5h"), Ok(Duration::from_secs(5400)));
+        assert_eq!(parse_duration("250ms"), Ok(Duration::from_millis(250)));
+        assert_eq!(parse_duration("12"), Ok(Duration::from_secs(12)));
+        for bad in ["", "0s", "-3s", "3 parsecs", "NaNs", "infs"] {
+            assert!(parse_duration(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,353 @@
+//! The mergeable film: per-pixel sums of radiance samples, sums of their squares and sample
+//! counts, in fixed point so that addition is exact and associative. Two renders of the same
+//! scene over disjoint sample ranges therefore merge into the very bytes of one render of all
+//! the samples, in any order (the basis of `--checkpoint`, `--time` and farm shards). Written to
+//! disk losslessly (`.part` files) with a checksum.
+
+use std::path::Path;
+
+use glam::{DVec3, Vec3};
+
+use super::Film;
+
+/// Fixed-point scale of the sums: samples are rounded to multiples of 2⁻⁶⁴ (about 5.4e-20) before
+/// summing, so even a light of a microwatt keeps 11 significant digits; sums saturate at
+/// 2⁶³ ≈ 9.2e18.
+const SCALE: f64 = 18_446_744_073_709_551_616.0;
+/// Fixed-point scale of the sums of squares: 2⁻³² resolution, saturating at 4e28.
+const SCALE_SQ: f64 = 4_294_967_296.0;
+/// File signature of a `.part` film.
+const MAGIC: &[u8; 16] = b"caustic-film-v1\n";
+
+/// Why a film file could not be read or merged.
+#[derive(Debug, thiserror::Error)]
+pub enum FilmError {
+    /// Not a film file, an unsupported version, or a truncated/corrupt one.
+    #[error("`{path}` is not a valid caustic film file: {reason}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Reading failed.
+    #[error("cannot read `{path}`: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The two films differ in size.
+    #[error("films of different sizes ({0}×{1} and {2}×{3}) cannot be merged")]
+    Size(u32, u32, u32, u32),
+}
+
+/// Per-pixel sample statistics, row-major from the top-left of the rendered region.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PixelSums {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Σ sample · 2⁶⁴ per pixel and channel.
+    sums: Vec<[i128; 3]>,
+    /// Σ sample² · 2³² per pixel and channel.
+    squares: Vec<[i128; 3]>,
+    /// Samples added per pixel (finite samples only; NaN/Inf are counted by the renderer).
+    counts: Vec<u32>,
+}
+
+#[inline]
+fn fixed(v: f64, scale: f64) -> i128 {
+    // `as` saturates; inputs are finite (the renderer drops NaN/Inf before they get here).
+    (v * scale).round() as i128
+}
+
+impl PixelSums {
+    /// Empty statistics for a `width × height` film.
+    #[must_use]
+    pub fn new(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        Self {
+            width,
+            height,
+            sums: vec![[0; 3]; n],
+            squares: vec![[0; 3]; n],
+            counts: vec![0; n],
+        }
+    }
+
+    /// Adds one finite radiance sample to pixel `index` (row-major).
+    #[inline]
+    pub fn add(&mut self, index: usize, l: Vec3) {
+        let l = l.as_dvec3();
+        let (s, q) = (&mut self.sums[index], &mut self.squares[index]);
+        for c in 0..3 {
+            s[c] = s[c].saturating_add(fixed(l[c], SCALE));
+            q[c] = q[c].saturating_add(fixed(l[c] * l[c], SCALE_SQ));
+        }
+        self.counts[index] += 1;
+    }
+
+    /// Adds pixel `from` of `other` into pixel `to` of `self` (tiles into the whole film).
+    #[inline]
+    pub fn add_pixel(&mut self, to: usize, other: &PixelSums, from: usize) {
+        for c in 0..3 {
+            self.sums[to][c] = self.sums[to][c].saturating_add(other.sums[from][c]);
+            self.squares[to][c] = self.squares[to][c].saturating_add(other.squares[from][c]);
+        }
+        self.counts[to] += other.counts[from];
+    }
+
+    /// Adds every pixel of `other` (same size) into `self`. Exact: the order of merges never
+    /// changes the result.
+    ///
+    /// # Errors
+    /// [`FilmError::Size`] when the sizes differ.
+    pub fn merge(&mut self, other: &PixelSums) -> Result<(), FilmError> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return Err(FilmError::Size(
+                self.width,
+                self.height,
+                other.width,
+                other.height,
+            ));
+        }
+        for i in 0..self.counts.len() {
+            self.add_pixel(i, other, i);
+        }
+        Ok(())
+    }
+
+    /// Samples added to pixel `index`.
+    #[must_use]
+    pub fn count(&self, index: usize) -> u32 {
+        self.counts[index]
+    }
+
+    /// Mean radiance of pixel `index` (black with no samples).
+    #[must_use]
+    pub fn mean(&self, index: usize) -> Vec3 {
+        let n = self.counts[index];
+        if n == 0 {
+            return Vec3::ZERO;
+        }
+        let s = self.sums[index];
+        (DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64) / (SCALE * f64::from(n))).as_vec3()
+    }
+
+    /// Unbiased sample variance of pixel `index`'s samples per channel (0 with fewer than two);
+    /// the variance of the pixel's mean is this over its count.
+    #[must_use]
+    pub fn variance(&self, index: usize) -> Vec3 {
+        let n = f64::from(self.counts[index]);
+        if n < 2.0 {
+            return Vec3::ZERO;
+        }
+        let (s, q) = (self.sums[index], self.squares[index]);
+        let v = |c: usize| {
+            let mean = s[c] as f64 / SCALE / n;
+            ((q[c] as f64 / SCALE_SQ - n * mean * mean) / (n - 1.0)).max(0.0)
+        };
+        DVec3::new(v(0), v(1), v(2)).as_vec3()
+    }
+
+    /// The image: each pixel's mean.
+    #[must_use]
+    pub fn to_film(&self) -> Film {
+        let mut film = Film::new(self.width, self.height);
+        for (i, p) in film.pixels.iter_mut().enumerate() {
+            *p = self.mean(i);
+        }
+        film
+    }
+
+    /// The statistics as bytes: signature, a metadata string (e.g. the scene and sample range,
+    /// so merges can check that parts belong together), the arrays little-endian, and an
+    /// FNV-1a 64 checksum of all that.
+    #[must_use]
+    pub fn to_bytes(&self, metadata: &str) -> Vec<u8> {
+        let n = self.counts.len();
+        let mut out = Vec::with_capacity(64 + metadata.len() + n * 100);
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&self.width.to_le_bytes());
+        out.extend_from_slice(&self.height.to_le_bytes());
+        out.extend_from_slice(&(metadata.len() as u64).to_le_bytes());
+        out.extend_from_slice(metadata.as_bytes());
+        for s in &self.sums {
+            for c in s {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        for s in &self.squares {
+            for c in s {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        for c in &self.counts {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+        let sum = fnv1a(&out);
+        out.extend_from_slice(&sum.to_le_bytes());
+        out
+    }
+
+    /// Reads what [`PixelSums::to_bytes`] wrote, with its metadata string; `name` is used in
+    /// errors.
+    ///
+    /// # Errors
+    /// [`FilmError::Invalid`] for a wrong signature, a truncated file or a checksum mismatch.
+    pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Self, String), FilmError> {
+        let bad = |reason: &str| FilmError::Invalid {
+            path: name.to_string(),
+            reason: reason.to_string(),
+        };
+        if bytes.len() < MAGIC.len() + 24 || &bytes[..MAGIC.len()] != MAGIC {
+            return Err(bad("no caustic film signature"));
+        }
+        let (body, tail) = bytes.split_at(bytes.len() - 8);
+        let stored = u64::from_le_bytes(tail.try_into().map_err(|_| bad("truncated"))?);
+        if fnv1a(body) != stored {
+            return Err(bad("checksum mismatch (truncated or corrupt)"));
+        }
+        let mut r = Reader {
+            bytes: body,
+            at: MAGIC.len(),
+        };
+        let width = u32::from_le_bytes(r.take::<4>().ok_or_else(|| bad("truncated"))?);
+        let height = u32::from_le_bytes(r.take::<4>().ok_or_else(|| bad("truncated"))?);
+        let meta_len = u64::from_le_bytes(r.take::<8>().ok_or_else(|| bad("truncated"))?);
+        let n = width as usize * height as usize;
+        let expected = (meta_len as usize)
+            .checked_add(n.checked_mul(100).ok_or_else(|| bad("absurd size"))?)
+            .and_then(|x| x.checked_add(r.at))
+            .ok_or_else(|| bad("absurd size"))?;
+        if expected != body.len() {
+            return Err(bad("size does not match its header"));
+        }
+        let meta = std::str::from_utf8(&body[r.at..r.at + meta_len as usize])
+            .map_err(|_| bad("metadata is not UTF-8"))?
+            .to_string();
+        r.at += meta_len as usize;
+        let mut film = Self::new(width, height);
+        for s in &mut film.sums {
+            for c in s.iter_mut() {
+                *c = i128::from_le_bytes(r.take::<16>().ok_or_else(|| bad("truncated"))?);
+            }
+        }
+        for s in &mut film.squares {
+            for c in s.iter_mut() {
+                *c = i128::from_le_bytes(r.take::<16>().ok_or_else(|| bad("truncated"))?);
+            }
+        }
+        for c in &mut film.counts {
+            *c = u32::from_le_bytes(r.take::<4>().ok_or_else(|| bad("truncated"))?);
+        }
+        Ok((film, meta))
+    }
+
+    /// Reads a `.part` film file.
+    ///
+    /// # Errors
+    /// As [`PixelSums::from_bytes`], or [`FilmError::Io`].
+    pub fn read(path: &Path) -> Result<(Self, String), FilmError> {
+        let bytes = std::fs::read(path).map_err(|source| FilmError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_bytes(&bytes, &path.display().to_string())
+    }
+
+    /// Writes the film atomically (temporary file + rename) to `path`.
+    ///
+    /// # Errors
+    /// When the file cannot be written.
+    pub fn write(&self, path: &Path, metadata: &str) -> Result<(), super::output::OutputError> {
+        super::output::write_atomic(path, &self.to_bytes(metadata))
+    }
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take<const N: usize>(&mut self) -> Option<[u8; N]> {
+        let s = self.bytes.get(self.at..self.at + N)?;
+        self.at += N;
+        s.try_into().ok()
+    }
+}
+
+/// FNV-1a, 64 bits: detects truncation and corruption of film files (not an adversary).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= u64::from(*b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn filled(values: &[(usize, Vec3)]) -> PixelSums {
+        let mut f = PixelSums::new(3, 2);
+        for (i, v) in values {
+            f.add(*i, *v);
+        }
+        f
+    }
+
+    #[test]
+    fn merging_is_exact_in_any_order_and_means_are_right() {
+        let samples = [
+            (0, Vec3::new(0.1, 0.2, 0.3)),
+            (0, Vec3::new(1e-7, 3.0, 1234.5)),
+            (0, Vec3::new(0.7, 0.0, 1e-3)),
+            (4, Vec3::new(5.0, 5.0, 5.0)),
+            (4, Vec3::new(0.3333, 0.1, 0.0)),
+        ];
+        let all = filled(&samples);
+        let mut a = filled(&samples[..2]);
+        let b = filled(&samples[2..]);
+        let mut b2 = b.clone();
+        a.merge(&b).unwrap();
+        b2.merge(&filled(&samples[..2])).unwrap();
+        assert_eq!(a, all);
+        assert_eq!(b2, all);
+        let m = all.mean(0);
+        let expected = (0.1 + 1e-7 + 0.7) / 3.0;
+        assert!((f64::from(m.x) - expected).abs() < 1e-7, "{m}");
+        // Sample variance of {5, 0.3333} in x.
+        let v = all.variance(4).x as f64;
+        let mean = (5.0 + 0.3333) / 2.0;
+        let expected = ((5.0f64 - mean).powi(2) + (0.3333f64 - mean).powi(2)) / 1.0;
+        assert!((v - expected).abs() < 1e-5, "{v} vs {expected}");
+        assert_eq!(all.mean(1), Vec3::ZERO);
+        assert_eq!(all.count(0), 3);
+    }
+
+    #[test]
+    fn bytes_round_trip_and_corruption_is_detected() {
+        let f = filled(&[(2, Vec3::new(0.5, 1.5, 2.5)), (5, Vec3::splat(1e6))]);
+        let bytes = f.to_bytes("scene=abc");
+        let (g, meta) = PixelSums::from_bytes(&bytes, "t").unwrap();
+        assert_eq!((g, meta.as_str()), (f.clone(), "scene=abc"));
+        for cut in [0, 10, bytes.len() / 2, bytes.len() - 1] {
+            assert!(
+                PixelSums::from_bytes(&bytes[..cut], "t").is_err(),
+                "cut {cut}"
+            );
+        }
+        let mut flipped = bytes.clone();
+        flipped[40] ^= 1;
+        assert!(PixelSums::from_bytes(&flipped, "t").is_err());
+        let mut other = PixelSums::new(2, 2);
+        assert!(matches!(other.merge(&f), Err(FilmError::Size(2, 2, 3, 2))));
+    }
+}

@@ -1,0 +1,134 @@
+//! The pass driver: renders a [`RenderJob`] in passes of samples per pixel, saving checkpoints
+//! between passes and stopping when a time budget is spent. Every command that renders
+//! (render, and later convergence reports and farm shards) goes through here, so passes,
+//! cancellation, checkpoints and budgets behave the same everywhere. The finished image never
+//! depends on how the samples were split into passes (the film's sums are exact).
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use super::output::write_image;
+use super::{RenderError, RenderJob, RenderOutput};
+
+/// Where and how often the image so far is saved.
+#[derive(Debug, Clone, Copy)]
+pub struct CheckpointPlan<'a> {
+    /// The checkpoint image (.png or .exr), replaced atomically at each save.
+    pub path: &'a Path,
+    /// Least time between saves (zero: after every pass).
+    pub every: Duration,
+    /// Exposure for 8-bit checkpoints.
+    pub exposure: f32,
+}
+
+/// How to split a render into passes.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PassPlan<'a> {
+    /// Save the image so far between passes.
+    pub checkpoint: Option<CheckpointPlan<'a>>,
+    /// Stop starting passes once this much time is spent (the image then has as many samples
+    /// per pixel as the passes that fitted; at least one). `None`: take every sample.
+    pub time_budget: Option<Duration>,
+    /// Show a time-based progress bar on stderr (for budgeted renders).
+    pub progress: bool,
+}
+
+/// The result of a render in passes.
+#[derive(Debug)]
+pub struct PassesOutcome {
+    /// The finished (or budget-stopped) render, or why it stopped.
+    pub result: Result<RenderOutput, RenderError>,
+    /// Samples per pixel of the last checkpoint written, if any.
+    pub checkpoint_spp: Option<u32>,
+}
+
+/// The shortest pass worth scheduling (a pass costs a sweep over the tiles).
+const MIN_PASS: Duration = Duration::from_millis(500);
+
+/// Renders `job` in passes following `plan`. The first pass is one sample per pixel; later
+/// ones are sized from the measured time per sample to end near the next checkpoint or the
+/// end of the budget, never past the job's samples per pixel. A budgeted render stops when the
+/// next sample per pixel would overrun the budget.
+#[must_use]
+pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOutcome {
+    let spp = job.samples_per_pixel();
+    let first = job.samples_done();
+    let start = Instant::now();
+    let bar = budget_bar(plan);
+    let mut saved = None;
+    let mut last_save = Instant::now();
+    let mut render_time = Duration::ZERO;
+    let mut pass = 1;
+    let fail = |e, saved| PassesOutcome {
+        result: Err(e),
+        checkpoint_spp: saved,
+    };
+    while job.samples_done() < spp {
+        let t = Instant::now();
+        if let Err(e) = job.render_pass(pass) {
+            return fail(e, saved);
+        }
+        render_time += t.elapsed();
+        let end = job.samples_done();
+        let done = end - first;
+        if let (Some(b), Some(budget)) = (&bar, plan.time_budget) {
+            b.set_position(start.elapsed().min(budget).as_millis() as u64);
+            b.set_message(format!("{done} spp"));
+        }
+        if end == spp {
+            break;
+        }
+        let per_sample = render_time.as_secs_f64() / f64::from(done);
+        let mut target = Duration::MAX;
+        if let Some(budget) = plan.time_budget {
+            let left = budget.saturating_sub(start.elapsed());
+            if left.as_secs_f64() < per_sample {
+                break;
+            }
+            target = left;
+        }
+        if let Some(cp) = &plan.checkpoint {
+            if last_save.elapsed() >= cp.every {
+                match write_image(&job.snapshot(), cp.path, cp.exposure) {
+                    Ok(()) => saved = Some(done),
+                    Err(e) => eprintln!("warning: checkpoint not saved: {e}"),
+                }
+                last_save = Instant::now();
+            }
+            let to_save = cp.every.saturating_sub(last_save.elapsed()).max(MIN_PASS);
+            target = target.min(to_save);
+        }
+        // `as` saturates, and a huge estimate only asks for everything left.
+        pass = if target == Duration::MAX {
+            spp - end
+        } else {
+            ((target.as_secs_f64() / per_sample) as u32).max(1)
+        };
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    PassesOutcome {
+        result: Ok(job.output()),
+        checkpoint_spp: saved,
+    }
+}
+
+fn budget_bar(plan: &PassPlan<'_>) -> Option<ProgressBar> {
+    let budget = plan.time_budget?;
+    if !plan.progress {
+        return None;
+    }
+    let bar = ProgressBar::with_draw_target(
+        Some(budget.as_millis() as u64),
+        ProgressDrawTarget::stderr(),
+    );
+    if let Ok(style) = ProgressStyle::with_template(
+        "{spinner} rendering [{bar:40}] {elapsed} of the budget, {msg}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    Some(bar)
+}
