@@ -241,7 +241,7 @@ impl<'a> Whitted<'a> {
             let mut sum = Vec3::ZERO;
             for _ in 0..n {
                 let u = rng.next_2d();
-                let Some(ls) = light.sample(sp.p, u) else {
+                let Some(ls) = light.sample_li(sp.p, u) else {
                     continue;
                 };
                 let cos_s = ns.dot(ls.wi);

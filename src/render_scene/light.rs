@@ -1,9 +1,16 @@
-//! Compiled lights and their sampling for direct illumination.
+//! Compiled lights: incident-light sampling for next-event estimation (`sample_li`, `pdf_li`),
+//! emitted radiance when a ray hits an emitter (`le`), and emission sampling for light and photon
+//! paths (`sample_le`, `pdf_le`).
+//!
+//! Sphere lights are sampled by the cone of directions they subtend (uniform in solid angle), not
+//! by their area: the density is constant over the visible cap, so the estimator's only variance
+//! is the cosine and the BSDF (pbrt-v4 §12.2.2 describes the same strategy for spheres).
 
 use glam::Vec3;
-use std::f32::consts::PI;
+use std::f32::consts::{PI, TAU};
 
-use crate::sampling::warp::uniform_cone;
+use crate::geometry::Frame;
+use crate::sampling::warp::{cosine_hemisphere, uniform_sphere};
 
 /// A light source in world space.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,17 +33,45 @@ pub enum Light {
     },
 }
 
-/// One sample of incident light at a point.
+/// One sample of incident light at a point (from [`Light::sample_li`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LightSample {
     /// Unit direction from the shaded point towards the light.
     pub wi: Vec3,
-    /// Distance to the sampled light point along `wi`.
+    /// Distance from the shaded point to `point` along `wi`.
     pub distance: f32,
     /// The sampled point on the light (shadow rays end just before it).
     pub point: Vec3,
-    /// Incident radiance divided by the sample density (already includes 1/r² for points).
+    /// Incident radiance along `wi`; for a point light, `intensity / distance²` (the weight of
+    /// the delta distribution).
+    pub radiance: Vec3,
+    /// Solid-angle density of `wi` (1 for a delta light, whose `delta` is true).
+    pub pdf: f32,
+    /// True when the light is a delta distribution in direction (point lights): BSDF sampling
+    /// can never hit it, so no MIS weight applies.
+    pub delta: bool,
+    /// `radiance / pdf`: what callers multiply by `f · cos θ` (and the shadow-ray visibility).
     pub weight: Vec3,
+}
+
+/// A ray leaving a light, for light and photon paths (from [`Light::sample_le`]).
+///
+/// The flux the ray carries is `le · |cos θ| / (pdf_pos · pdf_dir)` for an area light (θ between
+/// `dir` and `normal`) and `le / (pdf_pos · pdf_dir)` for a point light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EmissionSample {
+    /// Point on the light (exactly on the surface: offset it along `normal` before tracing).
+    pub origin: Vec3,
+    /// Outward unit surface normal at `origin`; zero for point lights.
+    pub normal: Vec3,
+    /// Unit direction of the emitted ray.
+    pub dir: Vec3,
+    /// Radiance (sphere light, W/(m²·sr)) or intensity (point light, W/sr) along `dir`.
+    pub le: Vec3,
+    /// Area density of `origin` (1/m²); 1 for point lights (a delta in position).
+    pub pdf_pos: f32,
+    /// Solid-angle density of `dir` (1/sr).
+    pub pdf_dir: f32,
 }
 
 impl Light {
@@ -59,9 +94,22 @@ impl Light {
         }
     }
 
-    /// Samples incident light at `p`; `None` if `p` is inside the emitter or the light is black.
+    /// True for lights that are delta distributions in direction from any point (point lights).
+    #[inline]
     #[must_use]
-    pub fn sample(&self, p: Vec3, u: (f32, f32)) -> Option<LightSample> {
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Light::Point { .. })
+    }
+
+    /// Samples a direction towards the light from `p` with `u ∈ [0, 1)²`.
+    ///
+    /// Sphere lights: uniform over the cone of directions the sphere subtends at `p`; the sample
+    /// point is where the ray `p + t·wi` first meets the sphere. Point lights: the one direction.
+    /// `None` when `p` is inside (or on) the emitter, the light is black, or the cone is too
+    /// small for `f32` (a sphere so far away that its density overflows; its contribution then
+    /// rounds to zero anyway). Never returns NaN or infinite fields.
+    #[must_use]
+    pub fn sample_li(&self, p: Vec3, u: (f32, f32)) -> Option<LightSample> {
         match *self {
             Light::Point {
                 position,
@@ -69,15 +117,19 @@ impl Light {
             } => {
                 let d = position - p;
                 let dist2 = d.length_squared();
-                if !(dist2 > 0.0) || intensity == Vec3::ZERO {
+                if !(dist2 > 0.0 && dist2.is_finite()) || intensity == Vec3::ZERO {
                     return None;
                 }
                 let dist = dist2.sqrt();
+                let radiance = intensity / dist2;
                 Some(LightSample {
                     wi: d / dist,
                     distance: dist,
                     point: position,
-                    weight: intensity / dist2,
+                    radiance,
+                    pdf: 1.0,
+                    delta: true,
+                    weight: radiance,
                 })
             }
             Light::Sphere {
@@ -88,31 +140,162 @@ impl Light {
                 let d = center - p;
                 let dist2 = d.length_squared();
                 let r2 = radius * radius;
-                if dist2 <= r2 || radiance == Vec3::ZERO {
+                if !(dist2 > r2 && dist2.is_finite()) || radiance == Vec3::ZERO {
                     return None;
                 }
                 let dist = dist2.sqrt();
                 let axis = d / dist;
-                // Uniform over the cone subtended by the sphere: pdf = 1 / (2π(1 − cos θmax)).
-                let sin2_max = r2 / dist2;
-                let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-                let one_minus_cos = if sin2_max < 1e-4 {
-                    0.5 * sin2_max
+                let one_minus_cos_max = cone_one_minus_cos(r2, dist2);
+                let pdf = 1.0 / (TAU * one_minus_cos_max);
+                if !pdf.is_finite() {
+                    return None;
+                }
+                // Uniform in solid angle: 1 − cos θ uniform in [0, 1 − cos θmax]. Sampling
+                // 1 − cos θ (not cos θ) keeps tiny cones from collapsing onto the axis.
+                let one_minus_cos = (u.0 * one_minus_cos_max).min(one_minus_cos_max);
+                let cos_t = 1.0 - one_minus_cos;
+                let sin2_t = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0);
+                let sin_t = sin2_t.sqrt();
+                let phi = TAU * u.1;
+                let wi = Frame::from_normal(axis)
+                    .to_world(Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t))
+                    .normalize();
+                // Near intersection t = D cos θ − √(r² − D² sin² θ), written without the
+                // cancellation: t = (D² − r²) / (D cos θ + √(r² − D² sin² θ)).
+                let root = (r2 - dist2 * sin2_t).max(0.0).sqrt();
+                let denom = dist * cos_t + root;
+                let t = if denom > 0.0 {
+                    ((dist2 - r2) / denom).max(0.0)
                 } else {
-                    1.0 - cos_max
+                    0.0
                 };
-                let wi = uniform_cone(u, axis, cos_max);
-                // Distance to the near side of the sphere along wi.
-                let b = wi.dot(d);
-                let disc = (r2 - (d - wi * b).length_squared()).max(0.0);
-                let t = (b - disc.sqrt()).max(0.0);
+                let weight = radiance * (TAU * one_minus_cos_max);
+                if !(weight.is_finite() && t.is_finite()) {
+                    return None;
+                }
                 Some(LightSample {
                     wi,
                     distance: t,
                     point: p + wi * t,
-                    weight: radiance * (2.0 * PI * one_minus_cos),
+                    radiance,
+                    pdf,
+                    delta: false,
+                    weight,
                 })
             }
+        }
+    }
+
+    /// Solid-angle density with which [`Light::sample_li`] at `p` returns the unit direction
+    /// `wi`: 0 for point lights (a delta), 0 outside the cone a sphere subtends or when `p` is
+    /// inside it. Used for the MIS weight when a BSDF-sampled ray hits a sphere light.
+    #[must_use]
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3) -> f32 {
+        match *self {
+            Light::Point { .. } => 0.0,
+            Light::Sphere { center, radius, .. } => {
+                let d = center - p;
+                let dist2 = d.length_squared();
+                let r2 = radius * radius;
+                if !(dist2 > r2 && dist2.is_finite()) || wi.dot(d) <= 0.0 {
+                    return 0.0;
+                }
+                // Inside the cone ⇔ the line along wi passes within r of the centre. A little
+                // slack keeps directions sampled exactly on the rim (and rays that graze the
+                // sphere) inside despite rounding.
+                let perp2 = wi.cross(d).length_squared();
+                if perp2 > r2 * (1.0 + 1e-4) + dist2 * 1e-12 {
+                    return 0.0;
+                }
+                let pdf = 1.0 / (TAU * cone_one_minus_cos(r2, dist2));
+                if pdf.is_finite() { pdf } else { 0.0 }
+            }
+        }
+    }
+
+    /// Radiance the light emits from a surface point with outward unit normal `n` in direction
+    /// `w` (unit, pointing away from the light): the sphere's radiance on its outer side, zero
+    /// otherwise and for point lights (which rays cannot hit).
+    #[inline]
+    #[must_use]
+    pub fn le(&self, n: Vec3, w: Vec3) -> Vec3 {
+        match *self {
+            Light::Point { .. } => Vec3::ZERO,
+            Light::Sphere { radiance, .. } => {
+                if n.dot(w) > 0.0 {
+                    radiance
+                } else {
+                    Vec3::ZERO
+                }
+            }
+        }
+    }
+
+    /// Samples a ray leaving the light, for light and photon paths, from two independent pairs
+    /// of uniforms in `[0, 1)²`.
+    ///
+    /// Sphere: a uniform point on the surface (`pdf_pos = 1/(4πr²)`) and a cosine-weighted
+    /// direction about its normal (`pdf_dir = cos θ / π`), so every sample carries exactly the
+    /// same flux `le · cos θ / (pdf_pos · pdf_dir) = Φ`. Point: uniform directions over the
+    /// sphere (`pdf_dir = 1/(4π)`), flux `le / pdf_dir = Φ`. `None` for black lights and for
+    /// the measure-zero grazing directions where `pdf_dir` would be 0.
+    #[must_use]
+    pub fn sample_le(&self, u_pos: (f32, f32), u_dir: (f32, f32)) -> Option<EmissionSample> {
+        match *self {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                if intensity == Vec3::ZERO {
+                    return None;
+                }
+                Some(EmissionSample {
+                    origin: position,
+                    normal: Vec3::ZERO,
+                    dir: point_emission_direction(u_dir),
+                    le: intensity,
+                    pdf_pos: 1.0,
+                    pdf_dir: 1.0 / (4.0 * PI),
+                })
+            }
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                if radiance == Vec3::ZERO || !radiance.is_finite() {
+                    return None;
+                }
+                let normal = uniform_sphere(u_pos);
+                let dir = cosine_hemisphere(u_dir, normal);
+                let cos_t = dir.dot(normal);
+                let pdf_pos = 1.0 / (4.0 * PI * radius * radius);
+                if !(cos_t > 0.0 && pdf_pos.is_finite()) {
+                    return None;
+                }
+                Some(EmissionSample {
+                    origin: center + normal * radius,
+                    normal,
+                    dir,
+                    le: radiance,
+                    pdf_pos,
+                    pdf_dir: cos_t / PI,
+                })
+            }
+        }
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` with which [`Light::sample_le`] produces a ray leaving
+    /// a point with outward normal `normal` in direction `dir` (both unit; `normal` is ignored
+    /// for point lights). `pdf_dir` is 0 for directions below the surface.
+    #[must_use]
+    pub fn pdf_le(&self, normal: Vec3, dir: Vec3) -> (f32, f32) {
+        match *self {
+            Light::Point { .. } => (1.0, 1.0 / (4.0 * PI)),
+            Light::Sphere { radius, .. } => (
+                1.0 / (4.0 * PI * radius * radius),
+                normal.dot(dir).max(0.0) / PI,
+            ),
         }
     }
 
@@ -128,36 +311,23 @@ impl Light {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sampling::Rng;
-
-    #[test]
-    fn point_light_follows_inverse_square() {
-        let l = Light::point(Vec3::new(0.0, 2.0, 0.0), Vec3::splat(4.0 * PI));
-        let s = l.sample(Vec3::ZERO, (0.5, 0.5)).unwrap();
-        assert!((s.weight.x - 0.25).abs() < 1e-6);
-        assert!(s.wi.distance(Vec3::Y) < 1e-6);
-        assert!((s.distance - 2.0).abs() < 1e-6);
-    }
-
-    #[test]
-    fn sphere_light_irradiance_matches_a_point_light_far_away() {
-        // E at distance D from a sphere of power Φ equals Φ/(4πD²) for D ≫ r (exactly, for a
-        // Lambertian sphere facing the normal) — check by Monte Carlo.
-        let power = Vec3::splat(100.0);
-        let l = Light::sphere(Vec3::new(0.0, 10.0, 0.0), 0.5, power);
-        let mut r = Rng::new(0, 0);
-        let n = 200_000;
-        let mut e = 0.0f64;
-        for _ in 0..n {
-            let s = l.sample(Vec3::ZERO, r.next_2d()).unwrap();
-            e += f64::from(s.weight.x * s.wi.y.max(0.0));
-        }
-        let e = e / f64::from(n);
-        let expected = 100.0 / (4.0 * std::f64::consts::PI * 100.0);
-        assert!((e / expected - 1.0).abs() < 0.005, "{e} vs {expected}");
-        assert!((l.power() - power).abs().max_element() < 1e-3);
-    }
+/// The direction a point light emits its photon/light path with `u ∈ [0, 1)²`: uniform over the
+/// sphere today. This is the one place to change for stratified point emission (a spherical
+/// Fibonacci lattice keyed by the photon index), which must keep density `1/(4π)`.
+#[inline]
+fn point_emission_direction(u: (f32, f32)) -> Vec3 {
+    uniform_sphere(u)
 }
+
+/// `1 − cos θmax` of the cone a sphere of squared radius `r2` subtends from squared distance
+/// `dist2 > r2`, as `sin²θmax / (1 + cos θmax)`: exact for tiny cones where `1 − cos θmax` would
+/// round to 0.
+#[inline]
+fn cone_one_minus_cos(r2: f32, dist2: f32) -> f32 {
+    let sin2_max = (r2 / dist2).min(1.0);
+    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+    sin2_max / (1.0 + cos_max)
+}
+
+#[cfg(test)]
+mod tests;

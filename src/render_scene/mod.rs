@@ -3,13 +3,15 @@
 pub mod camera;
 pub mod geometry;
 pub mod light;
+pub mod light_sampler;
 pub mod material;
 pub mod surface;
 pub mod texture;
 
 pub use camera::Camera;
 pub use geometry::{Geometry, Hit, PrimRef};
-pub use light::Light;
+pub use light::{EmissionSample, Light, LightSample};
+pub use light_sampler::LightSampler;
 pub use material::{ShadingPoint, SurfaceMaterial};
 pub use surface::SurfacePoint;
 pub use texture::Texture;

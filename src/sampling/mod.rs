@@ -1,5 +1,6 @@
 //! Deterministic random streams and the warps that turn uniform numbers into directions.
 
+pub mod alias;
 pub mod rng;
 pub mod warp;
 

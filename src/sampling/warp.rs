@@ -16,6 +16,32 @@ pub fn uniform_cone(u: (f32, f32), axis: Vec3, cos_max: f32) -> Vec3 {
     Frame::from_normal(axis).to_world(Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t))
 }
 
+/// A direction uniformly distributed in the cone around the unit `axis` whose half-angle θmax has
+/// `1 − cos θmax = one_minus_cos_max` (in `[0, 2]`); its density is `1 / (2π · one_minus_cos_max)`.
+///
+/// Unlike [`uniform_cone`] it keeps full precision for tiny cones (a far or small sphere light):
+/// it samples `1 − cos θ` directly and derives `sin θ` from it, so directions still spread over
+/// the cone when `cos θmax` rounds to 1 in `f32`.
+#[inline]
+#[must_use]
+pub fn uniform_cone_narrow(u: (f32, f32), axis: Vec3, one_minus_cos_max: f32) -> Vec3 {
+    let one_minus_cos = (u.0 * one_minus_cos_max).clamp(0.0, 2.0);
+    let cos_t = 1.0 - one_minus_cos;
+    let sin_t = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+    let phi = TAU * u.1;
+    Frame::from_normal(axis).to_world(Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t))
+}
+
+/// A direction uniformly distributed over the unit sphere; density `1 / (4π)`.
+#[inline]
+#[must_use]
+pub fn uniform_sphere(u: (f32, f32)) -> Vec3 {
+    let z = 1.0 - 2.0 * u.0;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = TAU * u.1;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
 /// Cosine-weighted direction in the hemisphere around the unit `n`; density `cos θ / π`.
 #[inline]
 #[must_use]
