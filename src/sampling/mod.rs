@@ -2,6 +2,9 @@
 
 pub mod alias;
 pub mod rng;
+pub mod sampler;
+pub mod sobol;
 pub mod warp;
 
 pub use rng::Rng;
+pub use sampler::{Sampler, SamplerKind};
