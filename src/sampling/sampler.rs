@@ -1,46 +1,181 @@
-//! TEMPORARY stand-in (lead's local build only; replaced by the sampling branch).
+//! The numbers integrators draw: one `Sampler` per worker, restarted for every camera sample (or
+//! light/photon path), whose values depend only on (seed, pixel or stream, sample index,
+//! dimension) — never on the thread or on what other pixels drew — so images are the same bytes
+//! for any thread count.
 
-use super::Rng;
+use super::rng::{Rng, mix64};
+use super::sobol::{shuffled_scrambled_2d, to_unit_f32};
 
-/// Which sequence a Sampler draws from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which sequence a [`Sampler`] draws from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SamplerKind {
-    /// Independent.
+    /// Independent uniform numbers: the PCG32 streams of [`Rng::for_pixel_sample`] (the same
+    /// numbers, in the same order, as the renderer drew before samplers existed).
     Independent,
-    /// Sobol.
+    /// Owen-scrambled Sobol points with Burley's (2020) hash-based shuffling and padding: each
+    /// 1-D or 2-D draw is stratified over a pixel's samples (a (0, 2)-net for 2ᵏ samples).
     Sobol,
 }
 
-/// Sampler.
+impl SamplerKind {
+    /// The names accepted by [`SamplerKind::from_name`], for messages listing valid values.
+    pub const NAMES: [&'static str; 2] = ["independent", "sobol"];
+
+    /// Parses a sampler name (case-insensitive); `None` for anything else.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name.to_ascii_lowercase().as_str() {
+            "independent" => Some(Self::Independent),
+            "sobol" => Some(Self::Sobol),
+            _ => None,
+        }
+    }
+
+    /// The lower-case name of this kind.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Independent => "independent",
+            Self::Sobol => "sobol",
+        }
+    }
+}
+
+/// Dimension at which integrator draws start after `start_pixel_sample`: 0 and 1 are the pixel
+/// position (`pixel_2d`).
+const FIRST_INTEGRATOR_DIMENSION: u32 = 2;
+
+/// Numbers for one camera sample (or one photon/light path), keyed by (seed, pixel or stream,
+/// sample index, dimension) — never by thread. No heap allocation; cheap to clone.
+///
+/// Call [`Sampler::start_pixel_sample`] (or [`Sampler::start_stream`]) before each sample, then
+/// draw with [`Sampler::pixel_2d`], [`Sampler::next_1d`] and [`Sampler::next_2d`]. Each draw
+/// uses the next dimension(s) of the sample, so an integrator that draws in a fixed order per
+/// bounce gets the same dimension for the same decision in every sample (which is what lets the
+/// Sobol sampler stratify it).
 #[derive(Debug, Clone)]
 pub struct Sampler {
+    kind: SamplerKind,
     seed: u64,
+    samples_per_pixel: u32,
+    /// Hash of (seed, pixel or stream): keys every scramble of this sample's dimensions.
+    key: u64,
+    /// Index of the sample within its pixel or stream (the Sobol point index).
+    index: u32,
+    /// Next dimension to draw.
+    dimension: u32,
+    /// Independent kind: the sample's stream.
     rng: Rng,
+    /// Independent kind: the pixel position, drawn first from the stream.
+    pixel: (f32, f32),
 }
 
 impl Sampler {
-    /// New.
+    /// A sampler of `kind` for renders of `samples_per_pixel` samples seeded with `seed`.
+    /// `samples_per_pixel` is advisory (Sobol works for any count, best at powers of 2).
     #[must_use]
-    pub fn new(_kind: SamplerKind, seed: u64, _spp: u32) -> Self {
+    pub fn new(kind: SamplerKind, seed: u64, samples_per_pixel: u32) -> Self {
         Self {
+            kind,
             seed,
+            samples_per_pixel,
+            key: 0,
+            index: 0,
+            dimension: 0,
             rng: Rng::new(seed, 0),
+            pixel: (0.5, 0.5),
         }
     }
-    /// Start.
+
+    /// The kind of sequence this sampler draws.
+    #[must_use]
+    pub fn kind(&self) -> SamplerKind {
+        self.kind
+    }
+
+    /// The samples per pixel it was created for.
+    #[must_use]
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.samples_per_pixel
+    }
+
+    /// Starts sample `index` of pixel `(x, y)`; [`Sampler::pixel_2d`] gives its position in the
+    /// pixel, and integrator draws start at dimension 2.
     pub fn start_pixel_sample(&mut self, x: u32, y: u32, index: u32) {
-        self.rng = Rng::for_pixel_sample(self.seed, x, y, index);
+        let pixel = (u64::from(y) << 32) | u64::from(x);
+        self.key = mix64(pixel ^ mix64(self.seed));
+        self.index = index;
+        self.dimension = FIRST_INTEGRATOR_DIMENSION;
+        if self.kind == SamplerKind::Independent {
+            self.rng = Rng::for_pixel_sample(self.seed, x, y, index);
+            self.pixel = self.rng.next_2d();
+        }
     }
-    /// 1d.
+
+    /// Starts path `index` of the independent stream family `stream` (e.g. photon paths: one
+    /// stream per light, or one per photon batch); draws start at dimension 0. Streams and
+    /// pixels never share keys.
+    pub fn start_stream(&mut self, stream: u64, index: u64) {
+        // Sobol indices are 32-bit: higher index bits select another scramble instead.
+        self.key = mix64(
+            mix64(stream ^ 0x6A09_E667_F3BC_C909)
+                ^ mix64(self.seed.wrapping_add(0xBB67_AE85_84CA_A73B))
+                ^ (index >> 32).wrapping_mul(0x3C6E_F372_FE94_F82B),
+        );
+        self.index = index as u32;
+        self.dimension = 0;
+        if self.kind == SamplerKind::Independent {
+            self.rng = Rng::new(self.seed ^ self.key, index);
+            self.pixel = (0.5, 0.5);
+        }
+    }
+
+    /// The next number, in `[0, 1)`.
+    #[inline]
     pub fn next_1d(&mut self) -> f32 {
-        self.rng.next_f32()
+        match self.kind {
+            SamplerKind::Independent => self.rng.next_f32(),
+            SamplerKind::Sobol => {
+                let d = self.dimension;
+                self.dimension += 1;
+                self.sobol(d).0
+            }
+        }
     }
-    /// 2d.
+
+    /// The next two numbers, in `[0, 1)²`.
+    #[inline]
     pub fn next_2d(&mut self) -> (f32, f32) {
-        self.rng.next_2d()
+        match self.kind {
+            SamplerKind::Independent => self.rng.next_2d(),
+            SamplerKind::Sobol => {
+                let d = self.dimension;
+                self.dimension += 2;
+                self.sobol(d)
+            }
+        }
     }
-    /// Pixel.
+
+    /// The 2-D position inside the pixel for the camera ray (the sample's first two dimensions,
+    /// whenever it is called).
+    #[inline]
     pub fn pixel_2d(&mut self) -> (f32, f32) {
-        self.rng.next_2d()
+        match self.kind {
+            SamplerKind::Independent => self.pixel,
+            SamplerKind::Sobol => self.sobol(0),
+        }
+    }
+
+    /// The 2-D Sobol point of this sample for the draw that starts at `dimension`: its own index
+    /// shuffle and scrambles, keyed by (seed, pixel or stream, dimension) ("padding").
+    #[inline]
+    fn sobol(&self, dimension: u32) -> (f32, f32) {
+        let h = mix64(self.key ^ mix64(u64::from(dimension) ^ 0x9E37_79B9_7F4A_7C15));
+        let h2 = mix64(h);
+        let (x, y) = shuffled_scrambled_2d(self.index, [h as u32, (h >> 32) as u32, h2 as u32]);
+        (to_unit_f32(x), to_unit_f32(y))
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -15,3 +15,5 @@ mod queries;
 mod render_snapshots;
 mod textures;
 mod watertight;
+mod passes;
+mod path_tracer;

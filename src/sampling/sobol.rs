@@ -1,0 +1,132 @@
+//! The first two dimensions of the Sobol sequence and hash-based Owen scrambling
+//! (B. Burley, "Practical Hash-based Owen Scrambling", JCGT 9(4), 2020).
+//!
+//! Points are 32-bit fixed-point fractions (`x / 2³²`). Dimensions 0 and 1 of Sobol's sequence
+//! form a (0, 2)-sequence in base 2: every aligned block of 2ᵏ consecutive points is a
+//! (0, k, 2)-net, with exactly one point in each elementary box of area 2⁻ᵏ. Owen scrambling and
+//! Burley's nested shuffle of the index both keep that property while randomising the points.
+
+/// Generator matrix of Sobol dimension 1, as 32 column vectors (column j is the contribution of
+/// index bit j, most significant output bit first).
+///
+/// Its primitive polynomial is x + 1 (degree 1, no inner coefficients) with initial direction
+/// number m₁ = 1 (Joe & Kuo's first entry), so the recurrence mᵢ = 2mᵢ₋₁ ⊕ mᵢ₋₁ gives
+/// m = 1, 3, 5, 15, 17, 51, … (Pascal's triangle mod 2), and column i−1 is mᵢ · 2^(32−i).
+const SOBOL_DIM1: [u32; 32] = dim1_matrix();
+
+const fn dim1_matrix() -> [u32; 32] {
+    let mut columns = [0u32; 32];
+    let mut m: u32 = 1;
+    let mut i = 1;
+    while i <= 32 {
+        columns[i - 1] = m << (32 - i);
+        m ^= m << 1;
+        i += 1;
+    }
+    columns
+}
+
+/// Sobol dimension 0 of point `index`: the van der Corput radical inverse (bit reversal).
+#[inline]
+#[must_use]
+pub fn sobol_dim0(index: u32) -> u32 {
+    index.reverse_bits()
+}
+
+/// Sobol dimension 1 of point `index`: the XOR of the generator columns of its set bits.
+#[inline]
+#[must_use]
+pub fn sobol_dim1(index: u32) -> u32 {
+    let mut x = 0;
+    let mut bits = index;
+    let mut j = 0;
+    while bits != 0 {
+        if bits & 1 != 0 {
+            x ^= SOBOL_DIM1[j];
+        }
+        bits >>= 1;
+        j += 1;
+    }
+    x
+}
+
+/// Laine & Karras's hash as tuned by Burley (2020, listing 2): a bijection on 32-bit words in
+/// which output bit k depends only on input bits 0..=k (adding a seed and XOR-ing with a
+/// multiple by an even constant both have that property), so on bit-reversed values it is a
+/// nested (Owen) permutation.
+#[inline]
+#[must_use]
+fn laine_karras_permutation(mut x: u32, seed: u32) -> u32 {
+    x = x.wrapping_add(seed);
+    x ^= x.wrapping_mul(0x6c50_b47c);
+    x ^= x.wrapping_mul(0xb82f_1e52);
+    x ^= x.wrapping_mul(0xc7af_e638);
+    x ^= x.wrapping_mul(0x8d22_f6e6);
+    x
+}
+
+/// Owen scrambling of the fixed-point fraction `x` keyed by `seed`: each output bit is the input
+/// bit flipped by a hash of all more significant input bits (a nested uniform scramble).
+#[inline]
+#[must_use]
+pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
+    laine_karras_permutation(x.reverse_bits(), seed).reverse_bits()
+}
+
+/// The fixed-point fraction `x / 2³²` as an `f32` in `[0, 1)` (top 24 bits, exact).
+#[inline]
+#[must_use]
+pub fn to_unit_f32(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+/// Point `index` of a shuffled, Owen-scrambled 2-D Sobol sequence: Burley's construction. The
+/// index itself is nested-uniform scrambled with `seeds[0]` (a random aligned block of the
+/// sequence, in a random order that keeps prefixes of length 2ᵏ as nets), then dimensions 0 and
+/// 1 are Owen-scrambled with `seeds[1]` and `seeds[2]`.
+#[inline]
+#[must_use]
+pub fn shuffled_scrambled_2d(index: u32, seeds: [u32; 3]) -> (u32, u32) {
+    let i = nested_uniform_scramble(index, seeds[0]);
+    (
+        nested_uniform_scramble(sobol_dim0(i), seeds[1]),
+        nested_uniform_scramble(sobol_dim1(i), seeds[2]),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn direction_numbers_are_joe_kuo_dimension_two() {
+        // Joe & Kuo's (and Sobol's) second dimension starts m = 1, 3, 5, 15, 17, 51, 85, 255.
+        let m: Vec<u32> = (1..=8).map(|i| SOBOL_DIM1[i - 1] >> (32 - i)).collect();
+        assert_eq!(m, [1, 3, 5, 15, 17, 51, 85, 255]);
+        // The first points, by hand: index 1 → (½, ½), 2 → (¼, ¾), 3 → (¾, ¼).
+        let f = |i| (to_unit_f32(sobol_dim0(i)), to_unit_f32(sobol_dim1(i)));
+        assert_eq!(f(0), (0.0, 0.0));
+        assert_eq!(f(1), (0.5, 0.5));
+        assert_eq!(f(2), (0.25, 0.75));
+        assert_eq!(f(3), (0.75, 0.25));
+    }
+
+    #[test]
+    fn owen_scrambling_is_nested() {
+        // Points that share their top k bits still share them after scrambling (and the map is
+        // a bijection on those k-bit prefixes): this is what keeps nets nets.
+        for seed in [0u32, 1, 0xdead_beef, 77_777] {
+            for k in [1u32, 3, 8] {
+                let mut seen = vec![false; 1 << k];
+                for prefix in 0..(1u32 << k) {
+                    let a = nested_uniform_scramble(prefix << (32 - k), seed) >> (32 - k);
+                    let b = nested_uniform_scramble((prefix << (32 - k)) | 0x1234 >> k, seed)
+                        >> (32 - k);
+                    assert_eq!(a, b);
+                    assert!(!seen[a as usize]);
+                    seen[a as usize] = true;
+                }
+            }
+        }
+    }
+}
