@@ -22,7 +22,11 @@ fn a_time_budget_renders_passes_until_it_is_spent() {
     ]);
     let took = started.elapsed().as_secs_f64();
     let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     assert!(out.exists());
     // "t.png: 24×24, N spp, …": a 24×24 Cornell box takes far more than 16 spp in 1.5 s.
     let spp: u64 = stdout
@@ -51,7 +55,11 @@ fn part_films_from_disjoint_runs_hold_their_samples() {
         "-o",
         part.to_str().expect("utf-8 path"),
     ]);
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     let (sums, meta) = caustic::render::PixelSums::read(&part).expect("reads back");
     assert_eq!((sums.width, sums.height, sums.count(0)), (16, 12, 3));
     assert!(meta.contains("spp=3"), "{meta}");

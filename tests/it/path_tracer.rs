@@ -39,7 +39,9 @@ const DIRECT_AND_MIRRORS: &str = r#"Scene(
 fn path_equals_whitted_for_direct_light_and_mirror_chains() {
     let render_with = |integrator: &str| {
         let scene = common::scene_from_text(&DIRECT_AND_MIRRORS.replace("INTEGRATOR", integrator));
-        render(&scene, &RenderOptions::default()).expect("renders").film
+        render(&scene, &RenderOptions::default())
+            .expect("renders")
+            .film
     };
     let (w, p) = (render_with("Whitted"), render_with("Path"));
     let mut worst = 0.0f32;
@@ -105,7 +107,11 @@ fn path_renders_every_scene_without_nan_or_black() {
         let o = with(common::small(32, 24, 2), &["render.integrator=Path"]);
         let (film, stats) = common::render_file(&path, &o, &RenderOptions::default());
         assert_eq!(stats.nan_samples, 0, "{}", path.display());
-        assert!(film.mean().max_element() > 0.01, "{}: black", path.display());
+        assert!(
+            film.mean().max_element() > 0.01,
+            "{}: black",
+            path.display()
+        );
     }
 }
 
@@ -172,7 +178,11 @@ fn both_samplers_are_deterministic_across_threads_regions_and_sample_ranges() {
         merged.merge(&second).expect("same size");
         let mut other_order = second.clone();
         other_order.merge(&first).expect("same size");
-        assert_eq!(merged.to_film().to_bytes(), one.to_bytes(), "{sampler}: merge");
+        assert_eq!(
+            merged.to_film().to_bytes(),
+            one.to_bytes(),
+            "{sampler}: merge"
+        );
         assert_eq!(merged, other_order);
         // And through a .part file.
         let bytes = merged.to_bytes("test");
@@ -228,19 +238,28 @@ fn path_converges_to_the_committed_reference() {
             );
         }
     }
-    // relMSE falls as 1/N: ×4 samples ⇒ ~÷4 (independent sampler: the Monte Carlo rate).
+    // relMSE falls as 1/N (independent sampler: the Monte Carlo rate). Path-traced glass
+    // makes rare bright samples, so one render's relMSE scatters; the mean over 6 seeds is
+    // stable enough to check ×16 samples ⇒ ÷16 error within a factor of 2.
     let rel_mse = |spp: u32| {
-        let o = cornell_path(32, 32, spp, "Independent");
-        let (f, _) = common::render_file(&file, &o, &RenderOptions::default());
-        caustic::render::metrics::compare(&f, &reference)
-            .expect("same size")
-            .rel_mse
+        let mut total = 0.0;
+        for seed in 1..=6 {
+            let mut o = cornell_path(32, 32, spp, "Independent");
+            o.seed = Some(seed);
+            let (f, _) = common::render_file(&file, &o, &RenderOptions::default());
+            total += caustic::render::metrics::compare(&f, &reference)
+                .expect("same size")
+                .rel_mse;
+        }
+        total / 6.0
     };
     let e: Vec<f64> = [4, 16, 64].iter().map(|&n| rel_mse(n)).collect();
-    for w in e.windows(2) {
-        let ratio = w[0] / w[1];
-        assert!((2.5..6.5).contains(&ratio), "relMSE {e:?}: ratio {ratio}");
-    }
+    let ratio = e[0] / e[2];
+    assert!(
+        (8.0..32.0).contains(&ratio),
+        "relMSE {e:?}: 4 → 64 spp ratio {ratio}"
+    );
+    assert!(e[0] > e[1] && e[1] > e[2], "relMSE {e:?}");
 }
 
 #[test]
@@ -258,6 +277,15 @@ fn unknown_integrator_and_sampler_names_are_clear_errors() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("Whitted") && err.contains("Path"), "{err}");
-    let out = common::caustic(&["check", "scenes/cornell.ron", "--set", "render.integrator=Path"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = common::caustic(&[
+        "check",
+        "scenes/cornell.ron",
+        "--set",
+        "render.integrator=Path",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
