@@ -263,3 +263,35 @@ fn a_broken_snippet_fails() {
         assert!(caught.is_err(), "accepted a broken snippet:\n{bad}");
     }
 }
+
+/// The commands in README.md's "The two commands" section: the ```sh blocks, one line each.
+fn readme_commands() -> Vec<String> {
+    let text = std::fs::read_to_string(common::root().join("README.md")).expect("README.md");
+    let section = text
+        .split("\n## ")
+        .find(|s| s.starts_with("The two commands"))
+        .expect("README.md has a \"The two commands\" section");
+    section
+        .split("```sh\n")
+        .skip(1)
+        .filter_map(|block| block.split("```").next())
+        .flat_map(str::lines)
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .map(str::to_string)
+        .collect()
+}
+
+/// CI runs the README's test command (with `--locked`), so the figures beside it are CI's too.
+#[test]
+fn ci_runs_the_readme_test_command() {
+    let commands = readme_commands();
+    assert_eq!(commands.len(), 2, "{commands:?}");
+    assert!(commands[0].starts_with("cargo run --release -- render "), "{commands:?}");
+    let ci = std::fs::read_to_string(common::root().join(".ci/run")).expect(".ci/run");
+    let want = format!("{} --locked", commands[1]);
+    assert!(
+        ci.lines().any(|l| l.trim() == want),
+        ".ci/run does not run the README's test command as `{want}`"
+    );
+}
