@@ -58,7 +58,8 @@ for cmd in "${cmds[@]}"; do
   cpu=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.0f", u + s }')
   printf '   wall %4.0f s (%s), CPU user+sys %5s s\n' "$wall" \
     "$(awk -v w="$wall" 'BEGIN { printf "%d min %02d s", w / 60, w % 60 }')" "$cpu"
-  grep -E '^test result:' "$log" | awk '{p += $4; f += $6; i += $8} END { if (NR) printf "   tests: %d passed, %d failed, %d ignored\n", p, f, i }'
+  awk '/^test result:/ {p += $4; f += $6; i += $8; n++}
+       END { if (n) printf "   tests: %d passed, %d failed, %d ignored\n", p, f, i }' "$log"
   total_wall=$(awk -v a="$total_wall" -v b="$wall" 'BEGIN { print a + b }')
   total_cpu=$(awk -v a="$total_cpu" -v b="$cpu" 'BEGIN { print a + b }')
 done

@@ -287,7 +287,10 @@ fn readme_commands() -> Vec<String> {
 fn ci_runs_the_readme_test_command() {
     let commands = readme_commands();
     assert_eq!(commands.len(), 2, "{commands:?}");
-    assert!(commands[0].starts_with("cargo run --release -- render "), "{commands:?}");
+    assert!(
+        commands[0].starts_with("cargo run --release -- render "),
+        "{commands:?}"
+    );
     let ci = std::fs::read_to_string(common::root().join(".ci/run")).expect(".ci/run");
     let want = format!("{} --locked", commands[1]);
     assert!(
