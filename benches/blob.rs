@@ -1,4 +1,4 @@
-//! Ray-casting benchmark on the "bumpy blob" workload of shared/bench/blob-workload.md, timed
+//! Ray-casting benchmark on the "bumpy blob" workload (docs/performance.md, "The blob workload"), timed
 //! as that text prescribes (chunks of 4096 rays from an atomic counter, medians of 5), so the
 //! figures compare with Embree 3.13's `rtcIntersect1` / `rtcOccluded1` on the same machine kind.
 //!

@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 runs=${1:-7}
 shift $(( $# > 0 ? 1 : 0 ))
 if [ $# -eq 0 ]; then set -- --spp 16; fi
-cargo build --release --quiet
+source scripts/caustic_bin.sh
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
@@ -38,7 +38,7 @@ for i in $(seq "$runs"); do
     IFS='|' read -r name scene sets <<<"${variants[$k]}"
     args=()
     for s in $sets; do args+=(--set "$s"); done
-    ./target/release/caustic render "$scene" -o "$out/img.png" --quiet "${args[@]}" "$@" 2>&1 \
+    "$caustic" render "$scene" -o "$out/img.png" --quiet "${args[@]}" "$@" 2>&1 \
       | grep -o 'in [0-9.]* s' | awk -v k="$k" '{print k, $2}' >>"$out/times"
   done
 done

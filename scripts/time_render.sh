@@ -6,11 +6,11 @@ cd "$(dirname "$0")/.."
 scene=${1:-scenes/cornell.ron}
 runs=${2:-5}
 shift $(( $# > 2 ? 2 : $# ))
-cargo build --release --quiet
+source scripts/caustic_bin.sh
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 for i in $(seq "$runs"); do
-  ./target/release/caustic render "$scene" -o "$out/img.png" --quiet "$@"
+  "$caustic" render "$scene" -o "$out/img.png" --quiet "$@"
 done | tee "$out/log"
 # Median of the "in X s" figures.
 grep -o 'in [0-9.]* s' "$out/log" | awk '{print $2}' | sort -n | awk '{a[NR]=$1} END {print "median render time:", a[int((NR+1)/2)], "s over", NR, "runs"}'

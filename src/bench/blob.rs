@@ -1,4 +1,4 @@
-//! The "bumpy blob" ray-casting workload (shared/bench/blob-workload.md): mesh and rays, bit-exact to its definition.
+//! The "bumpy blob" ray-casting workload (docs/performance.md, "The blob workload"): mesh and rays, bit-exact to its definition.
 //!
 //! Choices the text leaves open:
 //! - Icosahedron: the 12 vertices `(±1, ±φ, 0)`, `(0, ±1, ±φ)`, `(±φ, 0, ±1)` normalised, with the vertex and face

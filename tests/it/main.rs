@@ -6,6 +6,8 @@ mod bad_scenes;
 mod cli;
 mod common;
 mod determinism;
+mod doc_images;
+mod doc_snippets;
 mod hard_cases;
 mod interrupt;
 mod light_transport;
