@@ -200,11 +200,14 @@ impl Light {
                 if !(dist2 > r2 && dist2.is_finite()) || wi.dot(d) <= 0.0 {
                     return 0.0;
                 }
-                // Inside the cone ⇔ the line along wi passes within r of the centre. A little
-                // slack keeps directions sampled exactly on the rim (and rays that graze the
-                // sphere) inside despite rounding.
+                // Inside the cone ⇔ the line along wi passes within r of the centre. The slack
+                // is the f32 resolution of a unit direction (about an ulp, times the distance)
+                // plus a few ulps of r, so directions sampled on the rim (and rays that graze
+                // the sphere) count as inside; it adds a relative ~2 · RIM_SLACK · D/r to the
+                // cone's mass (more for cones near a hemisphere, whose rim is tangent).
                 let perp2 = wi.cross(d).length_squared();
-                if perp2 > r2 * (1.0 + 1e-4) + dist2 * 1e-12 {
+                let reach = radius * (1.0 + 5e-7) + RIM_SLACK * dist2.sqrt();
+                if perp2 > reach * reach {
                     return 0.0;
                 }
                 let pdf = 1.0 / (TAU * cone_one_minus_cos(r2, dist2));
@@ -318,6 +321,10 @@ impl Light {
 fn point_emission_direction(u: (f32, f32)) -> Vec3 {
     uniform_sphere(u)
 }
+
+/// Angular tolerance (radians) of [`Light::pdf_li`]'s rim test: about one `f32` ulp of a unit
+/// vector's components.
+pub const RIM_SLACK: f32 = 5e-8;
 
 /// `1 − cos θmax` of the cone a sphere of squared radius `r2` subtends from squared distance
 /// `dist2 > r2`, as `sin²θmax / (1 + cos θmax)`: exact for tiny cones where `1 − cos θmax` would

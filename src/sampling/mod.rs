@@ -1,6 +1,8 @@
 //! Deterministic random streams and the warps that turn uniform numbers into directions.
 
 pub mod alias;
+#[cfg(test)]
+pub(crate) mod chi2;
 pub mod rng;
 pub mod sampler;
 pub mod sobol;

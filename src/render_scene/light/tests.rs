@@ -192,3 +192,121 @@ fn emission_samples_carry_exactly_the_light_power() {
         assert!(dir_sum.length() / 10_000.0 < 0.03, "{dir_sum}");
     }
 }
+
+/// Sphere lights for the χ² tests: (label, centre, radius, shading point).
+fn chi2_cases() -> [(&'static str, Vec3, f32, Vec3); 4] {
+    [
+        ("near", Vec3::new(0.2, 1.5, -0.3), 1.0, Vec3::ZERO),
+        // Seen from 0.1% of its radius above the surface: a cone of half-angle 87.4°, whose
+        // rim directions graze the sphere.
+        ("grazing", Vec3::new(0.0, 0.0, 2.002), 2.0, Vec3::ZERO),
+        ("far", Vec3::new(600.0, -800.0, 0.0), 1.0, Vec3::ZERO),
+        // 1 − cos θmax = 5e-9: rounds to 0 in f32 as cos θmax.
+        (
+            "tiny",
+            Vec3::new(1.0, 2.0, 10.0),
+            1e-3,
+            Vec3::new(1.0, 2.0, 0.0),
+        ),
+    ]
+}
+
+/// `1 − cos θmax` of the cone in f64, for sizing the histogram's cap.
+fn cone_extent(center: Vec3, radius: f32, p: Vec3) -> f64 {
+    let sin2 = f64::from(radius).powi(2) / (center - p).as_dvec3().length_squared();
+    sin2 / (1.0 + (1.0 - sin2).sqrt())
+}
+
+#[test]
+fn sphere_cone_sampling_passes_chi2_against_pdf_li() {
+    use crate::sampling::chi2::{SphereBins, chi2_test, sidak_alpha};
+    let alpha = sidak_alpha(0.01, chi2_cases().len());
+    for (i, (label, center, radius, p)) in chi2_cases().into_iter().enumerate() {
+        let l = Light::sphere(center, radius, Vec3::ONE);
+        let axis = (center - p).normalize();
+        // The cap spans 1.25× the cone, so the rim and the empty band past it are binned too.
+        let bins = SphereBins::cap(axis, 16, 32, 1.25 * cone_extent(center, radius, p));
+        let r = chi2_test(
+            200_000,
+            i as u64,
+            &bins,
+            |rng| l.sample_li(p, rng.next_2d()).map(|s| s.wi),
+            |w| l.pdf_li(p, w),
+        );
+        eprintln!("sample_li χ² {label}: {r:?}");
+        assert!(r.passes(alpha) && r.rejected == 0, "{label}: {r:?}");
+        assert!(r.dof > 300, "{label}: {r:?}");
+    }
+}
+
+#[test]
+fn pdf_li_integrates_to_one() {
+    use crate::sampling::chi2::{SphereBins, integrate, integrate_sphere};
+    for (label, center, radius, p) in chi2_cases() {
+        let l = Light::sphere(center, radius, Vec3::ONE);
+        let axis = (center - p).normalize();
+        let extent = cone_extent(center, radius, p);
+        let cap = integrate(&SphereBins::cap(axis, 16, 32, 1.25 * extent), |w| {
+            l.pdf_li(p, w)
+        });
+        // The rim test's slack adds a band of relative mass ~2 · RIM_SLACK · D/r.
+        let slack = 2.2 * f64::from(RIM_SLACK * (center - p).length() / radius) + 2e-5;
+        eprintln!("∫ pdf_li over the cap, {label}: {cap} (slack {slack:.1e})");
+        assert!((cap - 1.0).abs() < 1e-4 + slack, "{label}: {cap}");
+        if extent > 1e-3 {
+            // Wide cones: the whole sphere too (narrow ones fit inside one cell of it).
+            let all = integrate_sphere(axis, |w| l.pdf_li(p, w));
+            assert!((all - 1.0).abs() < 1e-4 + slack, "{label}: {all}");
+        }
+    }
+}
+
+#[test]
+fn emission_directions_and_positions_pass_chi2() {
+    use crate::sampling::chi2::{SphereBins, chi2_test, sidak_alpha};
+    let alpha = sidak_alpha(0.01, 3);
+    let sphere = Light::sphere(Vec3::new(1.0, -2.0, 0.5), 0.7, Vec3::ONE);
+    let point = Light::point(Vec3::new(1.0, -2.0, 0.5), Vec3::ONE);
+    let bins = SphereBins::sphere(Vec3::Z, 20, 40);
+    let sample = |l: Light| {
+        move |rng: &mut Rng| {
+            let (a, b) = (rng.next_2d(), rng.next_2d());
+            l.sample_le(a, b)
+        }
+    };
+    // Sphere: directions about their own normal are cosine-distributed...
+    let le = sample(sphere);
+    let local = chi2_test(
+        200_000,
+        1,
+        &bins,
+        |rng| le(rng).map(|s| Frame::from_normal(s.normal).to_local(s.dir)),
+        |w| w.z.max(0.0) / PI,
+    );
+    // ...and the points (normals) are uniform over the sphere.
+    let le = sample(sphere);
+    let normals = chi2_test(
+        200_000,
+        2,
+        &bins,
+        |rng| le(rng).map(|s| s.normal),
+        |_| 1.0 / (4.0 * PI),
+    );
+    // Point: uniform directions.
+    let le = sample(point);
+    let points = chi2_test(
+        200_000,
+        3,
+        &bins,
+        |rng| le(rng).map(|s| s.dir),
+        |w| point.pdf_le(Vec3::ZERO, w).1,
+    );
+    for (label, r) in [
+        ("sphere dir", local),
+        ("sphere pos", normals),
+        ("point dir", points),
+    ] {
+        eprintln!("sample_le χ² {label}: {r:?}");
+        assert!(r.passes(alpha) && r.rejected == 0, "{label}: {r:?}");
+    }
+}
