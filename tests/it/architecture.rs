@@ -144,7 +144,10 @@ fn lower_layers_do_not_import_upper_ones() {
             let text = std::fs::read_to_string(&file).expect("read");
             for m in used_modules(&text) {
                 // `Error` etc. at the crate root are glue, not layers.
-                if m == me || allowed.contains(&m.as_str()) || m.chars().next().is_some_and(char::is_uppercase) {
+                if m == me
+                    || allowed.contains(&m.as_str())
+                    || m.chars().next().is_some_and(char::is_uppercase)
+                {
                     continue;
                 }
                 violations.push(format!("{}: uses `crate::{m}`", file.display()));
@@ -158,7 +161,9 @@ fn lower_layers_do_not_import_upper_ones() {
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
         if path.is_dir() && name != "cli" {
             assert!(
-                RULES.iter().any(|(d, _)| d.trim_start_matches("src/") == name),
+                RULES
+                    .iter()
+                    .any(|(d, _)| d.trim_start_matches("src/") == name),
                 "src/{name} has no layering rule"
             );
         }
