@@ -12,5 +12,6 @@ mod mutated_scenes;
 mod primitives;
 mod queries;
 mod render_snapshots;
+mod reported;
 mod textures;
 mod watertight;
