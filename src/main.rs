@@ -318,8 +318,8 @@ fn cmd_render(args: &RenderArgs) -> Result<(), Error> {
         .output
         .clone()
         .unwrap_or_else(|| default_output(&args.scene.scene));
-    // Refuse an output (or checkpoint) that cannot be written before doing any work.
-    caustic::render::output::check_output_path(&output)?;
+    // Refuse a bad output name before doing any work.
+    OutputFormat::for_path(&output)?;
     if let Some(cp) = &args.checkpoint {
         if OutputFormat::for_path(cp).is_err() {
             return Err(Error::Usage(format!(
@@ -333,7 +333,10 @@ fn cmd_render(args: &RenderArgs) -> Result<(), Error> {
                 cp.display()
             )));
         }
-        caustic::render::output::check_output_path(cp)?;
+    }
+    // Refuse an output (or checkpoint) that cannot be written before doing any work.
+    for path in std::iter::once(&output).chain(&args.checkpoint) {
+        caustic::render::output::check_output_path(path)?;
     }
     let region = args.region.as_deref().map(parse_region).transpose()?;
     if args.threads == Some(0) {
