@@ -494,3 +494,20 @@ fn non_finite_texels_are_an_error_and_negative_ones_a_warning_in_check() {
     // Green is 0 everywhere, red is lit everywhere.
     assert!(film.pixels.iter().all(|p| p.y == 0.0 && p.x > 0.1));
 }
+
+#[test]
+fn light_power_beyond_single_precision_is_refused() {
+    let text = |p: &str| floor_under(&format!("Point(position: (0, 2, 0), power: (1, {p}, 1))"));
+    let diags = |p: &str| {
+        let src = caustic::scene::SourceFile::new(Path::new("l.ron"), text(p)).expect("ron");
+        caustic::scene::validate::validate(&src.parse().expect("parses"))
+    };
+    assert!(!diags("1e30").iter().any(|d| d.is_error()));
+    let d = diags("2e30");
+    assert!(
+        d.iter().any(|d| d.is_error()
+            && d.path == "lights[0].power"
+            && d.message.contains("at most 1e30")),
+        "{d:?}"
+    );
+}
