@@ -32,7 +32,7 @@ impl Error {
         match self {
             Error::Interrupted(_) | Error::Render(RenderError::Cancelled) => 130,
             Error::Scene(_) | Error::Usage(_) | Error::Render(_) => 2,
-            Error::Output(OutputError::UnknownFormat { .. }) => 2,
+            Error::Output(OutputError::UnknownFormat { .. } | OutputError::Unwritable { .. }) => 2,
             Error::Output(_) => 1,
         }
     }

@@ -98,8 +98,14 @@ pub fn check(
 /// Reads, overrides, validates and compiles a scene file.
 pub fn prepare(path: &Path, overrides: &SceneOverrides) -> Result<Prepared, Error> {
     let (source, scene, warnings) = check(path, overrides)?;
-    let (render_scene, stats) = compile(&scene, &source.base_dir())
+    let (render_scene, mut stats) = compile(&scene, &source.base_dir())
         .map_err(|errs| SceneError::Invalid(locate(&source, errs, overrides)))?;
+    let mut warnings = warnings;
+    warnings.extend(locate(
+        &source,
+        std::mem::take(&mut stats.warnings),
+        overrides,
+    ));
     Ok(Prepared {
         source,
         scene,

@@ -12,6 +12,7 @@ use crate::render_scene::{SurfaceMaterial, Texture};
 use crate::scene::Diagnostic;
 use crate::scene::schema::{ColorSpec, Mapping, SceneFile, TextureSpec};
 use crate::shading::Bsdf;
+use crate::texture::bitmap::read_colour_image;
 use crate::texture::{
     BitmapTexture, GreyMipMap, HeightMap, Marble, MipMap, Noise, Ripples, TextureError,
 };
@@ -91,10 +92,12 @@ impl MaterialTable {
 pub(super) struct TextureTable {
     index: BTreeMap<String, Option<u32>>,
     pub list: Vec<Texture>,
-    colour_images: HashMap<(PathBuf, bool), Arc<MipMap<Vec3>>>,
+    colour_images: HashMap<(PathBuf, Option<bool>), Arc<MipMap<Vec3>>>,
     grey_images: HashMap<PathBuf, Arc<GreyMipMap>>,
     /// Image files decoded.
     pub images_loaded: usize,
+    /// Warnings about the images read (negative texels clamped).
+    pub warnings: Vec<Diagnostic>,
 }
 
 impl TextureTable {
@@ -142,13 +145,33 @@ impl TextureTable {
         Ok(match spec {
             TextureSpec::Bitmap { file, tile, srgb } => {
                 let path = base_dir.join(file);
+                let mut fresh = None;
                 let mip = cached(
                     &mut self.colour_images,
                     &mut self.images_loaded,
                     (path.clone(), *srgb),
-                    || MipMap::open(&path, *srgb),
+                    || {
+                        let image = read_colour_image(&path, *srgb)?;
+                        fresh = Some((image.negative_texels, image.first_negative));
+                        Ok(image.mip)
+                    },
                 )
                 .map_err(|e| load_error(file, e))?;
+                if let Some((count, Some((x, y)))) = fresh
+                    && count > 0
+                {
+                    self.warnings.push(
+                        Diagnostic::warning(
+                            format!("{at}.file"),
+                            format!(
+                                "`{}` has {count} texel{} with negative values (the first at x = {x}, y = {y}), clamped to 0: a colour is a reflectance, which cannot be negative",
+                                path.display(),
+                                if count == 1 { "" } else { "s" }
+                            ),
+                        )
+                        .with_help("negative values in an EXR usually come from a colour-space conversion; clamp them when exporting to silence this"),
+                    );
+                }
                 Texture::Bitmap(BitmapTexture::new(mip, Vec2::from(*tile)))
             }
             TextureSpec::HeightMap { file, depth, tile } => {
@@ -244,7 +267,10 @@ fn file_error(at: &str, base_dir: &Path, file: &str, e: &TextureError) -> Box<Di
                 image_error_text(e)
             ),
         )
-        .with_help("textures must be PNG, JPEG or EXR files; paths are relative to the scene file"),
+        .with_help(match e {
+            TextureError::NonFinite { .. } => "NaN and infinite values mean nothing as a colour or a height; fix or re-export the image",
+            _ => "textures must be PNG, JPEG or EXR files; paths are relative to the scene file",
+        }),
     )
 }
 

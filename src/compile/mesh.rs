@@ -1,10 +1,13 @@
-//! OBJ loading via tobj: triangulated, indices checked, each file read once per compilation.
+//! OBJ loading via tobj: polygons triangulated by their shape ([`super::polygon`]), indices
+//! checked, each file read once per compilation.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
 use glam::{Vec2, Vec3};
+
+use super::polygon::triangulate;
 
 /// One triangle corner: indices into positions, normals and texture coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,8 +30,12 @@ pub struct ObjMesh {
     /// Texture coordinates in the renderer's convention (v grows downwards, so OBJ's
     /// bottom-up `vt` v is stored as 1 − v).
     pub uvs: Vec<Vec2>,
-    /// Triangles (polygons are fan-triangulated by tobj).
+    /// Triangles: faces with more than three corners are triangulated by their shape (ear
+    /// clipping on their best-fit plane), so concave polygons keep their notches.
     pub triangles: Vec<[Corner; 3]>,
+    /// Faces whose shape is suspect (not planar, or crossing themselves), as sentences naming
+    /// the OBJ line; the triangles are still made.
+    pub warnings: Vec<String>,
 }
 
 /// Loaded meshes by resolved path (errors are not cached; each node reports its own).
@@ -42,14 +49,15 @@ impl MeshCache {
         self.meshes.len()
     }
 
-    /// Loads `path` (or returns the cached copy); the error is a user-facing sentence.
-    pub fn load(&mut self, path: &Path) -> Result<Rc<ObjMesh>, String> {
+    /// Loads `path` (or returns the cached copy); the error is a user-facing sentence. The flag
+    /// is true on the first load only, so a file's warnings are reported once.
+    pub fn load(&mut self, path: &Path) -> Result<(Rc<ObjMesh>, bool), String> {
         if let Some(m) = self.meshes.get(path) {
-            return Ok(Rc::clone(m));
+            return Ok((Rc::clone(m), false));
         }
         let mesh = Rc::new(read_obj(path)?);
         self.meshes.insert(path.to_path_buf(), Rc::clone(&mesh));
-        Ok(mesh)
+        Ok((mesh, true))
     }
 }
 
@@ -68,10 +76,10 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
             e.valid_up_to()
         )
     })?;
-    check_obj_text(text).map_err(|e| format!("`{}` {e}", path.display()))?;
+    let face_lines = check_obj_text(text).map_err(|e| format!("`{}` {e}", path.display()))?;
     let options = tobj::LoadOptions {
         single_index: false,
-        triangulate: true,
+        triangulate: false,
         ignore_points: true,
         ignore_lines: true,
     };
@@ -82,6 +90,7 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
     })
     .map_err(|e| format!("`{}` is not a valid OBJ file: {e}", path.display()))?;
     let mut mesh = ObjMesh::default();
+    let mut faces_seen = 0;
     for model in &models {
         let m = &model.mesh;
         let (p0, n0, t0) = (
@@ -106,21 +115,57 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
         );
         let has_n = m.normal_indices.len() == m.indices.len();
         let has_t = m.texcoord_indices.len() == m.indices.len();
-        for (f, tri) in m.indices.chunks_exact(3).enumerate() {
-            let mut corners = [Corner {
-                p: 0,
-                n: None,
-                t: None,
-            }; 3];
-            for k in 0..3 {
-                let i = f * 3 + k;
-                corners[k] = Corner {
-                    p: p0 + tri[k],
-                    n: has_n.then(|| n0 + m.normal_indices[i]),
-                    t: has_t.then(|| t0 + m.texcoord_indices[i]),
-                };
+        let corner = |i: usize| Corner {
+            p: p0 + m.indices[i],
+            n: has_n.then(|| n0 + m.normal_indices[i]),
+            t: has_t.then(|| t0 + m.texcoord_indices[i]),
+        };
+        // Empty arities: every face is a triangle.
+        let arities = if m.face_arities.is_empty() {
+            vec![3; m.indices.len() / 3]
+        } else {
+            m.face_arities.clone()
+        };
+        let mut start = 0;
+        for arity in arities {
+            if start + arity as usize > m.indices.len() {
+                break;
             }
-            mesh.triangles.push(corners);
+            let corners: Vec<Corner> = (start..start + arity as usize).map(corner).collect();
+            start += arity as usize;
+            let line = face_lines.get(faces_seen).copied();
+            faces_seen += 1;
+            if corners.len() == 3 {
+                mesh.triangles.push([corners[0], corners[1], corners[2]]);
+                continue;
+            }
+            // Indices are checked against the file's records above, so positions exist.
+            let shape: Vec<Vec3> = corners
+                .iter()
+                .map(|c| {
+                    let i = 3 * (c.p - p0) as usize;
+                    m.positions
+                        .get(i..i + 3)
+                        .map_or(Vec3::ZERO, Vec3::from_slice)
+                })
+                .collect();
+            let t = triangulate(&shape);
+            let at = line.map_or_else(|| format!("face {faces_seen}"), |l| format!("line {l}"));
+            if let Some(off) = t.non_planar {
+                mesh.warnings.push(format!(
+                    "{at}: the {}-corner face is not planar (a corner is {:.1}% of its size off its best-fit plane); it is triangulated as projected on that plane",
+                    corners.len(),
+                    off * 100.0
+                ));
+            }
+            if t.self_intersecting {
+                mesh.warnings.push(format!(
+                    "{at}: the {}-corner face crosses itself, so it has no well-defined inside; its triangles may cover too much or too little",
+                    corners.len()
+                ));
+            }
+            mesh.triangles
+                .extend(t.triangles.iter().map(|tri| tri.map(|k| corners[k])));
         }
     }
     check_indices(&mesh)
@@ -140,8 +185,10 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
 
 /// Checks the statements tobj relies on, so errors name the OBJ line: vertex records need
 /// numbers, faces need at least three corners whose indices refer to records defined so far.
-fn check_obj_text(text: &str) -> Result<(), String> {
+/// Returns the 1-based line of each face, in file order (tobj keeps that order).
+fn check_obj_text(text: &str) -> Result<Vec<usize>, String> {
     let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
+    let mut face_lines = Vec::new();
     for (n, raw) in text.lines().enumerate() {
         let line = raw.split('#').next().unwrap_or("").trim();
         let mut words = line.split_whitespace();
@@ -169,6 +216,7 @@ fn check_obj_text(text: &str) -> Result<(), String> {
                 if corners.len() < 3 {
                     return Err(at("a face needs at least three corners".into()));
                 }
+                face_lines.push(n + 1);
                 for corner in corners {
                     for (i, (part, count, what)) in corner
                         .split('/')
@@ -204,7 +252,7 @@ fn check_obj_text(text: &str) -> Result<(), String> {
             _ => {}
         }
     }
-    Ok(())
+    Ok(face_lines)
 }
 
 fn check_indices(mesh: &ObjMesh) -> Result<(), String> {

@@ -2,9 +2,11 @@
 //! flat [`RenderScene`] (world-space primitives, resolved indices, BVH), keeping only what the
 //! scene uses.
 
+pub mod lights;
 mod materials;
 pub mod mesh;
 mod nodes;
+pub mod polygon;
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -44,6 +46,9 @@ pub struct CompileStats {
     pub bvh_time: Duration,
     /// BVH shape.
     pub bvh: BvhStats,
+    /// Warnings found while compiling (e.g. a sphere light compiled as a point light), with the
+    /// field paths they concern; the pipeline locates them in the file.
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// Compiles a validated scene. Asset paths resolve against `base_dir`. Returns all asset errors.
@@ -65,6 +70,7 @@ pub fn compile(
         builder: &mut builder,
         meshes: mesh::MeshCache::default(),
         errors: &mut errors,
+        warnings: &mut stats.warnings,
         degenerate: 0,
     };
     for (i, node) in scene.nodes.iter().enumerate() {
@@ -87,6 +93,21 @@ pub fn compile(
                 radius,
                 power,
             } => {
+                let eye = match scene.camera {
+                    CameraSpec::Pinhole { eye, .. } => eye.into(),
+                };
+                let reach = lights::reach(&builder, center.into(), eye);
+                let min = lights::min_sphere_light_radius(power.into(), reach);
+                if f64::from(radius) < min {
+                    stats.warnings.push(lights::point_fallback_warning(
+                        i,
+                        radius,
+                        power.into(),
+                        reach,
+                    ));
+                    lights.push(Light::point(center.into(), power.into()));
+                    continue;
+                }
                 let light = lights.len() as u32;
                 lights.push(Light::sphere(center.into(), radius, power.into()));
                 let object = objects.len() as u32;
@@ -110,6 +131,7 @@ pub fn compile(
     stats.materials = materials.list.len();
     stats.textures = materials.textures.list.len();
     stats.images_loaded = materials.textures.images_loaded;
+    stats.warnings.append(&mut materials.textures.warnings);
     stats.lights = lights.len();
 
     let t1 = Instant::now();

@@ -22,6 +22,7 @@ pub(super) struct Flattener<'a> {
     pub builder: &'a mut GeometryBuilder,
     pub meshes: MeshCache,
     pub errors: &'a mut Vec<Diagnostic>,
+    pub warnings: &'a mut Vec<Diagnostic>,
     pub degenerate: usize,
 }
 
@@ -67,12 +68,16 @@ impl Flattener<'_> {
                 let m = xf
                     * DAffine3::from_translation(Vec3::from(*center).as_dvec3())
                     * DAffine3::from_scale(DVec3::splat(f64::from(*radius)));
-                self.sphere(m, object);
+                if self.resolvable(path, "sphere", &m, MIN_ELLIPSOID_THICKNESS) {
+                    self.sphere(m, object);
+                }
             }
             NodeSpec::Cube { size, .. } => {
                 let m = xf * DAffine3::from_scale(DVec3::splat(f64::from(*size)));
-                for face in CUBE_FACES {
-                    self.quad(&m, face, object);
+                if self.resolvable(path, "cube", &m, MIN_BOX_THICKNESS) {
+                    for face in CUBE_FACES {
+                        self.quad(&m, face, object);
+                    }
                 }
             }
             NodeSpec::Quad { size, .. } => {
@@ -83,7 +88,17 @@ impl Flattener<'_> {
             NodeSpec::Mesh { file, smooth, .. } => {
                 let full = self.base_dir.join(file);
                 match self.meshes.load(&full) {
-                    Ok(mesh) => self.mesh(&xf, &mesh, *smooth, object),
+                    Ok((mesh, first_load)) => {
+                        if first_load {
+                            self.warnings.extend(mesh.warnings.iter().map(|w| {
+                                Diagnostic::warning(
+                                    format!("{path}.file"),
+                                    format!("`{}` {w}", full.display()),
+                                )
+                            }));
+                        }
+                        self.mesh(&xf, &mesh, *smooth, object);
+                    }
                     Err(msg) => self
                         .errors
                         .push(Diagnostic::error(format!("{path}.file"), msg)),
@@ -96,6 +111,37 @@ impl Flattener<'_> {
                 format!("the scene exceeds {MAX_PRIMS_PER_KIND} triangles"),
             ));
         }
+    }
+
+    /// Whether the solid `kind` (a unit sphere or cube under `m`) keeps a thickness the renderer
+    /// can resolve: its thinnest extent (the smallest singular value of `m`'s linear part) at
+    /// least `limit` × its longest. If not, an error naming the node and the factor that would do.
+    fn resolvable(&mut self, path: &str, kind: &str, m: &DAffine3, limit: f64) -> bool {
+        let (thin, long) = (
+            smallest_singular_value(m.matrix3),
+            largest_singular_value(m.matrix3),
+        );
+        if thin >= limit * long {
+            return true;
+        }
+        let precision = if limit == MIN_ELLIPSOID_THICKNESS {
+            "double precision"
+        } else {
+            "single precision"
+        };
+        self.errors.push(
+            Diagnostic::error(
+                format!("{path}.transform"),
+                format!(
+                    "the transforms down to this {kind} squash it to {:.3e} of its size along one axis (its thinnest extent is {thin:.3e} against {long:.3e} along its longest), thinner than {precision} resolves: it would render with its two sides confused",
+                    thin / long,
+                ),
+            )
+            .with_help(format!(
+                "keep it at least {limit:.1e} of its size thick (a scale factor of at least {limit:.1e} relative to the other axes), or use a Quad for a flat shape",
+            )),
+        );
+        false
     }
 
     /// A unit sphere under `m`: kept analytic as a sphere if `m` is a similarity, else an ellipsoid.
@@ -218,6 +264,58 @@ fn box_projection(p: [Vec3; 3]) -> [Vec2; 3] {
     })
 }
 
+/// Thinnest resolvable ellipsoid, as a fraction of its longest semi-axis. Ellipsoid hits are
+/// solved in f64 in object space, where the thin axis is stretched by 1/thickness; the rounding
+/// of that solution, about 2.2e-16 × distance / thickness in object units, must stay far below
+/// the unit sphere's radius. Measured on a unit sphere squashed along y seen from 4.5 units
+/// (`tests/reported/near-singular-scale`): exact to 1e-4 down to a factor 1e-13, wrong pixels
+/// from 1e-14; 2^-36 ≈ 1.5e-11 leaves a 100× margin (for views up to ~100× farther).
+pub const MIN_ELLIPSOID_THICKNESS: f64 = 1.0 / (1u64 << 36) as f64;
+
+/// Thinnest resolvable box (a `Cube` under a squashing scale), as a fraction of its longest
+/// side: its two large faces are triangles hit in f32, which tells them apart only when they are
+/// a few f32 steps of the hit distance apart (`f32::EPSILON` ≈ 1.2e-7). Measured on a cube of
+/// side 1.5 squashed along y seen from 4.5 units: exact down to a factor 5e-7, wrong pixels from
+/// 3e-7; 2^-20 ≈ 9.5e-7 keeps a 2× margin at that distance. Any two surfaces closer than a few
+/// f32 steps of their distance from the camera are confused, however they were modelled: a thin
+/// slab seen from much farther than its size needs a proportionally thicker factor.
+pub const MIN_BOX_THICKNESS: f64 = 1.0 / (1u64 << 20) as f64;
+
+/// The largest singular value of `m`: the square root of the largest eigenvalue of `mᵀm`, by
+/// the closed form for symmetric 3×3 matrices (Smith, "Eigenvalues of a symmetric 3 × 3 matrix",
+/// CACM 1961), accurate for the largest eigenvalue.
+fn largest_singular_value(m: DMat3) -> f64 {
+    let a = m.transpose() * m;
+    let (x, y, z) = (a.x_axis, a.y_axis, a.z_axis);
+    let p1 = y.x * y.x + z.x * z.x + z.y * z.y;
+    let q = (x.x + y.y + z.z) / 3.0;
+    let p2 = (x.x - q).powi(2) + (y.y - q).powi(2) + (z.z - q).powi(2) + 2.0 * p1;
+    let p = (p2 / 6.0).sqrt();
+    let lambda = if p == 0.0 || !p.is_finite() {
+        q
+    } else {
+        let b = (a - DMat3::from_diagonal(DVec3::splat(q))) * (1.0 / p);
+        let r = (b.determinant() / 2.0).clamp(-1.0, 1.0);
+        q + 2.0 * p * (r.acos() / 3.0).cos()
+    };
+    lambda.max(0.0).sqrt()
+}
+
+/// The smallest singular value of `m`, as 1 / the largest of its inverse (accurate however thin
+/// `m` is); 0 for a singular or non-finite `m`.
+fn smallest_singular_value(m: DMat3) -> f64 {
+    let det = m.determinant();
+    if det == 0.0 || !det.is_finite() {
+        return 0.0;
+    }
+    let s = largest_singular_value(m.inverse());
+    if s > 0.0 && s.is_finite() {
+        1.0 / s
+    } else {
+        0.0
+    }
+}
+
 /// Inverse transpose of a linear map, for transforming normals.
 fn normal_matrix(l: DMat3) -> DMat3 {
     l.inverse().transpose()
@@ -270,3 +368,29 @@ const CUBE_FACES: [[[f64; 3]; 4]; 6] = [
         [-0.5, -0.5, 0.5],
     ], // -y
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn singular_values_of_thin_and_rotated_maps() {
+        // diag(3, 1e-9, 0.5) rotated on both sides: singular values 3 and 1e-9 (the rotation's
+        // rounding, ~1e-16 × 3 per entry, perturbs the small one by under 1e-6 of itself).
+        let r = DMat3::from_rotation_y(0.7) * DMat3::from_rotation_x(1.1);
+        let m = r * DMat3::from_diagonal(DVec3::new(3.0, 1e-9, 0.5)) * r.transpose();
+        assert!((largest_singular_value(m) / 3.0 - 1.0).abs() < 1e-12);
+        assert!((smallest_singular_value(m) / 1e-9 - 1.0).abs() < 1e-6);
+        // Unrotated, exact however thin.
+        let thin = DMat3::from_diagonal(DVec3::new(1.0, 1e-20, 2.0));
+        assert!((smallest_singular_value(thin) / 1e-20 - 1.0).abs() < 1e-12);
+        // Equal singular values (p = 0 in the closed form), and a shear [[1, 1], [0, 1]] in xy,
+        // whose singular values are the golden ratio φ and 1/φ (and 1 along z).
+        assert!((largest_singular_value(DMat3::IDENTITY * 2.0) - 2.0).abs() < 1e-15);
+        let shear = DMat3::from_cols(DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Z);
+        let phi = (1.0 + 5f64.sqrt()) / 2.0;
+        assert!((largest_singular_value(shear) - phi).abs() < 1e-12);
+        assert!((smallest_singular_value(shear) - 1.0 / phi).abs() < 1e-12);
+        assert_eq!(smallest_singular_value(DMat3::ZERO), 0.0);
+    }
+}

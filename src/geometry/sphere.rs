@@ -22,6 +22,17 @@ pub fn intersect_sphere(center: Vec3, radius: f32, ray: &Ray) -> Option<f32> {
 #[inline]
 #[must_use]
 pub fn intersect_unit_quadric(o: DVec3, d: DVec3, r: f64, t_max: f32) -> Option<f32> {
+    let t = unit_quadric_t(o, d, r)?;
+    let t32 = t as f32;
+    (t32 > 0.0 && t32 < t_max).then_some(t32)
+}
+
+/// The f64 root [`intersect_unit_quadric`] rounds to f32: the nearer root if positive, else the
+/// farther one, if positive. Shading recomputes it, because the f32 `t` can be off by more than
+/// a thin ellipsoid's thickness (in object space, `o + t·d` then lands on the wrong side).
+#[inline]
+#[must_use]
+pub fn unit_quadric_t(o: DVec3, d: DVec3, r: f64) -> Option<f64> {
     let a = d.length_squared();
     if a == 0.0 || !a.is_finite() {
         return None;
@@ -49,8 +60,7 @@ pub fn intersect_unit_quadric(o: DVec3, d: DVec3, r: f64, t_max: f32) -> Option<
         std::mem::swap(&mut t0, &mut t1);
     }
     let t = if t0 > 0.0 { t0 } else { t1 };
-    let t32 = t as f32;
-    (t > 0.0 && t32 > 0.0 && t32 < t_max).then_some(t32)
+    (t > 0.0).then_some(t)
 }
 
 /// Projects a point onto the sphere's surface (removing the error of `o + t·d`) in f64.

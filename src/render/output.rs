@@ -1,5 +1,6 @@
 //! Writing images: 8-bit sRGB PNG or linear float EXR by extension, atomically (a temporary file
 //! in the target directory renamed into place, so a failed or interrupted write leaves nothing).
+//! [`check_output_path`] refuses an unwritable target before any rendering is done.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -8,17 +9,26 @@ use image::{ImageFormat, Rgb32FImage, RgbImage};
 
 use super::Film;
 
-/// Why an image could not be written.
+/// Why an image could not be written. Every message starts with `error:` and names the path the
+/// user gave, never the temporary file.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
     /// The extension is not one we write.
-    #[error("cannot write `{}`: the output must end in `.png` or `.exr`", path.display())]
+    #[error("error: cannot write `{}`: the output must end in `.png` or `.exr`", path.display())]
     UnknownFormat {
         /// The requested path.
         path: PathBuf,
     },
-    /// The file system refused.
-    #[error("cannot write `{}`: {source}", path.display())]
+    /// The target cannot be written, found before rendering by [`check_output_path`].
+    #[error("error: cannot write `{}`: {reason}", path.display())]
+    Unwritable {
+        /// The requested path.
+        path: PathBuf,
+        /// Why, as a sentence fragment naming the folder or file at fault.
+        reason: String,
+    },
+    /// The file system refused while writing.
+    #[error("error: cannot write `{}`: {source}", path.display())]
     Io {
         /// The requested path.
         path: PathBuf,
@@ -26,7 +36,7 @@ pub enum OutputError {
         source: std::io::Error,
     },
     /// Encoding failed.
-    #[error("cannot encode `{}`: {source}", path.display())]
+    #[error("error: cannot encode `{}`: {source}", path.display())]
     Encode {
         /// The requested path.
         path: PathBuf,
@@ -118,22 +128,96 @@ pub fn write_image(film: &Film, path: &Path, exposure: f32) -> Result<(), Output
     write_atomic(path, &bytes)
 }
 
-/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`.
+/// The folder an output file goes in (`.` for a bare file name).
+fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// A temporary-file builder for the atomic write: hidden name, and the permissions of any newly
+/// created file (0o666 less the umask), not tempfile's owner-only 0o600.
+fn temp_builder() -> tempfile::Builder<'static, 'static> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".caustic-").suffix(".tmp");
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    builder
+}
+
+/// An OS error without the context `tempfile` attaches (` at path "…/.caustic-XXXX.tmp"`, which
+/// means nothing to the user): the OS's own sentence, same kind.
+fn bare(e: std::io::Error) -> std::io::Error {
+    if e.raw_os_error().is_some() {
+        return e;
+    }
+    let text = e.to_string();
+    match text.rfind(" at path ") {
+        Some(cut) => std::io::Error::new(e.kind(), &text[..cut]),
+        None => e,
+    }
+}
+
+/// Checks, before any rendering, that an image can be written at `path`, so a bad target is
+/// refused in a moment instead of after the whole render. The extension must be `.png` or
+/// `.exr`, `path` must not be a folder, its folder must exist and be a folder, and a new file
+/// must be creatable there: this is probed by creating and removing a temporary file in it, which
+/// catches missing permissions and read-only file systems exactly as the final write would meet
+/// them. Nothing is left behind.
+///
+/// # Errors
+/// [`OutputError::UnknownFormat`] for another extension, [`OutputError::Unwritable`] naming
+/// `path` and the folder at fault otherwise.
+pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
+    OutputFormat::for_path(path)?;
+    let refuse = |reason: String| OutputError::Unwritable {
+        path: path.to_path_buf(),
+        reason,
+    };
+    if path.is_dir() {
+        return Err(refuse(
+            "it is a folder; give a file name such as `out.png`".into(),
+        ));
+    }
+    let dir = parent_dir(path);
+    match std::fs::metadata(&dir) {
+        Ok(m) if !m.is_dir() => {
+            return Err(refuse(format!("`{}` is not a folder", dir.display())));
+        }
+        Ok(_) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(refuse(format!(
+                "the folder `{}` does not exist; create it first",
+                dir.display()
+            )));
+        }
+        Err(e) => {
+            return Err(refuse(format!(
+                "cannot open the folder `{}`: {e}",
+                dir.display()
+            )));
+        }
+    }
+    // Dropping the probe removes it.
+    temp_builder().tempfile_in(&dir).map_err(|e| {
+        refuse(format!(
+            "cannot create files in the folder `{}`: {}",
+            dir.display(),
+            bare(e)
+        ))
+    })?;
+    Ok(())
+}
+
+/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`. Errors name
+/// `path`, not the temporary file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     let io = |source| OutputError::Io {
         path: path.to_path_buf(),
-        source,
+        source: bare(source),
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".caustic-").suffix(".tmp");
-    // Like any newly created file (0o666 less the umask), not tempfile's owner-only 0o600.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut tmp = builder.tempfile_in(&dir).map_err(io)?;
+    let mut tmp = temp_builder().tempfile_in(parent_dir(path)).map_err(io)?;
     tmp.write_all(bytes).map_err(io)?;
     tmp.as_file().sync_all().map_err(io)?;
     tmp.persist(path).map_err(|e| io(e.error))?;
@@ -162,6 +246,50 @@ mod tests {
         write_image(&Film::new(2, 2), &image, 1.0).expect("written");
         let mode = |p: &Path| std::fs::metadata(p).expect("meta").permissions().mode() & 0o777;
         assert_eq!(mode(&image), mode(&plain));
+    }
+
+    #[test]
+    fn unwritable_targets_are_refused_naming_the_users_path() {
+        let dir = tempfile::tempdir().expect("tmp");
+        let d = dir.path();
+        let file = d.join("plain.txt");
+        std::fs::write(&file, b"x").expect("write");
+        std::fs::create_dir(d.join("adir.png")).expect("mkdir");
+        let cases = [
+            (d.join("missing/out.png"), "does not exist"),
+            (d.join("adir.png"), "it is a folder"),
+            (file.join("out.png"), "is not a folder"),
+        ];
+        for (path, why) in cases {
+            let e = check_output_path(&path).expect_err("refused").to_string();
+            assert!(e.starts_with("error: cannot write `"), "{e}");
+            assert!(e.contains(&format!("`{}`", path.display())), "{e}");
+            assert!(e.contains(why), "{e}");
+            assert!(matches!(
+                check_output_path(&path),
+                Err(OutputError::Unwritable { .. })
+            ));
+        }
+        assert!(matches!(
+            check_output_path(&d.join("out.jpg")),
+            Err(OutputError::UnknownFormat { .. })
+        ));
+        // A writable target passes and the probe leaves nothing behind.
+        check_output_path(&d.join("out.exr")).expect("writable");
+        let left: Vec<_> = std::fs::read_dir(d).expect("ls").collect();
+        assert_eq!(left.len(), 2, "only plain.txt and adir.png remain");
+    }
+
+    #[test]
+    fn a_failed_write_names_the_users_path_not_the_temporary_file() {
+        let dir = tempfile::tempdir().expect("tmp");
+        let path = dir.path().join("gone/out.png");
+        let e = write_image(&Film::new(2, 2), &path, 1.0)
+            .expect_err("no such folder")
+            .to_string();
+        assert!(e.starts_with("error: cannot write `"), "{e}");
+        assert!(e.contains(&path.display().to_string()), "{e}");
+        assert!(!e.contains(".caustic-") && !e.contains("at path"), "{e}");
     }
 
     #[test]

@@ -6,7 +6,7 @@ use glam::{DVec3, Vec2, Vec3};
 use super::geometry::{Geometry, Hit, PrimKind};
 use crate::geometry::Ray;
 use crate::geometry::float::gamma;
-use crate::geometry::sphere::reproject_to_sphere;
+use crate::geometry::sphere::{reproject_to_sphere, unit_quadric_t};
 use crate::geometry::triangle::hit_point_error;
 
 /// Everything shading needs about a hit point.
@@ -108,7 +108,9 @@ impl Geometry {
                 let e = &self.ellipsoids[hit.prim.index()];
                 let o = e.object_from_world.transform_point3(ray.origin.as_dvec3());
                 let d = e.object_from_world.transform_vector3(ray.dir.as_dvec3());
-                let po = reproject_to_sphere(DVec3::ZERO, 1.0, o + d * f64::from(hit.t));
+                // The f32 `t` can be off by more than a thin ellipsoid's thickness: re-solve in f64.
+                let t = unit_quadric_t(o, d, 1.0).unwrap_or(f64::from(hit.t));
+                let po = reproject_to_sphere(DVec3::ZERO, 1.0, o + d * t);
                 let pd = e.world_from_object.transform_point3(po);
                 let n = (e.normal_to_world * po).as_vec3().normalize();
                 let p = pd.as_vec3();

@@ -225,8 +225,7 @@ impl<'de> Deserialize<'de> for ColorSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub enum TextureSpec {
-    /// A colour image (PNG or JPEG; EXR is read as linear), repeated over the surface's uv
-    /// square and mipmapped.
+    /// A colour image (PNG, JPEG or EXR), repeated over the surface's uv square and mipmapped.
     Bitmap {
         /// Image file, relative to the scene file.
         file: String,
@@ -234,9 +233,11 @@ pub enum TextureSpec {
         #[serde(default = "unit_size")]
         #[serde(deserialize_with = "exact_floats::<_, 2>")]
         tile: [f32; 2],
-        /// Decode 8/16-bit values from sRGB to linear (true for photographs and paintings).
-        #[serde(default = "yes")]
-        srgb: bool,
+        /// Decode the stored values from sRGB to linear. Default: by format, true for 8/16-bit
+        /// images (PNG, JPEG: photographs and paintings), false for float images (EXR holds
+        /// linear values).
+        #[serde(default)]
+        srgb: Option<bool>,
     },
     /// A grey image used as a height field for bump mapping: height = `depth` × grey value.
     HeightMap {

@@ -27,6 +27,11 @@ pub const MAX_NOISE_FREQUENCY: f32 = 1e6;
 /// Largest marble turbulence (radians of phase).
 pub const MAX_TURBULENCE: f32 = 1e4;
 
+/// Largest light power, in watts per channel: f32 reaches 3.4e38, and radiance sums over samples,
+/// bounces and pixels need headroom; any scene brighter than this renders the same with every
+/// power divided by a constant and `render.exposure` multiplied by it.
+pub const MAX_LIGHT_POWER: f32 = 1e30;
+
 /// Most ripple centres per texture.
 pub const MAX_RIPPLE_CENTERS: usize = 256;
 
@@ -520,6 +525,17 @@ impl<'a> Validator<'a> {
             self.err(
                 &power_path,
                 format!("must not be negative, found {}", fmt3(*power)),
+            );
+        } else if power.iter().any(|c| *c > MAX_LIGHT_POWER) {
+            self.out.push(
+                Diagnostic::error(
+                    &power_path,
+                    format!(
+                        "must be at most {MAX_LIGHT_POWER:e} W per channel (single-precision radiance overflows beyond), found {}",
+                        fmt3(*power)
+                    ),
+                )
+                .with_help("divide every light's power by a constant and multiply `render.exposure` by it: the image is the same"),
             );
         }
     }

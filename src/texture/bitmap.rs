@@ -1,11 +1,76 @@
-//! Tiled colour textures from images.
+//! Tiled colour textures from images, and the policy for reading a colour image file: sRGB or
+//! linear by format unless the scene says, non-finite texels refused, negative ones clamped.
 
+use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
+use image::DynamicImage;
 
+use super::TextureError;
 use super::footprint::{Footprint, lookup_anisotropic};
-use super::mipmap::MipMap;
+use super::mipmap::{MipMap, check_finite, decode_limited, file_reader};
+
+/// A colour image file read into a linear-RGB pyramid, with what the reading did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColourImage {
+    /// The linear-RGB pyramid.
+    pub mip: MipMap<Vec3>,
+    /// The file holds float values (EXR), not 8/16-bit ones.
+    pub float: bool,
+    /// Values were decoded from sRGB (asked for, or by default for 8/16-bit images).
+    pub srgb: bool,
+    /// Texels with a negative channel (possible in float images), clamped to 0: a reflectance
+    /// cannot be negative.
+    pub negative_texels: usize,
+    /// The first such texel (x, y from the top-left).
+    pub first_negative: Option<(u32, u32)>,
+}
+
+/// Reads a colour texture image (PNG, JPEG or EXR by extension) under the texture limits.
+/// `srgb`: decode the stored values from sRGB to linear; `None` decides by the format: yes for
+/// 8/16-bit images (photographs and paintings are sRGB), no for float images (EXR holds linear
+/// values). Negative channels are clamped to 0 and counted; finite values are clamped to
+/// ±[`MAX_TEXEL`](super::mipmap::MAX_TEXEL).
+///
+/// # Errors
+/// [`TextureError::NonFinite`] for NaN or infinite values, and the errors of
+/// [`MipMap::open`].
+pub fn read_colour_image(path: &Path, srgb: Option<bool>) -> Result<ColourImage, TextureError> {
+    let img = decode_limited(file_reader(path)?, size_of::<Vec3>() as u64)?;
+    colour_image(img, srgb)
+}
+
+/// [`read_colour_image`] of an already decoded image.
+///
+/// # Errors
+/// As [`read_colour_image`].
+pub fn colour_image(img: DynamicImage, srgb: Option<bool>) -> Result<ColourImage, TextureError> {
+    let float = matches!(
+        img,
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+    );
+    let srgb = srgb.unwrap_or(!float);
+    let mut rgb = img.into_rgb32f();
+    let width = rgb.width();
+    check_finite(rgb.as_raw(), width, 3)?;
+    let mut negative_texels = 0;
+    let mut first_negative = None;
+    for (i, px) in rgb.pixels_mut().enumerate() {
+        if px.0.iter().any(|c| *c < 0.0) {
+            negative_texels += 1;
+            first_negative.get_or_insert((i as u32 % width, i as u32 / width));
+            px.0 = px.0.map(|c| c.max(0.0));
+        }
+    }
+    Ok(ColourImage {
+        mip: MipMap::from_rgb32f(rgb, srgb)?,
+        float,
+        srgb,
+        negative_texels,
+        first_negative,
+    })
+}
 
 /// A colour image repeated `tile` times per axis over the surface's uv square, looked up with
 /// trilinear mipmapping.

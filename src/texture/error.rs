@@ -38,6 +38,22 @@ pub enum TextureError {
         /// Bytes loading it would take: decoded image, float conversion and pyramid.
         needed: u64,
     },
+    /// The image holds NaN or infinite values (float formats such as EXR can), which no
+    /// reflectance or height can be.
+    #[error(
+        "the image has {count} texel{} with NaN or infinite values, the first at x = {x}, y = {y} (from the top-left) with {value}",
+        if *count == 1 { "" } else { "s" }
+    )]
+    NonFinite {
+        /// Column of the first such texel.
+        x: u32,
+        /// Row of the first such texel (0 at the top).
+        y: u32,
+        /// Its first non-finite channel value.
+        value: f32,
+        /// How many texels have a non-finite channel.
+        count: usize,
+    },
     /// The image file could not be read or decoded.
     #[error("cannot load texture image: {0}")]
     Image(#[from] image::ImageError),

@@ -56,23 +56,40 @@ pub const MAX_IMAGE_BYTES: u64 = 4 << 30;
 
 /// Magnitude to which decoded float texels (EXR) are clamped, the largest half-float: values
 /// beyond it mean nothing as a reflectance or a height, and keeping texels well inside `f32`
-/// keeps every filtered lookup finite. NaN texels read as 0.
+/// keeps every filtered lookup finite. Non-finite texels are an error
+/// ([`TextureError::NonFinite`]).
 pub const MAX_TEXEL: f32 = 65_504.0;
 
-/// A decoded channel value made safe to filter: NaN → 0, clamped to ±[`MAX_TEXEL`].
+/// A decoded channel value made safe to filter: clamped to ±[`MAX_TEXEL`] (callers have
+/// refused non-finite values with [`check_finite`]).
 #[inline]
 fn sanitize(v: f32) -> f32 {
-    if v.is_nan() {
-        0.0
-    } else {
-        v.clamp(-MAX_TEXEL, MAX_TEXEL)
-    }
+    v.clamp(-MAX_TEXEL, MAX_TEXEL)
+}
+
+/// Refuses decoded channel values (`channels` per texel, rows of `width` texels) that are NaN
+/// or infinite, naming the first such texel and how many there are.
+pub(super) fn check_finite(raw: &[f32], width: u32, channels: usize) -> Result<(), TextureError> {
+    let Some(first) = raw.iter().position(|v| !v.is_finite()) else {
+        return Ok(());
+    };
+    let texel = first / channels;
+    let count = raw
+        .chunks_exact(channels)
+        .filter(|t| t.iter().any(|v| !v.is_finite()))
+        .count();
+    Err(TextureError::NonFinite {
+        x: (texel % width.max(1) as usize) as u32,
+        y: (texel / width.max(1) as usize) as u32,
+        value: raw[first],
+        count,
+    })
 }
 
 /// Decodes an image under the texture limits ([`MAX_IMAGE_SIDE`], [`MAX_IMAGE_BYTES`] with
 /// `texel_bytes` bytes per texel in the final pyramid), reading only the header before refusing
 /// an image that is too large.
-fn decode_limited<R: BufRead + Seek>(
+pub(super) fn decode_limited<R: BufRead + Seek>(
     mut reader: ImageReader<R>,
     texel_bytes: u64,
 ) -> Result<DynamicImage, TextureError> {
@@ -100,7 +117,7 @@ fn decode_limited<R: BufRead + Seek>(
 }
 
 /// An `ImageReader` over the file at `path`, format from the extension (as `image::open`).
-fn file_reader(
+pub(super) fn file_reader(
     path: &Path,
 ) -> Result<ImageReader<std::io::BufReader<std::fs::File>>, TextureError> {
     Ok(ImageReader::open(path).map_err(image::ImageError::IoError)?)
@@ -241,10 +258,11 @@ impl MipMap<Vec3> {
     /// A colour pyramid from an image's RGB channels (alpha is ignored). With `srgb`, 8/16-bit
     /// values are decoded from sRGB to linear (what PNG/JPEG colour textures need); without, they
     /// are taken as linear (float images such as EXR, or data textures). Float channels are
-    /// clamped to ±[`MAX_TEXEL`], NaN to 0.
+    /// clamped to ±[`MAX_TEXEL`].
     ///
     /// # Errors
-    /// [`TextureError::Empty`] for a zero-sized image.
+    /// [`TextureError::Empty`] for a zero-sized image, [`TextureError::NonFinite`] for NaN or
+    /// infinite values.
     pub fn from_image(img: &DynamicImage, srgb: bool) -> Result<Self, TextureError> {
         Self::from_rgb32f(img.to_rgb32f(), srgb)
     }
@@ -275,9 +293,11 @@ impl MipMap<Vec3> {
         Self::from_rgb32f(img.into_rgb32f(), srgb)
     }
 
-    fn from_rgb32f(rgb: image::Rgb32FImage, srgb: bool) -> Result<Self, TextureError> {
+    /// [`from_image`](Self::from_image) of an RGB float image, consumed.
+    pub(super) fn from_rgb32f(rgb: image::Rgb32FImage, srgb: bool) -> Result<Self, TextureError> {
         let (w, h) = rgb.dimensions();
         let mut raw = rgb.into_raw();
+        check_finite(&raw, w, 3)?;
         for v in &mut raw {
             *v = sanitize(if srgb { srgb_to_linear(*v) } else { *v });
         }
@@ -291,10 +311,11 @@ impl MipMap<f32> {
     /// A grey pyramid of the image's **raw** grey values in [0, 1] (for 8/16-bit images), with no
     /// sRGB decoding: heights are data, and a grey ramp in the file stays a linear ramp. Colour
     /// images are reduced to the `image` crate's Rec. 709 luma of the stored values. Float values
-    /// are clamped to ±[`MAX_TEXEL`], NaN to 0.
+    /// are clamped to ±[`MAX_TEXEL`].
     ///
     /// # Errors
-    /// [`TextureError::Empty`] for a zero-sized image.
+    /// [`TextureError::Empty`] for a zero-sized image, [`TextureError::NonFinite`] for NaN or
+    /// infinite values.
     pub fn from_image_grey(img: &DynamicImage) -> Result<Self, TextureError> {
         Self::from_luma32f(img.to_luma32f())
     }
@@ -331,6 +352,7 @@ impl MipMap<f32> {
     ) -> Result<Self, TextureError> {
         let (w, h) = grey.dimensions();
         let mut raw = grey.into_raw();
+        check_finite(&raw, w, 1)?;
         for v in &mut raw {
             *v = sanitize(*v);
         }
@@ -559,29 +581,56 @@ mod tests {
     }
 
     #[test]
-    fn non_finite_float_texels_are_sanitised() {
-        let img = image::DynamicImage::ImageRgb32F(
-            image::Rgb32FImage::from_raw(
-                2,
-                1,
-                vec![f32::NAN, f32::INFINITY, -f32::INFINITY, 0.5, 1e30, -2.0],
-            )
-            .unwrap(),
-        );
-        let mut exr = Vec::new();
-        img.write_to(&mut Cursor::new(&mut exr), image::ImageFormat::OpenExr)
-            .unwrap();
+    fn non_finite_float_texels_are_refused_and_huge_ones_clamped() {
+        let exr_of = |texels: Vec<f32>| {
+            let img = image::DynamicImage::ImageRgb32F(
+                image::Rgb32FImage::from_raw(2, 2, texels).unwrap(),
+            );
+            let mut exr = Vec::new();
+            img.write_to(&mut Cursor::new(&mut exr), image::ImageFormat::OpenExr)
+                .unwrap();
+            (img, exr)
+        };
+        // Texels (0,0) fine, (1,0) has +inf in green, (0,1) fine, (1,1) NaN in blue.
+        let (img, exr) = exr_of(vec![
+            0.5,
+            0.5,
+            0.5,
+            1.0,
+            f32::INFINITY,
+            0.0,
+            0.2,
+            0.2,
+            0.2,
+            0.0,
+            0.0,
+            f32::NAN,
+        ]);
+        for result in [
+            MipMap::from_image(&img, false),
+            MipMap::from_bytes(&exr, false),
+            MipMap::from_bytes(&exr, true),
+        ] {
+            let Err(TextureError::NonFinite { x, y, value, count }) = result else {
+                panic!("{result:?}")
+            };
+            assert_eq!((x, y, value, count), (1, 0, f32::INFINITY, 2));
+        }
+        assert!(matches!(
+            MipMap::from_bytes_grey(&exr),
+            Err(TextureError::NonFinite { x: 1, y: 0, .. })
+        ));
+        // Finite but huge values are clamped to ±MAX_TEXEL; negative ones kept by the pyramid.
+        let (img, exr) = exr_of(vec![
+            1e30, -1e30, -2.0, 0.5, 0.5, 0.5, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0,
+        ]);
         for m in [
             MipMap::from_image(&img, false).unwrap(),
             MipMap::from_bytes(&exr, false).unwrap(),
         ] {
-            assert_eq!(m.texel(0, 0, 0), Vec3::new(0.0, MAX_TEXEL, -MAX_TEXEL));
-            assert_eq!(m.texel(0, 1, 0), Vec3::new(0.5, MAX_TEXEL, -2.0));
+            assert_eq!(m.texel(0, 0, 0), Vec3::new(MAX_TEXEL, -MAX_TEXEL, -2.0));
             assert!(m.lookup(Vec2::new(0.5, 0.5), 0.7).is_finite());
         }
-        let g = MipMap::from_bytes_grey(&exr).unwrap();
-        assert!(g.texel(0, 0, 0).is_finite() && g.texel(0, 1, 0).is_finite());
-        // sRGB decoding of huge or negative float values stays finite too.
         let m = MipMap::from_bytes(&exr, true).unwrap();
         assert!((0..2).all(|i| m.texel(0, i, 0).is_finite()));
     }

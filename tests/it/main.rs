@@ -17,5 +17,6 @@ mod path_tracer;
 mod primitives;
 mod queries;
 mod render_snapshots;
+mod reported;
 mod textures;
 mod watertight;
