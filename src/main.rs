@@ -159,9 +159,29 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("{e}");
+            eprintln!("{}", error_text(&e));
             ExitCode::from(e.exit_code() as u8)
         }
+    }
+}
+
+/// The message of a failed command, every error line starting with `error:` (scene diagnostics
+/// already carry their own `error:` lines; an interruption is reported as `interrupted:`).
+fn error_text(e: &Error) -> String {
+    let text = e.to_string();
+    match e {
+        Error::Scene(caustic::scene::SceneError::Invalid(_)) | Error::Interrupted(_) => text,
+        _ if text.starts_with("error:") => text,
+        _ => format!("error: {text}"),
+    }
+}
+
+/// `n` and the noun, singular for 1: "1 light", "2 lights".
+fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
     }
 }
 
@@ -176,19 +196,14 @@ fn cmd_check(args: &SceneArgs) -> Result<(), Error> {
     print_warnings(&prepared.warnings);
     let s = &prepared.stats;
     println!(
-        "{}: ok ({} triangles, {} spheres, {} ellipsoids, {} materials, {} lights; {} warning{})",
+        "{}: ok ({}, {}, {}, {}, {}; {})",
         args.scene.display(),
-        s.triangles,
-        s.spheres,
-        s.ellipsoids,
-        s.materials,
-        s.lights,
-        prepared.warnings.len(),
-        if prepared.warnings.len() == 1 {
-            ""
-        } else {
-            "s"
-        }
+        count(s.triangles, "triangle"),
+        count(s.spheres, "sphere"),
+        count(s.ellipsoids, "ellipsoid"),
+        count(s.materials, "material"),
+        count(s.lights, "light"),
+        count(prepared.warnings.len(), "warning"),
     );
     Ok(())
 }
@@ -345,14 +360,14 @@ fn cmd_render(args: &RenderArgs) -> Result<(), Error> {
     let s = &prepared.stats;
     if args.stats {
         eprintln!(
-            "scene: {} triangles ({} degenerate dropped), {} spheres, {} ellipsoids, {} materials, {} lights, {} OBJ files",
-            s.triangles,
-            s.degenerate_triangles,
-            s.spheres,
-            s.ellipsoids,
-            s.materials,
-            s.lights,
-            s.meshes_loaded
+            "scene: {} ({} dropped), {}, {}, {}, {}, {}",
+            count(s.triangles, "triangle"),
+            count(s.degenerate_triangles, "degenerate triangle"),
+            count(s.spheres, "sphere"),
+            count(s.ellipsoids, "ellipsoid"),
+            count(s.materials, "material"),
+            count(s.lights, "light"),
+            count(s.meshes_loaded, "OBJ file"),
         );
         eprintln!(
             "bvh: {} nodes, {} leaves, depth {}, max leaf {}, SAH cost {:.2}; flatten {:.3} s, build {:.3} s",
@@ -454,22 +469,12 @@ fn cmd_debug_pixel(args: &DebugPixelArgs) -> Result<(), Error> {
 }
 
 fn cmd_compare(image: &Path, reference: &Path) -> Result<(), Error> {
-    use caustic::render::metrics::{compare, read_film};
-    let read = |p: &Path| {
-        read_film(p).map_err(|e| Error::Usage(format!("error: cannot read `{}`: {e}", p.display())))
-    };
-    let (a, b) = (read(image)?, read(reference)?);
-    let e = compare(&a, &b).ok_or_else(|| {
-        Error::Usage(format!(
-            "error: `{}` is {}×{} but `{}` is {}×{}",
-            image.display(),
-            a.width,
-            a.height,
-            reference.display(),
-            b.width,
-            b.height
-        ))
-    })?;
+    let c = caustic::render::metrics::compare_files(image, reference)
+        .map_err(|e| Error::Usage(e.to_string()))?;
+    if let Some(note) = &c.note {
+        eprintln!("{note}");
+    }
+    let e = c.error;
     println!(
         "rmse {:.6}  relMSE {:.6}  max |diff| {:.6}  mean bias {:+.6}",
         e.rmse, e.rel_mse, e.max_abs, e.mean_bias
