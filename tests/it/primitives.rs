@@ -105,6 +105,7 @@ fn only_used_materials_are_compiled() {
 }
 
 #[test]
+#[allow(clippy::excessive_precision, clippy::inconsistent_digit_grouping)] // pbrt's exact values
 fn a_needle_triangle_is_dropped_so_the_ray_that_grazes_it_misses() {
     // pbrt-v4's "bad case": three collinear vertices (in f32) and a ray that the bare
     // intersector reports as a hit. Compiled from an OBJ, the triangle is dropped as degenerate
