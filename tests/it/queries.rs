@@ -84,7 +84,7 @@ fn closest_hit_and_any_hit_agree_with_brute_force() {
                     "closest: {o} {d} {t_max}: bvh {closest:?}, brute {all:?}"
                 ));
             }
-            if g.occluded(&ray) != !all.is_empty() {
+            if g.occluded(&ray) == all.is_empty() {
                 failures.push(format!("any: {o} {d} {t_max}: brute {all:?}"));
             }
             if all.is_empty() {
