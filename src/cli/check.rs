@@ -3,7 +3,7 @@
 use caustic::Error;
 use caustic::pipeline::prepare;
 
-use super::{SceneArgs, print_warnings};
+use super::{SceneArgs, count, print_warnings};
 
 /// Reports every error of the scene, or a one-line summary of what it holds.
 pub fn run(args: &SceneArgs) -> Result<(), Error> {
@@ -11,19 +11,14 @@ pub fn run(args: &SceneArgs) -> Result<(), Error> {
     print_warnings(&prepared.warnings);
     let s = &prepared.stats;
     println!(
-        "{}: ok ({} triangles, {} spheres, {} ellipsoids, {} materials, {} lights; {} warning{})",
+        "{}: ok ({}, {}, {}, {}, {}; {})",
         args.scene.display(),
-        s.triangles,
-        s.spheres,
-        s.ellipsoids,
-        s.materials,
-        s.lights,
-        prepared.warnings.len(),
-        if prepared.warnings.len() == 1 {
-            ""
-        } else {
-            "s"
-        }
+        count(s.triangles, "triangle"),
+        count(s.spheres, "sphere"),
+        count(s.ellipsoids, "ellipsoid"),
+        count(s.materials, "material"),
+        count(s.lights, "light"),
+        count(prepared.warnings.len(), "warning"),
     );
     Ok(())
 }

@@ -1,11 +1,10 @@
 //! `caustic compare`: error figures of an image against a reference.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use clap::Args;
 
 use caustic::Error;
-use caustic::render::metrics::{compare, read_film};
 
 /// Arguments of `caustic compare`.
 #[derive(Args)]
@@ -18,22 +17,12 @@ pub struct CompareArgs {
 
 /// Prints RMSE, relMSE, the largest difference and the mean bias.
 pub fn run(args: &CompareArgs) -> Result<(), Error> {
-    let (image, reference) = (&args.image, &args.reference);
-    let read = |p: &Path| {
-        read_film(p).map_err(|e| Error::Usage(format!("error: cannot read `{}`: {e}", p.display())))
-    };
-    let (a, b) = (read(image)?, read(reference)?);
-    let e = compare(&a, &b).ok_or_else(|| {
-        Error::Usage(format!(
-            "error: `{}` is {}×{} but `{}` is {}×{}",
-            image.display(),
-            a.width,
-            a.height,
-            reference.display(),
-            b.width,
-            b.height
-        ))
-    })?;
+    let c = caustic::render::metrics::compare_files(&args.image, &args.reference)
+        .map_err(|e| Error::Usage(e.to_string()))?;
+    if let Some(note) = &c.note {
+        eprintln!("{note}");
+    }
+    let e = c.error;
     println!(
         "rmse {:.6}  relMSE {:.6}  max |diff| {:.6}  mean bias {:+.6}",
         e.rmse, e.rel_mse, e.max_abs, e.mean_bias

@@ -130,6 +130,15 @@ impl SceneArgs {
     }
 }
 
+/// `n` and the noun, singular for 1: "1 light", "2 lights".
+fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 fn print_warnings(warnings: &[Diagnostic]) {
     for w in warnings {
         eprint!("{w}");

@@ -15,7 +15,7 @@ use caustic::render::output::{OutputFormat, write_image};
 use caustic::render::progressive::{CheckpointPlan, PassPlan, render_in_passes};
 use caustic::render::{Region, RenderError, RenderJob, RenderOptions};
 
-use super::{SceneArgs, print_warnings};
+use super::{SceneArgs, count, print_warnings};
 
 /// Samples per pixel a `--time` render may reach when `--spp` is not given.
 const BUDGET_SPP_CAP: u32 = 1 << 20;
@@ -201,6 +201,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             )));
         }
     }
+    // Refuse an output (or checkpoint) that cannot be written before doing any work.
+    for path in std::iter::once(&output).chain(&args.checkpoint) {
+        caustic::render::output::check_output_path(path)?;
+    }
     let region = args.region.as_deref().map(parse_region).transpose()?;
     if args.threads == Some(0) {
         return Err(Error::Usage("error: --threads must be at least 1".into()));
@@ -302,14 +306,14 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
 
 fn print_stats(s: &caustic::compile::CompileStats) {
     eprintln!(
-        "scene: {} triangles ({} degenerate dropped), {} spheres, {} ellipsoids, {} materials, {} lights, {} OBJ files",
-        s.triangles,
-        s.degenerate_triangles,
-        s.spheres,
-        s.ellipsoids,
-        s.materials,
-        s.lights,
-        s.meshes_loaded
+        "scene: {} ({} dropped), {}, {}, {}, {}, {}",
+        count(s.triangles, "triangle"),
+        count(s.degenerate_triangles, "degenerate triangle"),
+        count(s.spheres, "sphere"),
+        count(s.ellipsoids, "ellipsoid"),
+        count(s.materials, "material"),
+        count(s.lights, "light"),
+        count(s.meshes_loaded, "OBJ file"),
     );
     eprintln!(
         "bvh: {} nodes, {} leaves, depth {}, max leaf {}, SAH cost {:.2}; flatten {:.3} s, build {:.3} s",

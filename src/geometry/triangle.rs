@@ -282,9 +282,11 @@ mod tests {
             Vec3::new(-32.107_299_8, -183.355_865, -144.607_635),
         );
         ray.t_max = 0.9999;
-        // Its vertices are collinear in f32: the compiler drops it before it reaches the BVH.
+        // Its vertices are collinear in f32: the compiler drops it before it reaches the BVH
+        // (tests/it/primitives.rs checks that the ray then misses the scene). The intersector
+        // alone does report a hit on it, so the drop is what makes it missed.
         assert!(is_degenerate(p[0], p[1], p[2]));
-        let _ = intersect_triangle(&TriRay::new(&ray), p[0], p[1], p[2], ray.t_max);
+        assert!(intersect_triangle(&TriRay::new(&ray), p[0], p[1], p[2], ray.t_max).is_some());
     }
 
     #[test]

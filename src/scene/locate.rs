@@ -120,6 +120,24 @@ impl SourceIndex {
         Some(self.location_of_offset(offset))
     }
 
+    /// True if the whole of `path` names a value written in the text.
+    #[must_use]
+    pub fn contains(&self, path: &str) -> bool {
+        matches!(self.resolve(path), Some((_, true)))
+    }
+
+    /// Position of the payload of the enum variant at `path` (`(1, 2)` in `Scale((1, 2))`,
+    /// `[1, 2]` in `{ Scale = [1, 2] }`), or of the value itself when it is not a variant.
+    #[must_use]
+    pub fn locate_payload(&self, path: &str) -> Option<Location> {
+        let (node, complete) = self.resolve(path)?;
+        let node = match &self.nodes[node].wrapper {
+            Some(w) if complete => w.inner,
+            _ => node,
+        };
+        Some(self.location_of_offset(self.nodes[node].value))
+    }
+
     /// Converts a byte offset into a Location (line/column), clamped to the text.
     pub fn location_of_offset(&self, offset: usize) -> Location {
         let mut offset = offset.min(self.text.len());
@@ -307,6 +325,23 @@ fn toml_table(tree: &mut Tree, node: usize, table: &dyn TableLike, depth: usize)
 }
 
 // ---------------------------------------------------------------- RON
+
+/// The innermost `(`, `[` or `{` of RON `text` still open at the end of the text, as its byte
+/// offset and the bracket (comments and strings are skipped).
+#[must_use]
+pub fn ron_unclosed_bracket(text: &str) -> Option<(usize, char)> {
+    let mut open = Vec::new();
+    for token in lex(text) {
+        match token.tok {
+            Tok::Open(c) => open.push((token.start, char::from(c))),
+            Tok::Close(_) => {
+                open.pop();
+            }
+            _ => {}
+        }
+    }
+    open.pop()
+}
 
 #[derive(Debug, Clone, PartialEq)]
 enum Tok {
@@ -887,6 +922,23 @@ children = [
             "a@4:6 b@5:6 c@5:24 e@5:32 d[1]@6:13 d[4]@6:30 d[7]@6:47 \
             m.\"a.b\"@7:14 m.quo\"te@7:28 m.7@7:34 m.k.z@7:62 m.k.Some.z@7:62 m.k[0].z@7:62 f@8:6",
         );
+    }
+
+    #[test]
+    fn unclosed_brackets_and_payloads() {
+        assert_eq!(ron_unclosed_bracket("S(\n a: [1, 2],\n"), Some((1, '(')));
+        assert_eq!(ron_unclosed_bracket("S(a: [1, (2)\n"), Some((5, '[')));
+        assert_eq!(ron_unclosed_bracket("S(a: \"(\" /* [ */)"), None);
+        let index = ron("(t: [Scale((1, 2)), Translate(0, 1, 0)], s: 3)");
+        check(&index, false, "t[0]@1:6 t[1]@1:21");
+        let at = |p: &str| index.locate_payload(p).map(|l| l.column);
+        assert_eq!(
+            (at("t[0]"), at("t[1]"), at("s")),
+            (Some(12), Some(30), Some(45))
+        );
+        let index = toml("t = [{ Scale = [1, 2] }]\n");
+        assert_eq!(index.locate_payload("t[0]").map(|l| l.column), Some(16));
+        assert!(index.contains("t[0]") && !index.contains("t[1]") && !index.contains("u"));
     }
 
     #[test]

@@ -1,8 +1,18 @@
 //! The bad-scene corpus: every `.ron`/`.toml` file in `tests/bad_scenes/` is an invalid scene that
-//! `caustic check` must refuse with exit code 2 and a useful message (never a panic). The message
-//! of each is snapshotted in `tests/it/snapshots/bad_scenes/`, and the file's first line (a comment
-//! saying what is wrong and what the message must name) is stored with the snapshot, so a
-//! reviewer sees the expectation next to the actual output.
+//! `caustic check` must refuse with exit code 2 and a useful message (never a panic).
+//!
+//! Each file states what its message must say, and the test checks it: line 1 is a comment saying
+//! what is wrong in words; the next lines are `expect:` headers, one per error the message must
+//! report, in order:
+//!
+//! ```text
+//! // expect: 11:51 | nodes[0].transform[0] | found `(1, 2)` | !did you mean
+//! ```
+//!
+//! `LINE:COLUMN` is where the caret must be (`-` for a message that must have no location); each
+//! `|`-separated text must appear in that error's block, and a text starting with `!` must not.
+//! The whole message is also snapshotted in `tests/it/snapshots/bad_scenes/`, so a reviewer sees
+//! the rendering next to the expectation.
 //!
 //! `caustic render` on a bad scene must exit 2 without creating or touching the output image.
 
@@ -64,19 +74,142 @@ fn file_name(path: &Path) -> String {
         .into_owned()
 }
 
-/// The file's first line without its comment marker, which states what the message must say.
-fn expectation(path: &Path) -> Option<String> {
-    let bytes = std::fs::read(crate_root().join(path)).expect("cannot read corpus file");
-    let first = bytes.split(|b| *b == b'\n').next().unwrap_or_default();
-    let first = String::from_utf8_lossy(first);
-    let marker = if path.extension() == Some(OsStr::new("ron")) {
+/// What one error of a bad scene's message must say.
+#[derive(Debug, Clone, PartialEq)]
+struct Expect {
+    /// Line and column of the caret, or `None` for an unlocated message.
+    at: Option<(usize, usize)>,
+    /// Texts the error must contain.
+    contains: Vec<String>,
+    /// Texts it must not contain.
+    absent: Vec<String>,
+}
+
+/// The comment marker of a corpus file.
+fn marker(path: &Path) -> &'static str {
+    if path.extension() == Some(OsStr::new("ron")) {
         "//"
     } else {
         "#"
+    }
+}
+
+/// The file's first line without its comment marker (what is wrong, in words), and its `expect:`
+/// headers.
+fn expectation(path: &Path) -> (Option<String>, Vec<Expect>) {
+    let bytes = std::fs::read(crate_root().join(path)).expect("cannot read corpus file");
+    let text = String::from_utf8_lossy(&bytes);
+    let marker = marker(path);
+    let mut lines = text.lines();
+    let description = lines
+        .next()
+        .and_then(|l| l.strip_prefix(marker))
+        .map(|rest| rest.trim().to_string());
+    let expects = lines
+        .map_while(|l| l.strip_prefix(marker)?.trim().strip_prefix("expect:"))
+        .map(|e| {
+            parse_expect(e)
+                .unwrap_or_else(|m| panic!("{}: bad `expect:` header: {m}", path.display()))
+        })
+        .collect();
+    (description, expects)
+}
+
+/// Parses `LINE:COLUMN | text | !absent text` (or `- | …`).
+fn parse_expect(header: &str) -> Result<Expect, String> {
+    let mut parts = header.split(" | ").map(str::trim);
+    let at = parts.next().ok_or("empty header")?;
+    let at = if at == "-" {
+        None
+    } else {
+        let (line, col) = at
+            .split_once(':')
+            .ok_or(format!("`{at}` is not LINE:COLUMN or -"))?;
+        let num = |s: &str| s.parse::<usize>().map_err(|e| format!("`{at}`: {e}"));
+        Some((num(line)?, num(col)?))
     };
-    first
-        .strip_prefix(marker)
-        .map(|rest| rest.trim().to_string())
+    let (mut contains, mut absent) = (Vec::new(), Vec::new());
+    for part in parts {
+        match part.strip_prefix('!') {
+            Some(not) => absent.push(not.to_string()),
+            None => contains.push(part.to_string()),
+        }
+    }
+    if contains.is_empty() {
+        return Err("no text the message must contain".into());
+    }
+    Ok(Expect {
+        at,
+        contains,
+        absent,
+    })
+}
+
+/// The error blocks of a message: each starts at an `error:` line and runs to the next
+/// `error:`/`warning:` line or the closing count.
+fn error_blocks(stderr: &str) -> Vec<String> {
+    let mut blocks: Vec<(bool, String)> = Vec::new();
+    for line in stderr.lines() {
+        if line.starts_with("error:") || line.starts_with("warning:") {
+            blocks.push((line.starts_with("error:"), String::new()));
+        } else if line.ends_with(" found") && !line.starts_with(' ') {
+            continue;
+        }
+        if let Some((_, block)) = blocks.last_mut() {
+            block.push_str(line);
+            block.push('\n');
+        }
+    }
+    blocks
+        .into_iter()
+        .filter_map(|(is_error, b)| is_error.then_some(b))
+        .collect()
+}
+
+/// Every way `stderr` (the message for corpus file `path`) falls short of `expects`.
+fn unmet(path: &Path, expects: &[Expect], stderr: &str) -> Vec<String> {
+    let blocks = error_blocks(stderr);
+    let mut problems = Vec::new();
+    if blocks.len() != expects.len() {
+        problems.push(format!(
+            "{} errors reported, {} expected",
+            blocks.len(),
+            expects.len()
+        ));
+    }
+    let count = match blocks.len() {
+        1 => "1 error found".to_string(),
+        n => format!("{n} errors found"),
+    };
+    if !stderr.trim_end().ends_with(&count) {
+        problems.push(format!("the message does not end with `{count}`"));
+    }
+    for (i, (expect, block)) in expects.iter().zip(&blocks).enumerate() {
+        let at = block
+            .lines()
+            .find_map(|l| l.trim_start().strip_prefix("--> "))
+            .map(str::to_string);
+        let want = expect
+            .at
+            .map(|(line, col)| format!("{}:{line}:{col}", path.display()));
+        if at != want {
+            problems.push(format!(
+                "error {}: located at {at:?}, expected {want:?}",
+                i + 1
+            ));
+        }
+        for text in &expect.contains {
+            if !block.contains(text.as_str()) {
+                problems.push(format!("error {}: does not say `{text}`", i + 1));
+            }
+        }
+        for text in &expect.absent {
+            if block.contains(text.as_str()) {
+                problems.push(format!("error {}: says `{text}`, which it must not", i + 1));
+            }
+        }
+    }
+    problems
 }
 
 fn exit_code(out: &Output) -> Option<i32> {
@@ -86,10 +219,25 @@ fn exit_code(out: &Output) -> Option<i32> {
 /// Checks one corpus file; panics with a message naming it on any failure.
 fn check_one(path: &Path) {
     let name = file_name(path);
-    let description = expectation(path);
+    let (description, mut expects) = expectation(path);
+    if NO_COMMENT.contains(&name.as_str()) {
+        // An empty file cannot state its expectation: it is here.
+        expects = vec![Expect {
+            at: None,
+            contains: vec![
+                "is empty".into(),
+                "`camera`, `materials` and `nodes`".into(),
+            ],
+            absent: Vec::new(),
+        }];
+    }
     assert!(
         description.is_some() || NO_COMMENT.contains(&name.as_str()),
         "{name}: the first line must be a comment saying what is wrong and what the message must name"
+    );
+    assert!(
+        !expects.is_empty() || KNOWN_ACCEPTED.contains(&name.as_str()),
+        "{name}: line 2 must be an `expect:` header (see the top of tests/it/bad_scenes.rs)"
     );
     let out = caustic([OsStr::new("check"), path.as_os_str()]);
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -121,6 +269,13 @@ fn check_one(path: &Path) {
     assert!(
         stdout.is_empty(),
         "{name}: a refused scene must print nothing on stdout, got:\n{stdout}"
+    );
+
+    let problems = unmet(path, &expects, &stderr);
+    assert!(
+        problems.is_empty(),
+        "{name}: the message does not meet the file's `expect:` headers:\n  {}\nstderr:\n{stderr}",
+        problems.join("\n  ")
     );
 
     let mut settings = insta::Settings::clone_current();
@@ -162,6 +317,40 @@ fn every_bad_scene_is_refused_with_a_located_message() {
         files.len(),
         failed.join(", ")
     );
+}
+
+#[test]
+fn the_expectation_check_catches_a_wrong_place_text_or_count() {
+    let path = Path::new("tests/bad_scenes/x.ron");
+    let stderr = "error: camera.fov_y: must be within (0, 180) degrees, found 0\n \
+                  --> tests/bad_scenes/x.ron:5:64\n  |\n5 | fov_y: 0\n  |        ^\n\n\
+                  warning: lights: the scene has no lights\n\n1 error found\n";
+    let good = parse_expect("5:64 | camera.fov_y | found 0 | !did you mean").unwrap();
+    assert_eq!(
+        unmet(path, std::slice::from_ref(&good), stderr),
+        Vec::<String>::new()
+    );
+    for (header, problem) in [
+        ("5:63 | camera.fov_y", "located at"),
+        ("6:64 | camera.fov_y", "located at"),
+        ("- | camera.fov_y", "located at"),
+        ("5:64 | camera.eye", "does not say `camera.eye`"),
+        ("5:64 | camera.fov_y | !found 0", "must not"),
+    ] {
+        let e = parse_expect(header).unwrap();
+        let got = unmet(path, &[e], stderr);
+        assert!(
+            got.len() == 1 && got[0].contains(problem),
+            "{header}: {got:?}"
+        );
+    }
+    let got = unmet(path, &[good.clone(), good], stderr);
+    assert!(
+        got.iter()
+            .any(|p| p.contains("1 errors reported, 2 expected")),
+        "{got:?}"
+    );
+    assert!(parse_expect("5:64").is_err() && parse_expect("x | a").is_err());
 }
 
 #[test]

@@ -104,7 +104,163 @@ fn exr_output_is_linear_float() {
     let out = caustic(&[&args[..], &[exr.to_str().expect("utf8")]].concat());
     assert!(out.status.success(), "{}", stderr(&out));
     let img = image::open(&exr).expect("EXR readable").into_rgb32f();
-    assert!(img.pixels().any(|p| p.0.iter().any(|c| *c > 0.0)));
+    // Exactly the film the library renders (f32 stored as f32), not merely "something positive".
+    let (film, _) = common::render_file(
+        &root().join("scenes/cornell.ron"),
+        &common::small(8, 8, 1),
+        &caustic::render::RenderOptions::default(),
+    );
+    let stored: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
+    let rendered: Vec<[f32; 3]> = film.pixels.iter().map(|p| p.to_array()).collect();
+    assert_eq!(stored, rendered);
+    assert!(
+        rendered.iter().flatten().filter(|c| **c > 0.0).count() > 8 * 8 * 3 / 2,
+        "the film itself must not be mostly black"
+    );
+}
+
+/// Renders the Cornell box small to `name` in `dir` with `seed`, returning the path as text.
+fn small_render(dir: &std::path::Path, name: &str, seed: &str) -> String {
+    let path = dir.join(name).to_str().expect("utf8").to_string();
+    let out = caustic(&[
+        "render",
+        "scenes/cornell.ron",
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--spp",
+        "2",
+        "--seed",
+        seed,
+        "--quiet",
+        "-o",
+        &path,
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    path
+}
+
+/// The RMSE printed by `caustic compare`.
+fn compare_rmse(a: &str, b: &str) -> (f64, String) {
+    let out = caustic(&["compare", a, b]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let rmse = text
+        .split_whitespace()
+        .nth(1)
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no rmse in {text}"));
+    (rmse, stderr(&out))
+}
+
+#[test]
+fn compare_of_a_png_with_an_exr_compares_like_with_like() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let (png1, exr1) = (
+        small_render(dir.path(), "a.png", "1"),
+        small_render(dir.path(), "a.exr", "1"),
+    );
+    let (png2, exr2) = (
+        small_render(dir.path(), "b.png", "2"),
+        small_render(dir.path(), "b.exr", "2"),
+    );
+    // The same render as PNG and EXR: the EXR brought to 8-bit range is exactly the PNG.
+    let (same, note) = compare_rmse(&png1, &exr1);
+    assert_eq!(same, 0.0, "{note}");
+    assert!(note.contains("clamped to [0, 1]"), "{note}");
+    // Two seeds: PNG against EXR gives the PNG-against-PNG figure, in either order (the
+    // light seen directly is ~80 in the EXR and would otherwise dominate).
+    let (png_png, _) = compare_rmse(&png1, &png2);
+    let (png_exr, _) = compare_rmse(&png1, &exr2);
+    let (exr_png, _) = compare_rmse(&exr1, &png2);
+    assert!(png_png > 0.0);
+    assert_eq!((png_exr, exr_png), (png_png, png_png));
+    // Two EXRs keep their unclamped figures, larger here because of the light.
+    let (exr_exr, note) = compare_rmse(&exr1, &exr2);
+    assert!(
+        note.is_empty() && exr_exr > png_png,
+        "{exr_exr} {png_png} {note}"
+    );
+}
+
+#[test]
+fn every_error_line_starts_with_error() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let p = dir.path().join("x.png");
+    let p = p.to_str().expect("utf8");
+    for args in [
+        vec!["check", "scenes/no_such_scene.ron"],
+        vec!["render", "scenes/no_such_scene.ron", "-o", p],
+        vec!["render", "scenes/cornell.ron", "-o", p, "--region", "1,2"],
+        vec![
+            "render",
+            "scenes/cornell.ron",
+            "-o",
+            p,
+            "--region",
+            "60,60,10,10",
+            "--width",
+            "64",
+        ],
+        vec!["render", "scenes/cornell.ron", "-o", "x.jpg"],
+        vec!["render", "README.md", "-o", p],
+        vec!["compare", "no_such.png", "no_such.exr"],
+        vec!["check", "tests/bad_scenes/zero_ior.toml"],
+        vec!["render", "scenes/cornell.ron", "-o", p, "--threads", "0"],
+    ] {
+        let out = caustic(&args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        let first = err.lines().next().unwrap_or_default();
+        assert!(first.starts_with("error: "), "{args:?}: {err}");
+        assert!(!first.starts_with("error: error:"), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn counts_read_as_english() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let scene = dir.path().join("one.ron");
+    std::fs::write(
+        &scene,
+        "Scene(camera: Pinhole(eye: (0, 0, 5), look_at: (0, 0, 0), fov_y: 40), \
+         materials: { \"m\": () }, lights: [Point(position: (0, 5, 5), power: (9, 9, 9))], \
+         nodes: [Sphere(material: \"m\"), Quad(material: \"m\", transform: [Translate(0, -1, 0)])])",
+    )
+    .expect("write");
+    let s = scene.to_str().expect("utf8");
+    let out = caustic(&["check", s]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.ends_with(
+            "ok (2 triangles, 1 sphere, 0 ellipsoids, 1 material, 1 light; 0 warnings)\n"
+        ),
+        "{text}"
+    );
+    let png = dir.path().join("one.png");
+    let out = caustic(&[
+        "render",
+        s,
+        "--stats",
+        "--width",
+        "4",
+        "--height",
+        "4",
+        "--spp",
+        "1",
+        "--quiet",
+        "-o",
+        png.to_str().expect("utf8"),
+    ]);
+    let err = stderr(&out);
+    assert!(
+        err.contains(
+            "scene: 2 triangles (0 degenerate triangles dropped), 1 sphere, 0 ellipsoids, \
+             1 material, 1 light, 0 OBJ files"
+        ),
+        "{err}"
+    );
 }
 
 #[test]

@@ -297,6 +297,24 @@ mod cli {
             .and_then(|n| n.parse().ok())
             .expect("a sample count");
         assert!((1..4096).contains(&n), "{line}");
+        // Its content is exactly the first n samples of the 4096-spp render, as the library's
+        // job gives them (not a one-shot n-spp render: pixel jitter is stratified over a grid
+        // sized for all 4096 samples, so n of 4096 samples sit elsewhere than n of n).
+        let scene = super::cornell(&super::common::small(640, 480, 4096));
+        let mut job =
+            caustic::render::RenderJob::new(&scene, &super::options(2, None, None)).expect("job");
+        job.render_pass(n).expect("n samples");
+        let expected = caustic::render::output::to_srgb8(&job.snapshot(), scene.params.exposure);
+        let stored = img.into_rgb8();
+        let differing = stored
+            .pixels()
+            .zip(expected.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(
+            differing, 0,
+            "{differing} pixels of the {n}-sample checkpoint differ from the first {n} samples"
+        );
     }
 
     #[test]

@@ -103,3 +103,46 @@ fn only_used_materials_are_compiled() {
     assert_eq!(s.material_names, ["used"]);
     assert_eq!(stats.materials, 1);
 }
+
+#[test]
+#[allow(clippy::excessive_precision, clippy::inconsistent_digit_grouping)] // pbrt's exact values
+fn a_needle_triangle_is_dropped_so_the_ray_that_grazes_it_misses() {
+    // pbrt-v4's "bad case": three collinear vertices (in f32) and a ray that the bare
+    // intersector reports as a hit. Compiled from an OBJ, the triangle is dropped as degenerate
+    // and the ray misses; a proper triangle in the same file is kept and still hit.
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(
+        dir.path().join("needle.obj"),
+        "v -1113.45459 -79.049614 -56.2431908\nv -1113.45459 -87.0922699 -56.2431908\n\
+         v -1113.45459 -79.2090149 -56.2431908\n\
+         v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 4 5 6\n",
+    )
+    .expect("write obj");
+    let scene = dir.path().join("needle.ron");
+    std::fs::write(
+        &scene,
+        "Scene(camera: Pinhole(eye: (0, 0, 10), look_at: (0, 0, 0), fov_y: 40), \
+         materials: { \"m\": () }, nodes: [Mesh(material: \"m\", file: \"needle.obj\")])",
+    )
+    .expect("write scene");
+    let prepared = caustic::pipeline::prepare(&scene, &Default::default()).expect("prepares");
+    assert_eq!(
+        (
+            prepared.stats.triangles,
+            prepared.stats.degenerate_triangles
+        ),
+        (1, 1)
+    );
+    let g = &prepared.render_scene.geometry;
+    let mut ray = Ray::new(
+        Vec3::new(-1081.479_25, 99.999_954_2, 87.770_111_1),
+        Vec3::new(-32.107_299_8, -183.355_865, -144.607_635),
+    );
+    ray.t_max = 0.9999;
+    assert_eq!(g.intersect(&ray), None);
+    assert!(!g.occluded(&ray));
+    let h = g
+        .intersect(&Ray::new(Vec3::new(0.2, 0.2, 5.0), -Vec3::Z))
+        .expect("the proper triangle is kept");
+    assert!(close(h.t, 5.0), "{}", h.t);
+}

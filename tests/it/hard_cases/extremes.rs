@@ -44,6 +44,19 @@ fn light_power_scales_the_image_exactly() {
         worst < 1e-5,
         "bright/dim ratio deviates from 1e12 by {worst:e}"
     );
+    // Not a black image: the centre pixel sees the back wall at (0, 1, -1), lit directly by the
+    // point light at (0.5, 1.5, 1) (nothing in between): I = 1e6 / 4π, d² = 4.5, cos = 2 / √4.5,
+    // so white (0.75) diffuse gives 0.75 / π · I · cos / d² ≈ 3980 from that light alone. A
+    // quarter of that bounds it from below whatever the pixel's jitter and the other light.
+    let centre = bright.get(16, 16);
+    let expected =
+        0.75 / std::f32::consts::PI * (1e6 / (4.0 * std::f32::consts::PI)) * (2.0 / 4.5f32.sqrt())
+            / 4.5;
+    assert!((expected - 3980.0).abs() < 5.0, "{expected}");
+    assert!(
+        centre.min_element() > 0.25 * expected,
+        "centre pixel {centre} of the bright image is below a quarter of {expected}"
+    );
 }
 
 #[test]
@@ -88,15 +101,18 @@ fn minimal_settings_run_and_a_single_pixel_crop_matches() {
 fn albedo_one_mirrors_do_not_create_energy() {
     // Two facing perfect mirrors (albedo exactly 1) with a light between them: a camera ray
     // bouncing max_depth times may carry at most the light's radiance, never more.
+    // The light's mirror images lie at z = -2, -6, … on the line x = y = 0.5; the one at z = -6
+    // (three reflections) is seen 0.5 / 6.9 = tan 4.1° off-axis, 1.3 pixels in radius, so at
+    // least one pixel sees nothing but the light through the mirrors: exactly its radiance.
     let text = "Scene(render: (width: 16, height: 16, samples_per_pixel: 1, max_depth: 40),
         camera: Pinhole(eye: (0, 0, 0.9), look_at: (0, 0, -1), fov_y: 20),
         materials: { \"m\": (reflect: 1, color: (1, 1, 1)) },
-        lights: [Sphere(center: (0.5, 0.5, 0), radius: 0.05, power: (1, 1, 1))],
+        lights: [Sphere(center: (0.5, 0.5, 0), radius: 0.2, power: (1, 1, 1))],
         nodes: [Quad(material: \"m\", size: (4, 4), transform: [Translate(0, 0, -1)]),
                 Quad(material: \"m\", size: (4, 4), transform: [Translate(0, 0, 1)])])";
     let (img, st) = render_text(text);
     assert_eq!(st.nan_samples, 0);
-    let l_emit = 1.0 / (4.0 * std::f32::consts::PI.powi(2) * 0.05 * 0.05);
+    let l_emit = 1.0 / (4.0 * std::f32::consts::PI.powi(2) * 0.2 * 0.2);
     let max = img
         .pixels
         .iter()
@@ -105,5 +121,9 @@ fn albedo_one_mirrors_do_not_create_energy() {
     assert!(
         max <= l_emit * (1.0 + 1e-5),
         "max {max} > emitted radiance {l_emit}"
+    );
+    assert!(
+        max >= l_emit * (1.0 - 1e-5),
+        "max {max}: no pixel sees the light's image at its full radiance {l_emit}"
     );
 }
