@@ -393,15 +393,17 @@ fn mipmaps_remove_the_aliasing_of_a_grazing_floor() {
     let (e_bil, s_bil) = measure("Bilinear");
     let (e_tri, s_tri) = measure("Trilinear");
     let (e_ani, s_ani) = measure("Anisotropic");
-    assert!(e_tri < 0.6 * e_bil, "trilinear error {e_tri} vs {e_bil}");
-    assert!(e_ani < 0.6 * e_bil, "anisotropic error {e_ani} vs {e_bil}");
+    // The figures docs/textures.md states: mipmapped filters 2.7-3x closer (at least 2.5x
+    // asserted), shimmer 3x (anisotropic, at least 2.5x) and 9x (trilinear, at least 8x) less.
+    assert!(e_bil > 2.5 * e_tri, "trilinear error {e_tri} vs {e_bil}");
+    assert!(e_bil > 2.5 * e_ani, "anisotropic error {e_ani} vs {e_bil}");
     assert!(
         e_ani < e_tri,
         "anisotropic error {e_ani} vs trilinear {e_tri}"
     );
-    assert!(s_tri < 0.5 * s_bil, "trilinear shimmer {s_tri} vs {s_bil}");
+    assert!(s_bil > 8.0 * s_tri, "trilinear shimmer {s_tri} vs {s_bil}");
     assert!(
-        s_ani < 0.5 * s_bil,
+        s_bil > 2.5 * s_ani,
         "anisotropic shimmer {s_ani} vs {s_bil}"
     );
 }

@@ -267,3 +267,39 @@ fn a_glass_pane_passes_its_fresnel_transmittance_at_steep_and_shallow_angles() {
         assert!((got - t * t).abs() < 2e-3, "{angle}°: {got} vs {}", t * t);
     }
 }
+
+#[test]
+fn an_index_one_object_casts_no_shadow_to_two_parts_in_a_million() {
+    // docs/material.md: "an index-matched object is invisible, shadow included: checked to
+    // 2e-6". An index-1 sphere out of the camera's view (54° above it) but on the light's path:
+    // its shadow would cover much of the visible floor and the ball. Every pixel must match
+    // the render without it to 2e-6 of its value.
+    let without = still_life("", "");
+    let with = still_life(
+        r#"Sphere(material: "air", radius: 0.3, center: (1.6, 4.2, 2.6)),"#,
+        r#", "air": (color: (1, 1, 1), diffuse: 0, transmit: 1, ior: 1)"#,
+    );
+    let worst = with
+        .pixels
+        .iter()
+        .zip(&without.pixels)
+        .map(|(a, b)| ((*a - *b).abs().max_element() / b.max_element().max(1e-6)) as f64)
+        .fold(0.0, f64::max);
+    eprintln!("index-1 shadow: worst relative pixel difference {worst:e}");
+    assert!(worst <= 2e-6, "worst relative difference {worst:e}");
+    // Control: an opaque sphere in the same place does cast a shadow on the visible floor.
+    let opaque = still_life(
+        r#"Sphere(material: "floor", radius: 0.3, center: (1.6, 4.2, 2.6)),"#,
+        "",
+    );
+    let darker = opaque
+        .pixels
+        .iter()
+        .zip(&without.pixels)
+        .filter(|(a, b)| a.max_element() < 0.5 * b.max_element())
+        .count();
+    assert!(
+        darker > opaque.pixels.len() / 20,
+        "only {darker} pixels in the opaque sphere's shadow"
+    );
+}

@@ -1,7 +1,7 @@
 //! Perturbed shading normals (ripples, bump maps) at grazing angles and in the dark: no black
 //! speckles, no rays sent into surfaces, no NaN at singular points (hard cases B.9–B.11, B.13;
 //! B.12's light leak is prevented by requiring ωᵢ above the geometric normal, see
-//! `render/whitted.rs`).
+//! `render/whitted.rs`, and tested with controls that show the test could fail).
 //!
 //! Note: in this material model a back-facing shading normal would not by itself give black
 //! pixels (mirror and refraction fall back to the geometric normal, Lambert only tests the
@@ -282,4 +282,56 @@ fn zero_depth_and_zero_amplitude_bumps_are_bit_identical_to_none() {
     ] {
         assert!(render_with(bump) == none, "{bump} changed the image");
     }
+}
+
+/// A rippled diffuse floor lit only by a point light just below it, seen from above.
+fn floor_over_a_light(light_y: f32) -> RenderScene {
+    scene(&format!(
+        r#"Scene(
+            render: (width: 64, height: 48, samples_per_pixel: 2, seed: 3, max_depth: 4),
+            camera: Pinhole(eye: (0, 3, 3), look_at: (0, 0, 0), fov_y: 40),
+            textures: {{ {RIPPLES} }},
+            materials: {{ "floor": (color: (0.8, 0.8, 0.8), bump: "t") }},
+            lights: [Point(position: (0.3, {light_y}, 0.2), power: (5000, 5000, 5000))],
+            nodes: [Quad(material: "floor", size: (6, 6), transform: [RotateX(-90)])],
+        )"#
+    ))
+}
+
+#[test]
+fn a_light_below_a_bumped_floor_leaks_nothing() {
+    // B.12: the bumped shading normals lean towards a light below the floor, but light only
+    // counts when it is above the geometric normal too.
+    let below = floor_over_a_light(-0.05);
+    let (img, nans) = film(&below);
+    assert_eq!(nans, 0);
+    let lit = img.pixels.iter().filter(|p| p.max_element() > 0.0).count();
+    assert_eq!(lit, 0, "{lit} pixels lit through the floor");
+
+    // Control 1: the setup can leak. At many hits the normal actually shaded with faces the
+    // light below (ωᵢ above ns, below ng): a rule on the shading normal alone would light them.
+    let light = Vec3::new(0.3, -0.05, 0.2);
+    let (mut hits, mut would_leak) = (0u32, 0u32);
+    for_each_bumped_hit(&below, |b| {
+        hits += 1;
+        let wi = (light - b.sp.p).normalize();
+        let ns = below.shading_point(b.material, &b.sp, b.wo, 0.0).ns;
+        if ns.dot(wi) > 0.0 && b.sp.ng.dot(wi) < 0.0 {
+            would_leak += 1;
+        }
+    });
+    assert!(hits > 64 * 48 / 2, "the floor fills the view: {hits} hits");
+    assert!(
+        f64::from(would_leak) > 0.05 * f64::from(hits),
+        "only {would_leak} of {hits} shading normals face the light below: the test could not fail"
+    );
+
+    // Control 2: the same floor with the light just above it is lit almost everywhere, so the
+    // black image above is the rule at work, not a camera or measurement that sees nothing.
+    let (img, _) = film(&floor_over_a_light(0.05));
+    let lit = img.pixels.iter().filter(|p| p.max_element() > 0.0).count();
+    assert!(
+        lit > img.pixels.len() / 2,
+        "only {lit} pixels lit from above"
+    );
 }
