@@ -203,7 +203,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     }
     // Refuse an output (or checkpoint) that cannot be written before doing any work.
     for path in std::iter::once(&output).chain(&args.checkpoint) {
-        caustic::render::output::check_output_path(path)?;
+        caustic::render::output::check_writable(path)?;
     }
     let region = args.region.as_deref().map(parse_region).transpose()?;
     if args.threads == Some(0) {

@@ -171,6 +171,14 @@ fn bare(e: std::io::Error) -> std::io::Error {
 /// `path` and the folder at fault otherwise.
 pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
     OutputFormat::for_path(path)?;
+    check_writable(path)
+}
+
+/// The writability half of [`check_output_path`], for files of any kind (e.g. `.part` films).
+///
+/// # Errors
+/// [`OutputError::Unwritable`] naming `path` and the folder at fault.
+pub fn check_writable(path: &Path) -> Result<(), OutputError> {
     let refuse = |reason: String| OutputError::Unwritable {
         path: path.to_path_buf(),
         reason,

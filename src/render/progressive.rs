@@ -87,7 +87,9 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
             if left.as_secs_f64() < per_sample {
                 break;
             }
-            target = left;
+            // At most a tenth of the budget per pass: if the machine slows down (other work on
+            // its cores), the budget is overrun by at most one short pass.
+            target = left.min((budget / 10).max(MIN_PASS));
         }
         if let Some(cp) = &plan.checkpoint {
             if last_save.elapsed() >= cp.every {
