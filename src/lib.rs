@@ -25,6 +25,7 @@ pub mod bench;
 pub mod compile;
 pub mod error;
 pub mod geometry;
+pub mod photon;
 pub mod pipeline;
 pub mod render;
 pub mod render_scene;

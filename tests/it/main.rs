@@ -8,6 +8,7 @@ mod common;
 mod determinism;
 mod hard_cases;
 mod interrupt;
+mod kdtree;
 mod mutated_scenes;
 mod primitives;
 mod queries;
