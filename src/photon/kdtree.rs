@@ -85,7 +85,7 @@ pub struct BuildOptions {
 impl Default for BuildOptions {
     fn default() -> Self {
         Self {
-            leaf_size: 8,
+            leaf_size: 16,
             split_axis: SplitAxis::Widest,
         }
     }
@@ -281,32 +281,49 @@ fn widest_axis<T: HasPosition>(items: &[T]) -> usize {
     }
 }
 
-/// Lower bound on the squared distance from `q` to any point of `cell`: the query's per-axis
-/// offsets from the box, combined with the same operations, in the same order, as
-/// [`distance2`] (rounding is monotone, so the bound never exceeds an item's distance).
-#[inline]
-fn bound2(q: [f32; 3], cell: &Cell) -> f32 {
-    let off = |a: usize| {
-        if q[a] < cell[0][a] {
-            q[a] - cell[0][a]
-        } else if q[a] > cell[1][a] {
-            q[a] - cell[1][a]
-        } else {
-            0.0
-        }
-    };
-    let (x, y, z) = (off(0), off(1), off(2));
-    x * x + y * y + z * z
+/// A cell's box and the query's per-axis offsets from it (0 on axes where the query is inside).
+#[derive(Debug, Clone, Copy)]
+struct Region {
+    cell: Cell,
+    off: [f32; 3],
 }
 
-/// The boxes of a stem's two children.
+/// Distance from `q` to the interval `[lo, hi]` (0 inside). For any `p` in the interval,
+/// `|q − p| ≥` this in floating point too (rounding is monotone).
 #[inline]
-fn child_cells(cell: &Cell, stem: Stem) -> (Cell, Cell) {
-    let a = stem.axis as usize;
-    let (mut left, mut right) = (*cell, *cell);
-    left[1][a] = stem.left_max;
-    right[0][a] = stem.right_min;
-    (left, right)
+fn axis_offset(q: f32, lo: f32, hi: f32) -> f32 {
+    (lo - q).max(q - hi).max(0.0)
+}
+
+impl Region {
+    fn new(q: [f32; 3], cell: Cell) -> Self {
+        Self {
+            cell,
+            off: [0, 1, 2].map(|a| axis_offset(q[a], cell[0][a], cell[1][a])),
+        }
+    }
+
+    /// Lower bound on the squared distance from the query to any point of the cell: the offsets
+    /// combined with the same operations, in the same order, as [`distance2`], so the bound
+    /// never exceeds an item's distance.
+    #[inline]
+    fn bound2(&self) -> f32 {
+        let [x, y, z] = self.off;
+        x * x + y * y + z * z
+    }
+
+    /// The regions of a stem's two children: the cell cut at each half's plane, and the offset
+    /// on the stem's axis recomputed (the other two are the parent's).
+    #[inline]
+    fn children(&self, q: [f32; 3], stem: Stem) -> (Self, Self) {
+        let a = stem.axis as usize;
+        let (mut left, mut right) = (*self, *self);
+        left.cell[1][a] = stem.left_max;
+        left.off[a] = axis_offset(q[a], self.cell[0][a], stem.left_max);
+        right.cell[0][a] = stem.right_min;
+        right.off[a] = axis_offset(q[a], stem.right_min, self.cell[1][a]);
+        (left, right)
+    }
 }
 
 /// `max_dist2` as a search limit: NaN and negative give `None` (nothing can be found); −0 is +0.
@@ -359,7 +376,7 @@ impl<T: HasPosition> KdTree<T> {
         (self.root_half * 2).trailing_zeros()
     }
 
-    /// The root's cell, or `None` when `q` is not finite or the tree is empty.
+    /// The root's cell (the items' bounds), or `None` when `q` is not finite or the tree is empty.
     #[inline]
     fn root_cell(&self, q: [f32; 3]) -> Option<Cell> {
         (!self.items.is_empty() && q.iter().all(|c| c.is_finite())).then_some(self.bounds)
@@ -375,7 +392,8 @@ impl<T: HasPosition> KdTree<T> {
         let (Some(cell), Some(r2)) = (self.root_cell(q), radius_limit(max_dist2)) else {
             return 0;
         };
-        if heap.k() == 0 || bound2(q, &cell) > r2 {
+        let region = Region::new(q, cell);
+        if heap.k() == 0 || region.bound2() > r2 {
             return 0;
         }
         let search = Knn {
@@ -384,7 +402,7 @@ impl<T: HasPosition> KdTree<T> {
             // Accept iff key < open: distance² ≤ r2 at any slot (slots are below u32::MAX).
             open: key(r2, u32::MAX),
         };
-        search.node(0, self.root_half, 0, self.items.len(), &cell, heap);
+        search.node(0, self.root_half, 0, self.items.len(), &region, heap);
         heap.len()
     }
 
@@ -394,9 +412,10 @@ impl<T: HasPosition> KdTree<T> {
         let (Some(cell), Some(r2)) = (self.root_cell(q), radius_limit(max_dist2)) else {
             return;
         };
-        if bound2(q, &cell) <= r2 {
+        let region = Region::new(q, cell);
+        if region.bound2() <= r2 {
             let search = Within { tree: self, q, r2 };
-            search.node(0, self.root_half, 0, self.items.len(), &cell, &mut visit);
+            search.node(0, self.root_half, 0, self.items.len(), &region, &mut visit);
         }
     }
 
@@ -415,7 +434,15 @@ struct Knn<'a, T> {
 }
 
 impl<T: HasPosition> Knn<'_, T> {
-    fn node(&self, p: usize, half: usize, lo: usize, hi: usize, cell: &Cell, heap: &mut KnnHeap) {
+    fn node(
+        &self,
+        p: usize,
+        half: usize,
+        lo: usize,
+        hi: usize,
+        region: &Region,
+        heap: &mut KnnHeap,
+    ) {
         let tree = self.tree;
         if half == 0 {
             let mut limit = heap.limit(self.open);
@@ -428,22 +455,25 @@ impl<T: HasPosition> Knn<'_, T> {
             }
             return;
         }
-        let stem = tree.stems[p];
-        let (lc, rc) = child_cells(cell, stem);
+        let (lr, rr) = region.children(self.q, tree.stems[p]);
         let mid = lo + (hi - lo) / 2;
-        // Every item of a child has key ≥ (its bound, its first slot).
-        let lk = key(bound2(self.q, &lc), lo as u32);
-        let rk = key(bound2(self.q, &rc), mid as u32);
-        let left = (lk, p + 1, lo, mid, lc);
-        let right = (rk, p + half, mid, hi, rc);
-        let (first, second) = if lk <= rk {
-            (left, right)
+        let (left, right, child) = (p + 1, p + half, half / 2);
+        // Every item of a child has key ≥ (its bound, its first slot); nearer child first.
+        let lk = key(lr.bound2(), lo as u32);
+        let rk = key(rr.bound2(), mid as u32);
+        if lk <= rk {
+            if lk < heap.limit(self.open) {
+                self.node(left, child, lo, mid, &lr, heap);
+            }
+            if rk < heap.limit(self.open) {
+                self.node(right, child, mid, hi, &rr, heap);
+            }
         } else {
-            (right, left)
-        };
-        for (k, cp, clo, chi, cc) in [first, second] {
-            if k < heap.limit(self.open) {
-                self.node(cp, half / 2, clo, chi, &cc, heap);
+            if rk < heap.limit(self.open) {
+                self.node(right, child, mid, hi, &rr, heap);
+            }
+            if lk < heap.limit(self.open) {
+                self.node(left, child, lo, mid, &lr, heap);
             }
         }
     }
@@ -463,7 +493,7 @@ impl<T: HasPosition> Within<'_, T> {
         half: usize,
         lo: usize,
         hi: usize,
-        cell: &Cell,
+        region: &Region,
         visit: &mut F,
     ) {
         let tree = self.tree;
@@ -479,13 +509,13 @@ impl<T: HasPosition> Within<'_, T> {
             }
             return;
         }
-        let (lc, rc) = child_cells(cell, tree.stems[p]);
+        let (lr, rr) = region.children(self.q, tree.stems[p]);
         let mid = lo + (hi - lo) / 2;
-        if bound2(self.q, &lc) <= self.r2 {
-            self.node(p + 1, half / 2, lo, mid, &lc, visit);
+        if lr.bound2() <= self.r2 {
+            self.node(p + 1, half / 2, lo, mid, &lr, visit);
         }
-        if bound2(self.q, &rc) <= self.r2 {
-            self.node(p + half, half / 2, mid, hi, &rc, visit);
+        if rr.bound2() <= self.r2 {
+            self.node(p + half, half / 2, mid, hi, &rr, visit);
         }
     }
 }
@@ -500,8 +530,11 @@ mod tests {
             let pts: Vec<[f32; 3]> = (0..n).map(|i| [i as f32, 0.0, 0.0]).collect();
             let t = KdTree::build(pts).unwrap();
             let leaves = 1usize << t.depth();
-            assert!(n.div_ceil(leaves) <= 8, "n {n}");
-            assert!(leaves == 1 || n.div_ceil(leaves / 2) > 8, "n {n}: too deep");
+            assert!(n.div_ceil(leaves) <= 16, "n {n}");
+            assert!(
+                leaves == 1 || n.div_ceil(leaves / 2) > 16,
+                "n {n}: too deep"
+            );
             assert_eq!(t.stems.len(), leaves - 1);
         }
     }
