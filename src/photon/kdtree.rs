@@ -4,11 +4,12 @@
 //!
 //! **Shape.** Every interior node splits its range of items at the median (`select_nth_unstable`
 //! on the chosen axis; left half `⌊n/2⌋` items), so all leaves are at one depth `D`, the smallest
-//! with `⌈n / 2^D⌉ ≤ leaf_size`, and hold between `⌊n / 2^D⌋` and `⌈n / 2^D⌉` items. Item ranges
-//! are implicit (a node's range is found by halving its parent's on the way down) and stems are
-//! stored in pre-order, so a subtree's stems are one contiguous run: the left child of the stem at
-//! `p` is at `p + 1`, the right at `p + h` where `h = 2^(D − depth − 1)`. No pointers, no per-node
-//! allocation; the contiguous subtrees also let the build run in parallel, deterministically.
+//! with `⌈n / 2^D⌉ ≤ leaf_size`, and hold between `⌊n / 2^D⌋` and `⌈n / 2^D⌉` items (a leaf
+//! can be empty only when `leaf_size = 1`). Item ranges are implicit (a node's range is found by
+//! halving its parent's on the way down) and stems are stored in pre-order, so a subtree's stems
+//! are one contiguous run: the left child of the stem at `p` is at `p + 1`, the right at `p + h`
+//! where `h = 2^(D − depth − 1)`. No pointers, no per-node allocation; the contiguous subtrees
+//! also let the build run in parallel, deterministically.
 //!
 //! **Stems** keep two planes on their axis, the largest coordinate of the left half and the
 //! smallest of the right (the median item's), as a bounding interval hierarchy does (Wächter &
@@ -244,7 +245,9 @@ fn build_node<T: HasPosition + Send>(
             .iter()
             .map(|i| i.position()[axis])
             .fold(f32::NEG_INFINITY, f32::max),
-        right_min: right[0].position()[axis],
+        // The right half is never empty (n ≥ 1 at every stem), but an empty half costs nothing:
+        // its plane at ±∞ puts its cell out of every search's reach.
+        right_min: right.first().map_or(f32::INFINITY, |i| i.position()[axis]),
         axis: axis as u32,
     };
     let (left_stems, right_stems) = stems[1..].split_at_mut(half - 1);
