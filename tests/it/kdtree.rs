@@ -230,11 +230,16 @@ fn coincident_photons_tie_to_the_lowest_slots_without_scanning_the_map() {
         .collect();
     let tree = KdTree::build(photons).unwrap();
     let mut heap = KnnHeap::new(50);
-    let t0 = std::time::Instant::now();
-    for _ in 0..1000 {
-        assert_eq!(tree.nearest([0.25, 0.5, 0.8], 1.0, &mut heap), 50);
-    }
-    let per_query = t0.elapsed().as_secs_f64() / 1000.0;
+    // Fastest of ten batches, so a preemption on a loaded machine cannot fail the test.
+    let per_query = (0..10)
+        .map(|_| {
+            let t0 = std::time::Instant::now();
+            for _ in 0..100 {
+                assert_eq!(tree.nearest([0.25, 0.5, 0.8], 1.0, &mut heap), 50);
+            }
+            t0.elapsed().as_secs_f64() / 100.0
+        })
+        .fold(f64::INFINITY, f64::min);
     heap.sort();
     let slots: Vec<u32> = heap.iter().map(|n| n.index).collect();
     assert_eq!(slots, (0..50).collect::<Vec<u32>>());
