@@ -26,6 +26,7 @@ pub mod compile;
 pub mod error;
 pub mod geometry;
 pub mod integrators;
+pub mod photon;
 pub mod pipeline;
 pub mod render;
 pub mod render_scene;

@@ -11,6 +11,7 @@ mod doc_snippets;
 mod hard_cases;
 mod interrupt;
 mod light_transport;
+mod kdtree;
 mod mutated_scenes;
 mod passes;
 mod path_tracer;
