@@ -122,6 +122,12 @@ impl Light {
                 }
                 let dist = dist2.sqrt();
                 let radiance = intensity / dist2;
+                if !radiance.is_finite() {
+                    // A point light (almost) on the surface: its irradiance exceeds f32. Such a
+                    // point is never a pixel's whole story, and an infinite sample would be
+                    // dropped anyway; give no light rather than Inf.
+                    return None;
+                }
                 Some(LightSample {
                     wi: d / dist,
                     distance: dist,

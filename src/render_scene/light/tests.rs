@@ -310,3 +310,14 @@ fn emission_directions_and_positions_pass_chi2() {
         assert!(r.passes(alpha) && r.rejected == 0, "{label}: {r:?}");
     }
 }
+
+#[test]
+fn a_point_light_on_the_surface_gives_no_light_rather_than_infinity() {
+    // Power at the validation limit (1e30 W), the point 1e-20 away: intensity/d² overflows f32.
+    let l = Light::point(Vec3::new(0.0, 1e-20, 0.0), Vec3::splat(1e30));
+    assert!(l.sample_li(Vec3::ZERO, (0.5, 0.5)).is_none());
+    // A little further it is finite and exact.
+    let s = l.sample_li(Vec3::new(0.0, -1.0, 0.0), (0.5, 0.5)).unwrap();
+    assert!(s.radiance.is_finite());
+    assert!((s.radiance.x / (1e30 / (4.0 * std::f32::consts::PI)) - 1.0).abs() < 1e-5);
+}
