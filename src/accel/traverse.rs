@@ -106,15 +106,16 @@ fn sort2(a: &mut u32, b: &mut u32) {
 }
 
 impl Bvh {
-    /// Visits every leaf slot the ray may reach before `t_max`, nearest child first.
-    /// `test(slot, t_max)` intersects the primitive in `slot` and returns a closer distance on a
-    /// hit, which then shrinks the search. Returns the final `t_max`.
+    /// Visits every leaf the ray may reach before `t_max`, nearest child first.
+    /// `test(first, count, t_max)` intersects the primitives in slots `first .. first + count`
+    /// (`first` is a multiple of [`LEAF_BLOCK`](super::bvh::LEAF_BLOCK)) and returns the closest
+    /// distance it found below `t_max`, which then shrinks the search. Returns the final `t_max`.
     #[inline]
     pub fn closest(
         &self,
         ray: &RayBoxTest,
         t_max: f32,
-        test: impl FnMut(u32, f32) -> Option<f32>,
+        test: impl FnMut(u32, u32, f32) -> Option<f32>,
     ) -> f32 {
         if self.nodes.is_empty() {
             return t_max;
@@ -131,7 +132,7 @@ impl Bvh {
         &self,
         ray: &RayBoxTest,
         mut t_max: f32,
-        mut test: impl FnMut(u32, f32) -> Option<f32>,
+        mut test: impl FnMut(u32, u32, f32) -> Option<f32>,
     ) -> f32 {
         let nodes = &self.nodes[..];
         let mut stack = [Entry::default(); N];
@@ -195,12 +196,8 @@ impl Bvh {
                         continue;
                     }
                 }
-            } else {
-                for slot in index..index + count {
-                    if let Some(t) = test(slot, t_max) {
-                        t_max = t;
-                    }
-                }
+            } else if let Some(t) = test(index, count, t_max) {
+                t_max = t;
             }
             loop {
                 if sp == 0 {
@@ -216,9 +213,15 @@ impl Bvh {
         }
     }
 
-    /// True as soon as `test(slot, t_max)` reports a hit in any leaf the ray reaches before `t_max`.
+    /// True as soon as `test(first, count, t_max)` reports a hit among the primitives in slots
+    /// `first .. first + count` of a leaf the ray reaches before `t_max`.
     #[inline]
-    pub fn any(&self, ray: &RayBoxTest, t_max: f32, test: impl FnMut(u32, f32) -> bool) -> bool {
+    pub fn any(
+        &self,
+        ray: &RayBoxTest,
+        t_max: f32,
+        test: impl FnMut(u32, u32, f32) -> bool,
+    ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
@@ -234,7 +237,7 @@ impl Bvh {
         &self,
         ray: &RayBoxTest,
         t_max: f32,
-        mut test: impl FnMut(u32, f32) -> bool,
+        mut test: impl FnMut(u32, u32, f32) -> bool,
     ) -> bool {
         let nodes = &self.nodes[..];
         let mut stack = [(0u32, 0u32); N];
@@ -256,12 +259,8 @@ impl Bvh {
                     (index, count) = (node.index[c], node.count[c]);
                     continue;
                 }
-            } else {
-                for slot in index..index + count {
-                    if test(slot, t_max) {
-                        return true;
-                    }
-                }
+            } else if test(index, count, t_max) {
+                return true;
             }
             if sp == 0 {
                 return false;
@@ -371,6 +370,38 @@ mod tests {
         assert!(entry(far, Vec3::new(0.0, 0.5, 0.5), Vec3::X, f32::INFINITY).is_some());
     }
 
+    /// `Bvh::closest` with a per-slot test, in slot order (as a leaf callback would run it).
+    fn closest_slots(
+        bvh: &Bvh,
+        r: &RayBoxTest,
+        t_max: f32,
+        mut test: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> f32 {
+        bvh.closest(r, t_max, |first, count, mut t_max| {
+            assert_eq!(first as usize % crate::accel::bvh::LEAF_BLOCK, 0);
+            let mut found = None;
+            for slot in first..first + count {
+                if let Some(t) = test(slot, t_max) {
+                    t_max = t;
+                    found = Some(t);
+                }
+            }
+            found
+        })
+    }
+
+    /// `Bvh::any` with a per-slot test.
+    fn any_slots(
+        bvh: &Bvh,
+        r: &RayBoxTest,
+        t_max: f32,
+        mut test: impl FnMut(u32, f32) -> bool,
+    ) -> bool {
+        bvh.any(r, t_max, |first, count, t_max| {
+            (first..first + count).any(|slot| test(slot, t_max))
+        })
+    }
+
     fn brute_first(boxes: &[Aabb], o: Vec3, d: Vec3) -> Option<f32> {
         boxes
             .iter()
@@ -394,7 +425,7 @@ mod tests {
                 let o = Vec3::new(i as f32 / 126.0, j as f32 / 126.0, 2.0);
                 let d = Vec3::new(0.0, -0.0, -1.0);
                 let r = RayBoxTest::new(o, d);
-                let t = bvh.closest(&r, f32::INFINITY, |slot, tmax| {
+                let t = closest_slots(&bvh, &r, f32::INFINITY, |slot, tmax| {
                     let b = boxes[bvh.order[slot as usize] as usize];
                     entry(b, o, d, tmax)
                 });
@@ -402,7 +433,7 @@ mod tests {
                 if found != brute_first(&boxes, o, d) {
                     mismatches += 1;
                 }
-                let any = bvh.any(&r, f32::INFINITY, |slot, tmax| {
+                let any = any_slots(&bvh, &r, f32::INFINITY, |slot, tmax| {
                     entry(boxes[bvh.order[slot as usize] as usize], o, d, tmax).is_some()
                 });
                 if any != found.is_some() {
@@ -451,7 +482,7 @@ mod tests {
                 rng.next_f32() * 10.0,
             );
             let r = RayBoxTest::new(o, d);
-            let t = bvh.closest(&r, f32::INFINITY, |slot, tmax| {
+            let t = closest_slots(&bvh, &r, f32::INFINITY, |slot, tmax| {
                 entry(boxes[bvh.order[slot as usize] as usize], o, d, tmax)
             });
             let found = (t != f32::INFINITY).then_some(t);
@@ -477,7 +508,13 @@ mod tests {
         assert!(t0.elapsed().as_secs_f32() < 1.0);
         assert!(s.max_depth <= 20, "depth {}", s.max_depth);
         assert!(s.max_leaf_size <= 8);
-        let mut seen = bvh.order.clone();
+        assert_eq!(bvh.order.len() % crate::accel::bvh::LEAF_BLOCK, 0);
+        let mut seen: Vec<u32> = bvh
+            .order
+            .iter()
+            .copied()
+            .filter(|&o| o != crate::accel::bvh::PAD)
+            .collect();
         seen.sort_unstable();
         assert_eq!(seen, (0..100_000).collect::<Vec<u32>>());
     }
@@ -486,15 +523,15 @@ mod tests {
     fn empty_and_single_primitive_trees() {
         let r = RayBoxTest::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z);
         let bvh = Bvh::build(&[]);
-        assert_eq!(bvh.closest(&r, 5.0, |_, _| Some(1.0)), 5.0);
-        assert!(!bvh.any(&r, 5.0, |_, _| true));
+        assert_eq!(closest_slots(&bvh, &r, 5.0, |_, _| Some(1.0)), 5.0);
+        assert!(!any_slots(&bvh, &r, 5.0, |_, _| true));
         let one = Bvh::build(&[Aabb {
             min: Vec3::ZERO,
             max: Vec3::ONE,
         }]);
-        assert_eq!(one.closest(&r, 5.0, |_, _| Some(1.0)), 1.0);
-        assert!(one.any(&r, 5.0, |_, _| true));
+        assert_eq!(closest_slots(&one, &r, 5.0, |_, _| Some(1.0)), 1.0);
+        assert!(any_slots(&one, &r, 5.0, |_, _| true));
         let miss = RayBoxTest::new(Vec3::new(5.0, 5.0, -1.0), Vec3::Z);
-        assert!(!one.any(&miss, 5.0, |_, _| true));
+        assert!(!any_slots(&one, &miss, 5.0, |_, _| true));
     }
 }
