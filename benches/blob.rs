@@ -9,8 +9,11 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
+use caustic::accel::RayBoxTest;
+use caustic::accel::bvh::LEAF_BLOCK;
 use caustic::bench::blob::{BlobMesh, WorkloadRay, blob_mesh, primary_rays, secondary_rays};
 use caustic::geometry::Ray;
+use caustic::geometry::triangle::{TriRay, intersect_pack_k};
 use caustic::render_scene::geometry::{Geometry, GeometryBuilder, TriAttrs};
 use glam::{Vec2, Vec3};
 
@@ -167,6 +170,41 @@ fn option(name: &str) -> Option<String> {
     std::env::args().find_map(|a| a.strip_prefix(&prefix).map(str::to_owned))
 }
 
+/// Mean leaves visited and triangle packs tested per ray by closest-hit queries (for `--stats`).
+fn leaf_visits(g: &Geometry, rays: &[WorkloadRay]) -> (f64, f64) {
+    let (mut leaves, mut packs) = (0usize, 0usize);
+    for r in rays {
+        let ray = ray_of(r);
+        let tri = TriRay::new(&ray);
+        let boxes = RayBoxTest::new(ray.origin, ray.dir);
+        g.bvh.closest(&boxes, ray.t_max, |first, count, t_max| {
+            leaves += 1;
+            let mut best: Option<f32> = None;
+            for p in
+                first as usize / LEAF_BLOCK..(first + count).div_ceil(LEAF_BLOCK as u32) as usize
+            {
+                packs += 1;
+                let pack = &g.tri_packs[p];
+                let t = best.unwrap_or(t_max);
+                let h = match tri.dominant_axis() {
+                    0 => intersect_pack_k::<0>(&tri, pack, t),
+                    1 => intersect_pack_k::<1>(&tri, pack, t),
+                    _ => intersect_pack_k::<2>(&tri, pack, t),
+                };
+                let Some(h) = h else { continue };
+                for lane in 0..LEAF_BLOCK {
+                    if h.mask & (1 << lane) != 0 && best.is_none_or(|b| h.t[lane] < b) {
+                        best = Some(h.t[lane]);
+                    }
+                }
+            }
+            best
+        });
+    }
+    let n = rays.len().max(1) as f64;
+    (leaves as f64 / n, packs as f64 / n)
+}
+
 fn main() {
     let filter: Vec<String> = std::env::args()
         .skip(1)
@@ -220,6 +258,13 @@ fn main() {
         let sec_count = sec_hits.iter().flatten().count();
         let sec_sum: f64 = sec_hits.iter().flatten().map(|h| f64::from(h.0)).sum();
         let (_, occluded) = any_hit(&g, &secondary, 1);
+        if std::env::args().any(|a| a == "--stats") {
+            let (pl, pp) = leaf_visits(&g, &primary);
+            let (sl, sp) = leaf_visits(&g, &secondary);
+            eprintln!(
+                "{name}: per ray, leaves visited / packs tested: primary {pl:.2} / {pp:.2}, secondary {sl:.2} / {sp:.2}"
+            );
+        }
         let bs = g.bvh.stats();
         eprintln!(
             "{name}: bvh {} nodes, {} leaves (mean {:.2} prims), depth {}, SAH {:.1}",

@@ -21,24 +21,6 @@ fn blocks(n: u32) -> f32 {
     n.div_ceil(LEAF_BLOCK as u32) as f32
 }
 
-fn tune(name: &str, default: f32) -> f32 {
-    static T: std::sync::OnceLock<(f32, f32)> = std::sync::OnceLock::new();
-    let get = |n: &str, d: f32| {
-        std::env::var(n)
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(d)
-    };
-    let t = T.get_or_init(|| {
-        (
-            get("BVH_TRAV", TRAVERSAL_COST),
-            get("BVH_MAXLEAF", MAX_LEAF as f32),
-        )
-    });
-    let _ = default;
-    if name == "BVH_TRAV" { t.0 } else { t.1 }
-}
-
 struct Task {
     node: usize,
     start: usize,
@@ -196,14 +178,14 @@ fn sah_split(
     }
     let (cost, axis, boundary) = best?;
     let node_area = node_bounds.half_area();
-    let split_cost = tune("BVH_TRAV", TRAVERSAL_COST)
+    let split_cost = TRAVERSAL_COST
         + if node_area > 0.0 {
             cost / node_area
         } else {
             0.0
         };
     let leaf_cost = blocks(slice.len() as u32);
-    if slice.len() <= tune("BVH_MAXLEAF", MAX_LEAF as f32) as usize && split_cost >= leaf_cost {
+    if slice.len() <= MAX_LEAF && split_cost >= leaf_cost {
         return None;
     }
     let lo = centroid_bounds.min[axis];

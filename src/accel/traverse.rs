@@ -68,8 +68,21 @@ impl RayBoxTest {
     #[inline(always)]
     #[must_use]
     pub fn entries(&self, node: &Node4, t_max: f32) -> (u32, Vec4) {
+        self.entries_with(node, t_max, self.near)
+    }
+
+    /// The ray's octant: bit `axis` set if the near plane on `axis` is the max plane.
+    #[inline(always)]
+    fn octant(&self) -> usize {
+        self.near[0] | (self.near[1] << 1) | (self.near[2] << 2)
+    }
+
+    /// [`RayBoxTest::entries`] with the near planes given (`near[axis]` is 0 or 1); when they are
+    /// constants, the plane loads compile to fixed offsets.
+    #[inline(always)]
+    fn entries_with(&self, node: &Node4, t_max: f32, near: [usize; 3]) -> (u32, Vec4) {
         let slab = |axis: usize| {
-            let n = self.near[axis] & 1;
+            let n = near[axis] & 1;
             let b = &node.bounds[axis];
             let near = (b[n] - self.o[axis]) * self.inv[axis];
             let far = (b[n ^ 1] - self.o[axis]) * self.inv[axis];
@@ -98,6 +111,27 @@ fn key_t(k: u32) -> f32 {
     f32::from_bits(k & !3)
 }
 
+/// The near planes of octant `oct` (0..8), or the ray's own for `oct == 8` (the generic path).
+#[inline(always)]
+fn near_of<const OCT: usize>(ray: &RayBoxTest) -> [usize; 3] {
+    if OCT < 8 {
+        [OCT & 1, (OCT >> 1) & 1, (OCT >> 2) & 1]
+    } else {
+        ray.near
+    }
+}
+
+/// Starts loading a node that the traversal pushed for later: a plain load whose value is unused
+/// (the crate forbids `unsafe`, so there is no prefetch intrinsic), which the CPU runs ahead.
+#[inline(always)]
+fn touch(nodes: &[Node4], index: u32, count: u32) {
+    if count == 0
+        && let Some(n) = nodes.get(index as usize)
+    {
+        std::hint::black_box(n.bounds[0][0].x);
+    }
+}
+
 #[inline(always)]
 fn sort2(a: &mut u32, b: &mut u32) {
     let (lo, hi) = ((*a).min(*b), (*a).max(*b));
@@ -120,38 +154,48 @@ impl Bvh {
         if self.nodes.is_empty() {
             return t_max;
         }
-        if self.stack_need <= STACK_SMALL {
-            self.closest_with::<STACK_SMALL>(ray, t_max, test)
-        } else {
-            self.closest_with::<STACK_MAX>(ray, t_max, test)
+        if self.stack_need > STACK_SMALL {
+            return self.closest_with::<STACK_MAX, 8>(ray, t_max, test);
+        }
+        // One copy of the loop per ray octant, so the slab planes are fixed offsets.
+        match ray.octant() {
+            0 => self.closest_with::<STACK_SMALL, 0>(ray, t_max, test),
+            1 => self.closest_with::<STACK_SMALL, 1>(ray, t_max, test),
+            2 => self.closest_with::<STACK_SMALL, 2>(ray, t_max, test),
+            3 => self.closest_with::<STACK_SMALL, 3>(ray, t_max, test),
+            4 => self.closest_with::<STACK_SMALL, 4>(ray, t_max, test),
+            5 => self.closest_with::<STACK_SMALL, 5>(ray, t_max, test),
+            6 => self.closest_with::<STACK_SMALL, 6>(ray, t_max, test),
+            _ => self.closest_with::<STACK_SMALL, 7>(ray, t_max, test),
         }
     }
 
     #[inline(always)]
-    fn closest_with<const N: usize>(
+    fn closest_with<const N: usize, const OCT: usize>(
         &self,
         ray: &RayBoxTest,
         mut t_max: f32,
         mut test: impl FnMut(u32, u32, f32) -> Option<f32>,
     ) -> f32 {
         let nodes = &self.nodes[..];
+        let near_planes = near_of::<OCT>(ray);
         let mut stack = [Entry::default(); N];
         let mut sp = 0usize;
         let (mut index, mut count) = (0u32, 0u32);
         loop {
             if count == 0 {
                 let node = &nodes[index as usize];
-                let (mask, near) = ray.entries(node, t_max);
+                let (mask, near) = ray.entries_with(node, t_max, near_planes);
                 match mask.count_ones() {
                     0 => {}
                     1 => {
-                        let c = mask.trailing_zeros() as usize;
+                        let c = (mask.trailing_zeros() & 3) as usize;
                         (index, count) = (node.index[c], node.count[c]);
                         continue;
                     }
                     2 => {
-                        let a = mask.trailing_zeros() as usize;
-                        let b = 31 - mask.leading_zeros() as usize;
+                        let a = (mask.trailing_zeros() & 3) as usize;
+                        let b = ((31 - mask.leading_zeros()) & 3) as usize;
                         let (ta, tb) = (near[a], near[b]);
                         let (c, f, tf) = if ta <= tb { (a, b, tb) } else { (b, a, ta) };
                         stack[sp] = Entry {
@@ -159,6 +203,7 @@ impl Bvh {
                             count: node.count[f],
                             t: tf,
                         };
+                        touch(nodes, node.index[f], node.count[f]);
                         sp += 1;
                         (index, count) = (node.index[c], node.count[c]);
                         continue;
@@ -189,6 +234,7 @@ impl Bvh {
                                 count: node.count[c],
                                 t: key_t(kk),
                             };
+                            touch(nodes, node.index[c], node.count[c]);
                             sp += 1;
                         }
                         let c = (k0 & 3) as usize;
@@ -225,34 +271,44 @@ impl Bvh {
         if self.nodes.is_empty() {
             return false;
         }
-        if self.stack_need <= STACK_SMALL {
-            self.any_with::<STACK_SMALL>(ray, t_max, test)
-        } else {
-            self.any_with::<STACK_MAX>(ray, t_max, test)
+        if self.stack_need > STACK_SMALL {
+            return self.any_with::<STACK_MAX, 8>(ray, t_max, test);
+        }
+        match ray.octant() {
+            0 => self.any_with::<STACK_SMALL, 0>(ray, t_max, test),
+            1 => self.any_with::<STACK_SMALL, 1>(ray, t_max, test),
+            2 => self.any_with::<STACK_SMALL, 2>(ray, t_max, test),
+            3 => self.any_with::<STACK_SMALL, 3>(ray, t_max, test),
+            4 => self.any_with::<STACK_SMALL, 4>(ray, t_max, test),
+            5 => self.any_with::<STACK_SMALL, 5>(ray, t_max, test),
+            6 => self.any_with::<STACK_SMALL, 6>(ray, t_max, test),
+            _ => self.any_with::<STACK_SMALL, 7>(ray, t_max, test),
         }
     }
 
     #[inline(always)]
-    fn any_with<const N: usize>(
+    fn any_with<const N: usize, const OCT: usize>(
         &self,
         ray: &RayBoxTest,
         t_max: f32,
         mut test: impl FnMut(u32, u32, f32) -> bool,
     ) -> bool {
         let nodes = &self.nodes[..];
+        let near_planes = near_of::<OCT>(ray);
         let mut stack = [(0u32, 0u32); N];
         let mut sp = 0usize;
         let (mut index, mut count) = (0u32, 0u32);
         loop {
             if count == 0 {
                 let node = &nodes[index as usize];
-                let (mut mask, _) = ray.entries(node, t_max);
+                let (mut mask, _) = ray.entries_with(node, t_max, near_planes);
                 if mask != 0 {
-                    let c = mask.trailing_zeros() as usize;
+                    let c = (mask.trailing_zeros() & 3) as usize;
                     mask &= mask - 1;
                     while mask != 0 {
-                        let f = 31 - mask.leading_zeros() as usize;
+                        let f = ((31 - mask.leading_zeros()) & 3) as usize;
                         stack[sp] = (node.index[f], node.count[f]);
+                        touch(nodes, node.index[f], node.count[f]);
                         sp += 1;
                         mask &= !(1 << f);
                     }

@@ -189,7 +189,7 @@ impl TriPack4 {
 /// [`intersect_triangle_k`] loop would (meaningful only in `mask` lanes).
 #[derive(Debug, Clone, Copy)]
 pub struct PackHits {
-    /// Bit `l` set if lane `l` is hit.
+    /// Bit `l` set if lane `l` is hit (never 0).
     pub mask: u32,
     /// Ray parameter per lane.
     pub t: Vec4,
@@ -237,10 +237,14 @@ impl PackHits {
 /// [`intersect_triangle_k`] on four triangles at once (one per SIMD lane): the same operations
 /// in the same order per lane, so every lane's hit, distance and barycentrics are bit for bit
 /// those of the scalar test (Woop, Benthin & Wald, JCGT 2013, watertight). `KZ` must equal
-/// [`TriRay::dominant_axis`].
+/// [`TriRay::dominant_axis`]. `None` if no lane is hit.
 #[inline(always)]
 #[must_use]
-pub fn intersect_pack_k<const KZ: usize>(r: &TriRay, pack: &TriPack4, t_max: f32) -> PackHits {
+pub fn intersect_pack_k<const KZ: usize>(
+    r: &TriRay,
+    pack: &TriPack4,
+    t_max: f32,
+) -> Option<PackHits> {
     debug_assert_eq!(KZ, r.kz);
     let kz = KZ;
     let kx = (KZ + 1) % 3;
@@ -274,17 +278,8 @@ pub fn intersect_pack_k<const KZ: usize>(r: &TriRay, pack: &TriPack4, t_max: f32
     let det_neg = det.cmplt(zero);
     let det_pos = det.cmpgt(zero);
     let inside = !(neg & pos) & (det_neg | det_pos);
-    let none = PackHits {
-        mask: 0,
-        t: zero,
-        t_scaled: zero,
-        det: zero,
-        b0: zero,
-        b1: zero,
-        b2: zero,
-    };
     if !inside.any() {
-        return none;
+        return None;
     }
     let sz = Vec4::splat(r.sz);
     let (z0, z1, z2) = (p0z * sz, p1z * sz, p2z * sz);
@@ -294,7 +289,7 @@ pub fn intersect_pack_k<const KZ: usize>(r: &TriRay, pack: &TriPack4, t_max: f32
     let reject_pos = det_pos & (t_scaled.cmple(zero) | t_scaled.cmpgt(t_max_det));
     let mask: BVec4A = inside & !reject_neg & !reject_pos;
     if !mask.any() {
-        return none;
+        return None;
     }
     let inv_det = Vec4::ONE / det;
     let t = t_scaled * inv_det;
@@ -310,16 +305,19 @@ pub fn intersect_pack_k<const KZ: usize>(r: &TriRay, pack: &TriPack4, t_max: f32
     let delta_t = Vec4::splat(3.0)
         * (Vec4::splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
         * inv_det.abs();
-    let mask = mask & !t.cmple(delta_t);
-    PackHits {
-        mask: mask.bitmask(),
+    let mask = (mask & !t.cmple(delta_t)).bitmask();
+    if mask == 0 {
+        return None;
+    }
+    Some(PackHits {
+        mask,
         t,
         t_scaled,
         det,
         b0: e0 * inv_det,
         b1: e1 * inv_det,
         b2: e2 * inv_det,
-    }
+    })
 }
 
 /// The scalar test's f64 fallback for the lanes in `lanes` (an edge function exactly 0 in f32):
@@ -482,11 +480,12 @@ mod tests {
                 1 => intersect_pack_k::<1>(&r, &pack, t_max),
                 _ => intersect_pack_k::<2>(&r, &pack, t_max),
             };
+            let mask = h.map_or(0, |h| h.mask);
             for lane in 0..4 {
                 let scalar = group
                     .get(lane)
                     .and_then(|t| intersect_triangle(&r, t[0], t[1], t[2], t_max));
-                let simd = (h.mask & (1 << lane) != 0).then(|| h.hit(lane));
+                let simd = h.filter(|_| mask & (1 << lane) != 0).map(|h| h.hit(lane));
                 let bits = |x: Option<TriHit>| x.map(|x| [x.t, x.b0, x.b1, x.b2].map(f32::to_bits));
                 if bits(scalar) != bits(simd) {
                     bad += 1;

@@ -248,20 +248,15 @@ impl Geometry {
             return None;
         }
         let tri_ray = TriRay::new(ray);
-        match tri_ray.dominant_axis() {
-            0 => self.intersect_k::<0>(ray, &tri_ray),
-            1 => self.intersect_k::<1>(ray, &tri_ray),
-            _ => self.intersect_k::<2>(ray, &tri_ray),
-        }
-    }
-
-    #[inline(always)]
-    fn intersect_k<const KZ: usize>(&self, ray: &Ray, tri_ray: &TriRay) -> Option<Hit> {
         let box_ray = RayBoxTest::new(ray.origin, ray.dir);
         let mut best = None;
         self.bvh
             .closest(&box_ray, ray.t_max, |first, count, t_max| {
-                self.leaf_closest::<KZ>(first, count, tri_ray, ray, t_max, &mut best)
+                match tri_ray.dominant_axis() {
+                    0 => self.leaf_closest::<0>(first, count, &tri_ray, ray, t_max, &mut best),
+                    1 => self.leaf_closest::<1>(first, count, &tri_ray, ray, t_max, &mut best),
+                    _ => self.leaf_closest::<2>(first, count, &tri_ray, ray, t_max, &mut best),
+                }
             });
         best
     }
@@ -297,7 +292,9 @@ impl Geometry {
             return found;
         }
         for pack in first / LEAF_BLOCK..end.div_ceil(LEAF_BLOCK) {
-            let h = intersect_pack_k::<KZ>(tri_ray, &self.tri_packs[pack], t_max);
+            let Some(h) = intersect_pack_k::<KZ>(tri_ray, &self.tri_packs[pack], t_max) else {
+                continue;
+            };
             let mut mask = h.mask;
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
@@ -323,23 +320,7 @@ impl Geometry {
     #[inline]
     #[must_use]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if !ray.is_valid() {
-            return false;
-        }
-        let tri_ray = TriRay::new(ray);
-        match tri_ray.dominant_axis() {
-            0 => self.occluded_k::<0>(ray, &tri_ray),
-            1 => self.occluded_k::<1>(ray, &tri_ray),
-            _ => self.occluded_k::<2>(ray, &tri_ray),
-        }
-    }
-
-    #[inline(always)]
-    fn occluded_k<const KZ: usize>(&self, ray: &Ray, tri_ray: &TriRay) -> bool {
-        let box_ray = RayBoxTest::new(ray.origin, ray.dir);
-        self.bvh.any(&box_ray, ray.t_max, |first, count, t_max| {
-            self.leaf_any::<KZ>(first, count, tri_ray, ray, t_max, |_| true)
-        })
+        self.occluded_by(ray, |_| true)
     }
 
     /// True if some primitive for which `counts` is true blocks `ray` within
@@ -352,23 +333,13 @@ impl Geometry {
             return false;
         }
         let tri_ray = TriRay::new(ray);
-        match tri_ray.dominant_axis() {
-            0 => self.occluded_by_k::<0>(ray, &tri_ray, &counts),
-            1 => self.occluded_by_k::<1>(ray, &tri_ray, &counts),
-            _ => self.occluded_by_k::<2>(ray, &tri_ray, &counts),
-        }
-    }
-
-    #[inline(always)]
-    fn occluded_by_k<const KZ: usize>(
-        &self,
-        ray: &Ray,
-        tri_ray: &TriRay,
-        counts: &impl Fn(PrimRef) -> bool,
-    ) -> bool {
         let box_ray = RayBoxTest::new(ray.origin, ray.dir);
         self.bvh.any(&box_ray, ray.t_max, |first, count, t_max| {
-            self.leaf_any::<KZ>(first, count, tri_ray, ray, t_max, counts)
+            match tri_ray.dominant_axis() {
+                0 => self.leaf_any::<0>(first, count, &tri_ray, ray, t_max, &counts),
+                1 => self.leaf_any::<1>(first, count, &tri_ray, ray, t_max, &counts),
+                _ => self.leaf_any::<2>(first, count, &tri_ray, ray, t_max, &counts),
+            }
         })
     }
 
@@ -398,7 +369,10 @@ impl Geometry {
             });
         }
         (first / LEAF_BLOCK..end.div_ceil(LEAF_BLOCK)).any(|pack| {
-            let mut mask = intersect_pack_k::<KZ>(tri_ray, &self.tri_packs[pack], t_max).mask;
+            let Some(h) = intersect_pack_k::<KZ>(tri_ray, &self.tri_packs[pack], t_max) else {
+                return false;
+            };
+            let mut mask = h.mask;
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
