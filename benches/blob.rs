@@ -3,16 +3,21 @@
 //! figures compare with Embree 3.13's `rtcIntersect1` / `rtcOccluded1` on the same machine kind.
 //!
 //! Run: `cargo bench --bench blob` (both meshes) or `cargo bench --bench blob -- blob100k`.
+//! Options: `--threads=1,2` (default both), `--reps=5` (default 5; 1 for a quick run, e.g. under
+//! `valgrind --tool=callgrind`, where instruction counts compare variants deterministically).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
+use caustic::accel::RayBoxTest;
+use caustic::accel::bvh::LEAF_BLOCK;
 use caustic::bench::blob::{BlobMesh, WorkloadRay, blob_mesh, primary_rays, secondary_rays};
 use caustic::geometry::Ray;
+use caustic::geometry::triangle::{TriRay, intersect_pack_k};
 use caustic::render_scene::geometry::{Geometry, GeometryBuilder, TriAttrs};
 use glam::{Vec2, Vec3};
 
-const REPS: usize = 5;
+const DEFAULT_REPS: usize = 5;
 const CHUNK: usize = 4096;
 
 /// Embree 3.13 on a 2-vCPU Zen 3 (blob-workload.md): (mesh, threads) → primary, secondary closest,
@@ -60,28 +65,34 @@ fn thread_cpu_secs() -> f64 {
 /// Total CPU seconds of the worker threads of the last timed pass (see [`thread_cpu_secs`]).
 static CPU_NS: AtomicUsize = AtomicUsize::new(0);
 
-/// Runs `f(i)` for every ray index on `threads` OS threads taking chunks from a shared counter;
+/// Runs `f(i)` for every ray index on `threads` OS threads taking chunks from a shared counter
+/// (one thread: the calling thread, so a profiler attributes the work to the caller);
 /// returns the elapsed seconds.
 fn timed<F: Fn(usize) + Sync>(n: usize, threads: usize, f: F) -> f64 {
     let next = AtomicUsize::new(0);
     CPU_NS.store(0, Ordering::Relaxed);
-    let start = Instant::now();
-    std::thread::scope(|s| {
-        for _ in 0..threads {
-            s.spawn(|| {
-                let _cpu = CpuTimer(thread_cpu_secs());
-                loop {
-                    let begin = next.fetch_add(CHUNK, Ordering::Relaxed);
-                    if begin >= n {
-                        break;
-                    }
-                    for i in begin..(begin + CHUNK).min(n) {
-                        f(i);
-                    }
-                }
-            });
+    let work = || {
+        let _cpu = CpuTimer(thread_cpu_secs());
+        loop {
+            let begin = next.fetch_add(CHUNK, Ordering::Relaxed);
+            if begin >= n {
+                break;
+            }
+            for i in begin..(begin + CHUNK).min(n) {
+                f(i);
+            }
         }
-    });
+    };
+    let start = Instant::now();
+    if threads <= 1 {
+        work();
+    } else {
+        std::thread::scope(|s| {
+            for _ in 0..threads {
+                s.spawn(work);
+            }
+        });
+    }
     start.elapsed().as_secs_f64()
 }
 
@@ -97,6 +108,29 @@ impl Drop for CpuTimer {
 
 fn cpu_secs() -> f64 {
     CPU_NS.load(Ordering::Relaxed) as f64 * 1e-9
+}
+
+/// Primary rays, closest hit (a separate function so that a profiler reports each ray kind; the
+/// `black_box` keeps the linker from merging it with [`trace_secondary`]).
+#[inline(never)]
+fn trace_primary(
+    g: &Geometry,
+    rays: &[WorkloadRay],
+    threads: usize,
+) -> (f64, Vec<Option<(f32, u32)>>) {
+    std::hint::black_box(1);
+    closest(g, rays, threads)
+}
+
+/// Secondary rays, closest hit.
+#[inline(never)]
+fn trace_secondary(
+    g: &Geometry,
+    rays: &[WorkloadRay],
+    threads: usize,
+) -> (f64, Vec<Option<(f32, u32)>>) {
+    std::hint::black_box(2);
+    closest(g, rays, threads)
 }
 
 fn closest(g: &Geometry, rays: &[WorkloadRay], threads: usize) -> (f64, Vec<Option<(f32, u32)>>) {
@@ -119,6 +153,7 @@ fn closest(g: &Geometry, rays: &[WorkloadRay], threads: usize) -> (f64, Vec<Opti
     (secs, hits)
 }
 
+#[inline(never)]
 fn any_hit(g: &Geometry, rays: &[WorkloadRay], threads: usize) -> (f64, usize) {
     let count = AtomicUsize::new(0);
     let secs = timed(rays.len(), threads, |i| {
@@ -129,11 +164,59 @@ fn any_hit(g: &Geometry, rays: &[WorkloadRay], threads: usize) -> (f64, usize) {
     (secs, count.into_inner())
 }
 
+/// The value of `--name=value` among the arguments, if given.
+fn option(name: &str) -> Option<String> {
+    let prefix = format!("--{name}=");
+    std::env::args().find_map(|a| a.strip_prefix(&prefix).map(str::to_owned))
+}
+
+/// Mean leaves visited and triangle packs tested per ray by closest-hit queries (for `--stats`).
+fn leaf_visits(g: &Geometry, rays: &[WorkloadRay]) -> (f64, f64) {
+    let (mut leaves, mut packs) = (0usize, 0usize);
+    for r in rays {
+        let ray = ray_of(r);
+        let tri = TriRay::new(&ray);
+        let boxes = RayBoxTest::new(ray.origin, ray.dir);
+        g.bvh.closest(&boxes, ray.t_max, |first, count, t_max| {
+            leaves += 1;
+            let mut best: Option<f32> = None;
+            for p in
+                first as usize / LEAF_BLOCK..(first + count).div_ceil(LEAF_BLOCK as u32) as usize
+            {
+                packs += 1;
+                let pack = &g.tri_packs[p];
+                let t = best.unwrap_or(t_max);
+                let h = match tri.dominant_axis() {
+                    0 => intersect_pack_k::<0>(&tri, pack, t),
+                    1 => intersect_pack_k::<1>(&tri, pack, t),
+                    _ => intersect_pack_k::<2>(&tri, pack, t),
+                };
+                let Some(h) = h else { continue };
+                for lane in 0..LEAF_BLOCK {
+                    if h.mask & (1 << lane) != 0 && best.is_none_or(|b| h.t[lane] < b) {
+                        best = Some(h.t[lane]);
+                    }
+                }
+            }
+            best
+        });
+    }
+    let n = rays.len().max(1) as f64;
+    (leaves as f64 / n, packs as f64 / n)
+}
+
 fn main() {
     let filter: Vec<String> = std::env::args()
         .skip(1)
         .filter(|a| !a.starts_with("--"))
         .collect();
+    let reps = option("reps")
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(DEFAULT_REPS)
+        .max(1);
+    let thread_counts: Vec<usize> = option("threads").map_or(vec![1, 2], |t| {
+        t.split(',').filter_map(|n| n.parse().ok()).collect()
+    });
     println!(
         "| mesh | threads | build s | primary Mrays/s | secondary closest | secondary any-hit | vs Embree (prim / sec / any / build) |"
     );
@@ -145,7 +228,7 @@ fn main() {
         let mesh = blob_mesh(k);
         let mut build_times = Vec::new();
         let mut geometry = None;
-        for _ in 0..REPS {
+        for _ in 0..reps {
             let b = builder(&mesh);
             let t0 = Instant::now();
             let g = b.build();
@@ -167,14 +250,21 @@ fn main() {
                 .collect(),
         };
         let primary = primary_rays();
-        let (_, hits) = closest(&g, &primary, 1);
+        let (_, hits) = trace_primary(&g, &primary, 1);
         let hit_count = hits.iter().flatten().count();
         let t_sum: f64 = hits.iter().flatten().map(|h| f64::from(h.0)).sum();
         let secondary = secondary_rays(&leaf_mesh, &primary, &hits);
-        let (_, sec_hits) = closest(&g, &secondary, 1);
+        let (_, sec_hits) = trace_secondary(&g, &secondary, 1);
         let sec_count = sec_hits.iter().flatten().count();
         let sec_sum: f64 = sec_hits.iter().flatten().map(|h| f64::from(h.0)).sum();
         let (_, occluded) = any_hit(&g, &secondary, 1);
+        if std::env::args().any(|a| a == "--stats") {
+            let (pl, pp) = leaf_visits(&g, &primary);
+            let (sl, sp) = leaf_visits(&g, &secondary);
+            eprintln!(
+                "{name}: per ray, leaves visited / packs tested: primary {pl:.2} / {pp:.2}, secondary {sl:.2} / {sp:.2}"
+            );
+        }
         let bs = g.bvh.stats();
         eprintln!(
             "{name}: bvh {} nodes, {} leaves (mean {:.2} prims), depth {}, SAH {:.1}",
@@ -189,28 +279,28 @@ fn main() {
             g.triangles.len(),
             secondary.len()
         );
-        for threads in [1usize, 2] {
+        for &threads in &thread_counts {
             let mut cpu = [Vec::new(), Vec::new(), Vec::new()];
             let prim = median(
-                (0..REPS)
+                (0..reps)
                     .map(|_| {
-                        let s = closest(&g, &primary, threads).0;
+                        let s = trace_primary(&g, &primary, threads).0;
                         cpu[0].push(cpu_secs());
                         s
                     })
                     .collect(),
             );
             let sec = median(
-                (0..REPS)
+                (0..reps)
                     .map(|_| {
-                        let s = closest(&g, &secondary, threads).0;
+                        let s = trace_secondary(&g, &secondary, threads).0;
                         cpu[1].push(cpu_secs());
                         s
                     })
                     .collect(),
             );
             let any = median(
-                (0..REPS)
+                (0..reps)
                     .map(|_| {
                         let s = any_hit(&g, &secondary, threads).0;
                         cpu[2].push(cpu_secs());

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use super::bvh::BvhNode;
+use super::bvh::{BvhNode, LEAF_BLOCK};
 use crate::geometry::Aabb;
 use crate::geometry::float::{next_down, next_up};
 
@@ -12,8 +12,14 @@ const MAX_LEAF: usize = 8;
 /// Below this depth the SAH chooses splits; deeper nodes split at the median, which bounds the
 /// tree depth by `SAH_DEPTH + log2(n)` and so keeps it within the traversal stack.
 const SAH_DEPTH: usize = 32;
-/// Cost of visiting a node relative to intersecting one primitive.
+/// Cost of visiting a node relative to intersecting one block of primitives.
 const TRAVERSAL_COST: f32 = 2.0;
+
+/// SAH cost of intersecting `n` primitives: they are tested [`LEAF_BLOCK`] at a time.
+#[inline]
+fn blocks(n: u32) -> f32 {
+    n.div_ceil(LEAF_BLOCK as u32) as f32
+}
 
 struct Task {
     node: usize,
@@ -164,7 +170,7 @@ fn sah_split(
             if cnt == 0 || right_count[b] == 0 {
                 continue;
             }
-            let cost = acc.half_area() * cnt as f32 + right_area[b] * right_count[b] as f32;
+            let cost = acc.half_area() * blocks(cnt) + right_area[b] * blocks(right_count[b]);
             if best.is_none_or(|(c, _, _)| cost < c) {
                 best = Some((cost, axis, b));
             }
@@ -178,7 +184,7 @@ fn sah_split(
         } else {
             0.0
         };
-    let leaf_cost = slice.len() as f32;
+    let leaf_cost = blocks(slice.len() as u32);
     if slice.len() <= MAX_LEAF && split_cost >= leaf_cost {
         return None;
     }

@@ -35,12 +35,21 @@ pub struct Node4 {
     pub count: [u32; 4],
 }
 
+/// Leaves start at a multiple of this many slots, so a leaf's primitives fill whole SIMD packs
+/// (slot `s` is lane `s % LEAF_BLOCK` of pack `s / LEAF_BLOCK`).
+pub const LEAF_BLOCK: usize = 4;
+
+/// The `order` entry of a padding slot (after a leaf's last primitive, up to the next block).
+pub const PAD: u32 = u32::MAX;
+
 /// A BVH over a set of primitives: traversal nodes plus the order in which primitives appear in leaves.
 #[derive(Debug, Clone, Default)]
 pub struct Bvh {
     /// Traversal nodes; node 0 holds the root's children. Empty when there are no primitives.
     pub nodes: Vec<Node4>,
-    /// `order[slot]` is the index (in the build input) of the primitive stored at leaf slot `slot`.
+    /// `order[slot]` is the index (in the build input) of the primitive stored at leaf slot `slot`,
+    /// or [`PAD`] for the padding slots that start every leaf on a multiple of [`LEAF_BLOCK`].
+    /// Its length is a multiple of [`LEAF_BLOCK`].
     pub order: Vec<u32>,
     /// Bounds of everything.
     pub bounds: Aabb,
@@ -127,7 +136,7 @@ impl Bvh {
     pub fn build(bounds: &[Aabb]) -> Bvh {
         let (binary, order) = super::build::build(bounds);
         let bounds = binary.first().map_or(Aabb::EMPTY, BvhNode::bounds);
-        let (nodes, stack_need) = collapse(&binary);
+        let (nodes, order, stack_need) = collapse(&binary, &order);
         Bvh {
             nodes,
             order,
@@ -172,16 +181,27 @@ impl Bvh {
 
 /// Collapses the binary tree into four-wide nodes: starting from a node's two children, the
 /// interior child with the largest surface area is repeatedly replaced by its own two children
-/// until there are four or only leaves remain. Returns the nodes (depth first, parents before
-/// children) and a bound on the traversal stack: a node pushes at most `children - 1` entries.
-fn collapse(binary: &[BvhNode]) -> (Vec<Node4>, usize) {
+/// until there are four or only leaves remain. Leaves are copied out of `order` in the same
+/// depth-first order, each padded to a whole [`LEAF_BLOCK`]. Returns the nodes (depth first,
+/// parents before children), the padded order and a bound on the traversal stack: a node pushes
+/// at most `children - 1` entries.
+fn collapse(binary: &[BvhNode], order: &[u32]) -> (Vec<Node4>, Vec<u32>, usize) {
     let Some(root) = binary.first() else {
-        return (Vec::new(), 0);
+        return (Vec::new(), Vec::new(), 0);
+    };
+    let mut padded = Vec::with_capacity(order.len() + order.len() / 2);
+    let mut place = |n: &BvhNode| -> u32 {
+        let first = padded.len();
+        let (a, count) = (n.index as usize, n.count as usize);
+        padded.extend_from_slice(&order[a..a + count]);
+        padded.resize(first + count.next_multiple_of(LEAF_BLOCK), PAD);
+        first as u32
     };
     if root.is_leaf() {
         let mut n = Node4::EMPTY;
-        n.set_child(0, root.min, root.max, root.index, root.count);
-        return (vec![n], 0);
+        let first = place(root);
+        n.set_child(0, root.min, root.max, first, root.count);
+        return (vec![n], padded, 0);
     }
     let mut nodes = Vec::with_capacity(binary.len() / 3 + 1);
     nodes.push(Node4::EMPTY);
@@ -214,7 +234,8 @@ fn collapse(binary: &[BvhNode]) -> (Vec<Node4>, usize) {
         for (c, &child) in kids[..k].iter().enumerate() {
             let n = &binary[child];
             if n.is_leaf() {
-                node.set_child(c, n.min, n.max, n.index, n.count);
+                let first = place(n);
+                node.set_child(c, n.min, n.max, first, n.count);
             } else {
                 let target = nodes.len();
                 nodes.push(Node4::EMPTY);
@@ -240,5 +261,5 @@ fn collapse(binary: &[BvhNode]) -> (Vec<Node4>, usize) {
             .unwrap_or(0);
         need[i] = children.saturating_sub(1) + deepest;
     }
-    (nodes, need[0])
+    (nodes, padded, need[0])
 }

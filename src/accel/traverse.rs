@@ -68,8 +68,21 @@ impl RayBoxTest {
     #[inline(always)]
     #[must_use]
     pub fn entries(&self, node: &Node4, t_max: f32) -> (u32, Vec4) {
+        self.entries_with(node, t_max, self.near)
+    }
+
+    /// The ray's octant: bit `axis` set if the near plane on `axis` is the max plane.
+    #[inline(always)]
+    fn octant(&self) -> usize {
+        self.near[0] | (self.near[1] << 1) | (self.near[2] << 2)
+    }
+
+    /// [`RayBoxTest::entries`] with the near planes given (`near[axis]` is 0 or 1); when they are
+    /// constants, the plane loads compile to fixed offsets.
+    #[inline(always)]
+    fn entries_with(&self, node: &Node4, t_max: f32, near: [usize; 3]) -> (u32, Vec4) {
         let slab = |axis: usize| {
-            let n = self.near[axis] & 1;
+            let n = near[axis] & 1;
             let b = &node.bounds[axis];
             let near = (b[n] - self.o[axis]) * self.inv[axis];
             let far = (b[n ^ 1] - self.o[axis]) * self.inv[axis];
@@ -98,6 +111,27 @@ fn key_t(k: u32) -> f32 {
     f32::from_bits(k & !3)
 }
 
+/// The near planes of octant `oct` (0..8), or the ray's own for `oct == 8` (the generic path).
+#[inline(always)]
+fn near_of<const OCT: usize>(ray: &RayBoxTest) -> [usize; 3] {
+    if OCT < 8 {
+        [OCT & 1, (OCT >> 1) & 1, (OCT >> 2) & 1]
+    } else {
+        ray.near
+    }
+}
+
+/// Starts loading a node that the traversal pushed for later: a plain load whose value is unused
+/// (the crate forbids `unsafe`, so there is no prefetch intrinsic), which the CPU runs ahead.
+#[inline(always)]
+fn touch(nodes: &[Node4], index: u32, count: u32) {
+    if count == 0
+        && let Some(n) = nodes.get(index as usize)
+    {
+        std::hint::black_box(n.bounds[0][0].x);
+    }
+}
+
 #[inline(always)]
 fn sort2(a: &mut u32, b: &mut u32) {
     let (lo, hi) = ((*a).min(*b), (*a).max(*b));
@@ -106,51 +140,62 @@ fn sort2(a: &mut u32, b: &mut u32) {
 }
 
 impl Bvh {
-    /// Visits every leaf slot the ray may reach before `t_max`, nearest child first.
-    /// `test(slot, t_max)` intersects the primitive in `slot` and returns a closer distance on a
-    /// hit, which then shrinks the search. Returns the final `t_max`.
+    /// Visits every leaf the ray may reach before `t_max`, nearest child first.
+    /// `test(first, count, t_max)` intersects the primitives in slots `first .. first + count`
+    /// (`first` is a multiple of [`LEAF_BLOCK`](super::bvh::LEAF_BLOCK)) and returns the closest
+    /// distance it found below `t_max`, which then shrinks the search. Returns the final `t_max`.
     #[inline]
     pub fn closest(
         &self,
         ray: &RayBoxTest,
         t_max: f32,
-        test: impl FnMut(u32, f32) -> Option<f32>,
+        test: impl FnMut(u32, u32, f32) -> Option<f32>,
     ) -> f32 {
         if self.nodes.is_empty() {
             return t_max;
         }
-        if self.stack_need <= STACK_SMALL {
-            self.closest_with::<STACK_SMALL>(ray, t_max, test)
-        } else {
-            self.closest_with::<STACK_MAX>(ray, t_max, test)
+        if self.stack_need > STACK_SMALL {
+            return self.closest_with::<STACK_MAX, 8>(ray, t_max, test);
+        }
+        // One copy of the loop per ray octant, so the slab planes are fixed offsets.
+        match ray.octant() {
+            0 => self.closest_with::<STACK_SMALL, 0>(ray, t_max, test),
+            1 => self.closest_with::<STACK_SMALL, 1>(ray, t_max, test),
+            2 => self.closest_with::<STACK_SMALL, 2>(ray, t_max, test),
+            3 => self.closest_with::<STACK_SMALL, 3>(ray, t_max, test),
+            4 => self.closest_with::<STACK_SMALL, 4>(ray, t_max, test),
+            5 => self.closest_with::<STACK_SMALL, 5>(ray, t_max, test),
+            6 => self.closest_with::<STACK_SMALL, 6>(ray, t_max, test),
+            _ => self.closest_with::<STACK_SMALL, 7>(ray, t_max, test),
         }
     }
 
     #[inline(always)]
-    fn closest_with<const N: usize>(
+    fn closest_with<const N: usize, const OCT: usize>(
         &self,
         ray: &RayBoxTest,
         mut t_max: f32,
-        mut test: impl FnMut(u32, f32) -> Option<f32>,
+        mut test: impl FnMut(u32, u32, f32) -> Option<f32>,
     ) -> f32 {
         let nodes = &self.nodes[..];
+        let near_planes = near_of::<OCT>(ray);
         let mut stack = [Entry::default(); N];
         let mut sp = 0usize;
         let (mut index, mut count) = (0u32, 0u32);
         loop {
             if count == 0 {
                 let node = &nodes[index as usize];
-                let (mask, near) = ray.entries(node, t_max);
+                let (mask, near) = ray.entries_with(node, t_max, near_planes);
                 match mask.count_ones() {
                     0 => {}
                     1 => {
-                        let c = mask.trailing_zeros() as usize;
+                        let c = (mask.trailing_zeros() & 3) as usize;
                         (index, count) = (node.index[c], node.count[c]);
                         continue;
                     }
                     2 => {
-                        let a = mask.trailing_zeros() as usize;
-                        let b = 31 - mask.leading_zeros() as usize;
+                        let a = (mask.trailing_zeros() & 3) as usize;
+                        let b = ((31 - mask.leading_zeros()) & 3) as usize;
                         let (ta, tb) = (near[a], near[b]);
                         let (c, f, tf) = if ta <= tb { (a, b, tb) } else { (b, a, ta) };
                         stack[sp] = Entry {
@@ -158,6 +203,7 @@ impl Bvh {
                             count: node.count[f],
                             t: tf,
                         };
+                        touch(nodes, node.index[f], node.count[f]);
                         sp += 1;
                         (index, count) = (node.index[c], node.count[c]);
                         continue;
@@ -188,6 +234,7 @@ impl Bvh {
                                 count: node.count[c],
                                 t: key_t(kk),
                             };
+                            touch(nodes, node.index[c], node.count[c]);
                             sp += 1;
                         }
                         let c = (k0 & 3) as usize;
@@ -195,12 +242,8 @@ impl Bvh {
                         continue;
                     }
                 }
-            } else {
-                for slot in index..index + count {
-                    if let Some(t) = test(slot, t_max) {
-                        t_max = t;
-                    }
-                }
+            } else if let Some(t) = test(index, count, t_max) {
+                t_max = t;
             }
             loop {
                 if sp == 0 {
@@ -216,52 +259,64 @@ impl Bvh {
         }
     }
 
-    /// True as soon as `test(slot, t_max)` reports a hit in any leaf the ray reaches before `t_max`.
+    /// True as soon as `test(first, count, t_max)` reports a hit among the primitives in slots
+    /// `first .. first + count` of a leaf the ray reaches before `t_max`.
     #[inline]
-    pub fn any(&self, ray: &RayBoxTest, t_max: f32, test: impl FnMut(u32, f32) -> bool) -> bool {
+    pub fn any(
+        &self,
+        ray: &RayBoxTest,
+        t_max: f32,
+        test: impl FnMut(u32, u32, f32) -> bool,
+    ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        if self.stack_need <= STACK_SMALL {
-            self.any_with::<STACK_SMALL>(ray, t_max, test)
-        } else {
-            self.any_with::<STACK_MAX>(ray, t_max, test)
+        if self.stack_need > STACK_SMALL {
+            return self.any_with::<STACK_MAX, 8>(ray, t_max, test);
+        }
+        match ray.octant() {
+            0 => self.any_with::<STACK_SMALL, 0>(ray, t_max, test),
+            1 => self.any_with::<STACK_SMALL, 1>(ray, t_max, test),
+            2 => self.any_with::<STACK_SMALL, 2>(ray, t_max, test),
+            3 => self.any_with::<STACK_SMALL, 3>(ray, t_max, test),
+            4 => self.any_with::<STACK_SMALL, 4>(ray, t_max, test),
+            5 => self.any_with::<STACK_SMALL, 5>(ray, t_max, test),
+            6 => self.any_with::<STACK_SMALL, 6>(ray, t_max, test),
+            _ => self.any_with::<STACK_SMALL, 7>(ray, t_max, test),
         }
     }
 
     #[inline(always)]
-    fn any_with<const N: usize>(
+    fn any_with<const N: usize, const OCT: usize>(
         &self,
         ray: &RayBoxTest,
         t_max: f32,
-        mut test: impl FnMut(u32, f32) -> bool,
+        mut test: impl FnMut(u32, u32, f32) -> bool,
     ) -> bool {
         let nodes = &self.nodes[..];
+        let near_planes = near_of::<OCT>(ray);
         let mut stack = [(0u32, 0u32); N];
         let mut sp = 0usize;
         let (mut index, mut count) = (0u32, 0u32);
         loop {
             if count == 0 {
                 let node = &nodes[index as usize];
-                let (mut mask, _) = ray.entries(node, t_max);
+                let (mut mask, _) = ray.entries_with(node, t_max, near_planes);
                 if mask != 0 {
-                    let c = mask.trailing_zeros() as usize;
+                    let c = (mask.trailing_zeros() & 3) as usize;
                     mask &= mask - 1;
                     while mask != 0 {
-                        let f = 31 - mask.leading_zeros() as usize;
+                        let f = ((31 - mask.leading_zeros()) & 3) as usize;
                         stack[sp] = (node.index[f], node.count[f]);
+                        touch(nodes, node.index[f], node.count[f]);
                         sp += 1;
                         mask &= !(1 << f);
                     }
                     (index, count) = (node.index[c], node.count[c]);
                     continue;
                 }
-            } else {
-                for slot in index..index + count {
-                    if test(slot, t_max) {
-                        return true;
-                    }
-                }
+            } else if test(index, count, t_max) {
+                return true;
             }
             if sp == 0 {
                 return false;
@@ -371,6 +426,38 @@ mod tests {
         assert!(entry(far, Vec3::new(0.0, 0.5, 0.5), Vec3::X, f32::INFINITY).is_some());
     }
 
+    /// `Bvh::closest` with a per-slot test, in slot order (as a leaf callback would run it).
+    fn closest_slots(
+        bvh: &Bvh,
+        r: &RayBoxTest,
+        t_max: f32,
+        mut test: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> f32 {
+        bvh.closest(r, t_max, |first, count, mut t_max| {
+            assert_eq!(first as usize % crate::accel::bvh::LEAF_BLOCK, 0);
+            let mut found = None;
+            for slot in first..first + count {
+                if let Some(t) = test(slot, t_max) {
+                    t_max = t;
+                    found = Some(t);
+                }
+            }
+            found
+        })
+    }
+
+    /// `Bvh::any` with a per-slot test.
+    fn any_slots(
+        bvh: &Bvh,
+        r: &RayBoxTest,
+        t_max: f32,
+        mut test: impl FnMut(u32, f32) -> bool,
+    ) -> bool {
+        bvh.any(r, t_max, |first, count, t_max| {
+            (first..first + count).any(|slot| test(slot, t_max))
+        })
+    }
+
     fn brute_first(boxes: &[Aabb], o: Vec3, d: Vec3) -> Option<f32> {
         boxes
             .iter()
@@ -394,7 +481,7 @@ mod tests {
                 let o = Vec3::new(i as f32 / 126.0, j as f32 / 126.0, 2.0);
                 let d = Vec3::new(0.0, -0.0, -1.0);
                 let r = RayBoxTest::new(o, d);
-                let t = bvh.closest(&r, f32::INFINITY, |slot, tmax| {
+                let t = closest_slots(&bvh, &r, f32::INFINITY, |slot, tmax| {
                     let b = boxes[bvh.order[slot as usize] as usize];
                     entry(b, o, d, tmax)
                 });
@@ -402,7 +489,7 @@ mod tests {
                 if found != brute_first(&boxes, o, d) {
                     mismatches += 1;
                 }
-                let any = bvh.any(&r, f32::INFINITY, |slot, tmax| {
+                let any = any_slots(&bvh, &r, f32::INFINITY, |slot, tmax| {
                     entry(boxes[bvh.order[slot as usize] as usize], o, d, tmax).is_some()
                 });
                 if any != found.is_some() {
@@ -451,7 +538,7 @@ mod tests {
                 rng.next_f32() * 10.0,
             );
             let r = RayBoxTest::new(o, d);
-            let t = bvh.closest(&r, f32::INFINITY, |slot, tmax| {
+            let t = closest_slots(&bvh, &r, f32::INFINITY, |slot, tmax| {
                 entry(boxes[bvh.order[slot as usize] as usize], o, d, tmax)
             });
             let found = (t != f32::INFINITY).then_some(t);
@@ -477,7 +564,13 @@ mod tests {
         assert!(t0.elapsed().as_secs_f32() < 1.0);
         assert!(s.max_depth <= 20, "depth {}", s.max_depth);
         assert!(s.max_leaf_size <= 8);
-        let mut seen = bvh.order.clone();
+        assert_eq!(bvh.order.len() % crate::accel::bvh::LEAF_BLOCK, 0);
+        let mut seen: Vec<u32> = bvh
+            .order
+            .iter()
+            .copied()
+            .filter(|&o| o != crate::accel::bvh::PAD)
+            .collect();
         seen.sort_unstable();
         assert_eq!(seen, (0..100_000).collect::<Vec<u32>>());
     }
@@ -486,15 +579,15 @@ mod tests {
     fn empty_and_single_primitive_trees() {
         let r = RayBoxTest::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z);
         let bvh = Bvh::build(&[]);
-        assert_eq!(bvh.closest(&r, 5.0, |_, _| Some(1.0)), 5.0);
-        assert!(!bvh.any(&r, 5.0, |_, _| true));
+        assert_eq!(closest_slots(&bvh, &r, 5.0, |_, _| Some(1.0)), 5.0);
+        assert!(!any_slots(&bvh, &r, 5.0, |_, _| true));
         let one = Bvh::build(&[Aabb {
             min: Vec3::ZERO,
             max: Vec3::ONE,
         }]);
-        assert_eq!(one.closest(&r, 5.0, |_, _| Some(1.0)), 1.0);
-        assert!(one.any(&r, 5.0, |_, _| true));
+        assert_eq!(closest_slots(&one, &r, 5.0, |_, _| Some(1.0)), 1.0);
+        assert!(any_slots(&one, &r, 5.0, |_, _| true));
         let miss = RayBoxTest::new(Vec3::new(5.0, 5.0, -1.0), Vec3::Z);
-        assert!(!one.any(&miss, 5.0, |_, _| true));
+        assert!(!any_slots(&one, &miss, 5.0, |_, _| true));
     }
 }

@@ -2,9 +2,10 @@
 
 use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 
+use crate::accel::bvh::{LEAF_BLOCK, PAD};
 use crate::accel::{Bvh, RayBoxTest};
 use crate::geometry::sphere::{intersect_sphere, intersect_unit_quadric};
-use crate::geometry::triangle::{TriRay, intersect_triangle_k};
+use crate::geometry::triangle::{TriPack4, TriRay, intersect_pack_k, intersect_triangle_k};
 use crate::geometry::{Aabb, Ray};
 
 /// A primitive reference: kind in the top two bits, index into that kind's array below.
@@ -125,8 +126,14 @@ pub struct GeometryBuilder {
 pub struct Geometry {
     /// The hierarchy; leaf slots index `slots`.
     pub bvh: Bvh,
-    /// Primitive at each leaf slot.
+    /// Primitive at each leaf slot. A padding slot (see [`crate::accel::bvh::PAD`]) repeats the
+    /// slot before it and is never visited.
     pub slots: Vec<PrimRef>,
+    /// The triangles of slots `4p .. 4p + 4` in SIMD layout, at index `p`; lanes of other
+    /// primitives and of padding slots are empty.
+    pub tri_packs: Vec<TriPack4>,
+    /// True if some slot holds a sphere or an ellipsoid: leaves are then checked for them.
+    pub has_quadrics: bool,
     /// Triangle positions, in leaf order.
     pub triangles: Vec<[Vec3; 3]>,
     /// Triangle attributes, parallel to `triangles`.
@@ -177,12 +184,21 @@ impl GeometryBuilder {
             tri_attrs: Vec::with_capacity(self.triangles.len()),
             spheres: Vec::with_capacity(self.spheres.len()),
             ellipsoids: Vec::with_capacity(self.ellipsoids.len()),
+            tri_packs: vec![TriPack4::EMPTY; bvh.order.len() / LEAF_BLOCK],
+            has_quadrics: !self.spheres.is_empty() || !self.ellipsoids.is_empty(),
             bvh: Bvh::default(),
         };
-        for &o in &bvh.order {
+        for (slot, &o) in bvh.order.iter().enumerate() {
+            if o == PAD {
+                let last = g.slots.last().copied().unwrap_or(PrimRef(0));
+                g.slots.push(last);
+                continue;
+            }
             let r = refs[o as usize];
             let new = match r.kind() {
                 PrimKind::Triangle => {
+                    let [p0, p1, p2] = self.triangles[r.index()];
+                    g.tri_packs[slot / LEAF_BLOCK].set(slot % LEAF_BLOCK, p0, p1, p2);
                     g.triangles.push(self.triangles[r.index()]);
                     g.tri_attrs.push(self.tri_attrs[r.index()]);
                     PrimRef::new(PrimKind::Triangle, g.triangles.len() - 1)
@@ -232,48 +248,79 @@ impl Geometry {
             return None;
         }
         let tri_ray = TriRay::new(ray);
-        match tri_ray.dominant_axis() {
-            0 => self.intersect_k::<0>(ray, &tri_ray),
-            1 => self.intersect_k::<1>(ray, &tri_ray),
-            _ => self.intersect_k::<2>(ray, &tri_ray),
-        }
-    }
-
-    #[inline(always)]
-    fn intersect_k<const KZ: usize>(&self, ray: &Ray, tri_ray: &TriRay) -> Option<Hit> {
         let box_ray = RayBoxTest::new(ray.origin, ray.dir);
         let mut best = None;
-        self.bvh.closest(&box_ray, ray.t_max, |slot, t_max| {
-            let prim = self.slots[slot as usize];
-            let (t, b1, b2) = self.intersect_prim::<KZ>(prim, tri_ray, ray, t_max)?;
-            best = Some(Hit { t, prim, b1, b2 });
-            Some(t)
-        });
+        self.bvh
+            .closest(&box_ray, ray.t_max, |first, count, t_max| {
+                match tri_ray.dominant_axis() {
+                    0 => self.leaf_closest::<0>(first, count, &tri_ray, ray, t_max, &mut best),
+                    1 => self.leaf_closest::<1>(first, count, &tri_ray, ray, t_max, &mut best),
+                    _ => self.leaf_closest::<2>(first, count, &tri_ray, ray, t_max, &mut best),
+                }
+            });
         best
+    }
+
+    /// Closest hit among slots `first .. first + count` below `t_max`, written to `best`;
+    /// returns its distance. Triangles are tested four at a time and taken in slot order, so the
+    /// result is that of testing the slots one by one.
+    #[inline(always)]
+    fn leaf_closest<const KZ: usize>(
+        &self,
+        first: u32,
+        count: u32,
+        tri_ray: &TriRay,
+        ray: &Ray,
+        mut t_max: f32,
+        best: &mut Option<Hit>,
+    ) -> Option<f32> {
+        let (first, end) = (first as usize, (first + count) as usize);
+        let mut found = None;
+        if self.has_quadrics
+            && self.slots[first..end]
+                .iter()
+                .any(|p| p.kind() != PrimKind::Triangle)
+        {
+            for slot in first..end {
+                let prim = self.slots[slot];
+                if let Some((t, b1, b2)) = self.intersect_prim::<KZ>(prim, tri_ray, ray, t_max) {
+                    *best = Some(Hit { t, prim, b1, b2 });
+                    t_max = t;
+                    found = Some(t);
+                }
+            }
+            return found;
+        }
+        for pack in first / LEAF_BLOCK..end.div_ceil(LEAF_BLOCK) {
+            let Some(h) = intersect_pack_k::<KZ>(tri_ray, &self.tri_packs[pack], t_max) else {
+                continue;
+            };
+            let mut mask = h.mask;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if found.is_some() && !h.within(lane, t_max) {
+                    continue;
+                }
+                let t = h.t[lane];
+                *best = Some(Hit {
+                    t,
+                    prim: self.slots[pack * LEAF_BLOCK + lane],
+                    b1: h.b1[lane],
+                    b2: h.b2[lane],
+                });
+                t_max = t;
+                found = Some(t);
+            }
+        }
+        found
     }
 
     /// True if anything blocks `ray` within `(0, ray.t_max)`.
     #[inline]
     #[must_use]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if !ray.is_valid() {
-            return false;
-        }
-        let tri_ray = TriRay::new(ray);
-        match tri_ray.dominant_axis() {
-            0 => self.occluded_k::<0>(ray, &tri_ray),
-            1 => self.occluded_k::<1>(ray, &tri_ray),
-            _ => self.occluded_k::<2>(ray, &tri_ray),
-        }
-    }
-
-    #[inline(always)]
-    fn occluded_k<const KZ: usize>(&self, ray: &Ray, tri_ray: &TriRay) -> bool {
-        let box_ray = RayBoxTest::new(ray.origin, ray.dir);
-        self.bvh.any(&box_ray, ray.t_max, |slot, t_max| {
-            self.intersect_prim::<KZ>(self.slots[slot as usize], tri_ray, ray, t_max)
-                .is_some()
-        })
+        self.occluded_by(ray, |_| true)
     }
 
     /// True if some primitive for which `counts` is true blocks `ray` within
@@ -286,27 +333,54 @@ impl Geometry {
             return false;
         }
         let tri_ray = TriRay::new(ray);
-        match tri_ray.dominant_axis() {
-            0 => self.occluded_by_k::<0>(ray, &tri_ray, &counts),
-            1 => self.occluded_by_k::<1>(ray, &tri_ray, &counts),
-            _ => self.occluded_by_k::<2>(ray, &tri_ray, &counts),
-        }
+        let box_ray = RayBoxTest::new(ray.origin, ray.dir);
+        self.bvh.any(&box_ray, ray.t_max, |first, count, t_max| {
+            match tri_ray.dominant_axis() {
+                0 => self.leaf_any::<0>(first, count, &tri_ray, ray, t_max, &counts),
+                1 => self.leaf_any::<1>(first, count, &tri_ray, ray, t_max, &counts),
+                _ => self.leaf_any::<2>(first, count, &tri_ray, ray, t_max, &counts),
+            }
+        })
     }
 
+    /// True if a primitive in slots `first .. first + count` for which `counts` holds blocks
+    /// the ray before `t_max`.
     #[inline(always)]
-    fn occluded_by_k<const KZ: usize>(
+    fn leaf_any<const KZ: usize>(
         &self,
-        ray: &Ray,
+        first: u32,
+        count: u32,
         tri_ray: &TriRay,
-        counts: &impl Fn(PrimRef) -> bool,
+        ray: &Ray,
+        t_max: f32,
+        counts: impl Fn(PrimRef) -> bool,
     ) -> bool {
-        let box_ray = RayBoxTest::new(ray.origin, ray.dir);
-        self.bvh.any(&box_ray, ray.t_max, |slot, t_max| {
-            let prim = self.slots[slot as usize];
-            counts(prim)
-                && self
-                    .intersect_prim::<KZ>(prim, tri_ray, ray, t_max)
-                    .is_some()
+        let (first, end) = (first as usize, (first + count) as usize);
+        if self.has_quadrics
+            && self.slots[first..end]
+                .iter()
+                .any(|p| p.kind() != PrimKind::Triangle)
+        {
+            return self.slots[first..end].iter().any(|&prim| {
+                counts(prim)
+                    && self
+                        .intersect_prim::<KZ>(prim, tri_ray, ray, t_max)
+                        .is_some()
+            });
+        }
+        (first / LEAF_BLOCK..end.div_ceil(LEAF_BLOCK)).any(|pack| {
+            let Some(h) = intersect_pack_k::<KZ>(tri_ray, &self.tri_packs[pack], t_max) else {
+                return false;
+            };
+            let mut mask = h.mask;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if counts(self.slots[pack * LEAF_BLOCK + lane]) {
+                    return true;
+                }
+            }
+            false
         })
     }
 
