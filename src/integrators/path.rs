@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use super::Counters;
 use super::shadow::{RayCone, shadow_ray};
-use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog, TraceNode};
+use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{Hit, Light, LightSampler, RenderScene, SurfacePoint};
@@ -75,15 +75,18 @@ impl<'a> PathTracer<'a> {
         let mut kind = RayKind::Camera;
         let mut parent: Option<usize> = None;
         let mut depth = 0u32;
+        // Debug logs only: each node holds the radiance gathered before it until the path ends.
+        let mut root: Option<usize> = None;
         loop {
             counters.rays += 1;
-            let node = log
-                .as_deref_mut()
-                .map(|lg| push_node(lg, depth, kind, &ray, beta, parent));
+            let node = log.as_deref_mut().map(|lg| {
+                let id = lg.push(depth, kind, &ray, beta, parent);
+                lg.nodes[id].radiance = l;
+                id
+            });
+            root = root.or(node);
             let Some(hit) = scene.geometry.intersect(&ray) else {
-                let bg = params.background;
-                l += beta * bg;
-                set_radiance(log.as_deref_mut(), node, bg);
+                l += beta * params.background;
                 break;
             };
             let sp = scene.geometry.surface(&ray, &hit);
@@ -106,7 +109,7 @@ impl<'a> PathTracer<'a> {
                 };
                 l += beta * le;
                 if let Some(lg) = log.as_deref_mut() {
-                    record_hit(lg, node, scene, &hit, &sp, "light", le);
+                    record_hit(lg, node, scene, &hit, &sp, "light");
                 }
                 break;
             };
@@ -118,10 +121,10 @@ impl<'a> PathTracer<'a> {
             );
             if let Some(lg) = log.as_deref_mut() {
                 let name = scene.material_names[m as usize].clone();
-                record_hit(lg, node, scene, &hit, &sp, &name, Vec3::ZERO);
+                record_hit(lg, node, scene, &hit, &sp, &name);
             }
             if depth >= params.max_depth {
-                note(log.as_deref_mut(), node, "max depth reached");
+                TraceLog::note(log.as_deref_mut(), node, "max depth reached");
                 break;
             }
             let fr = ShadingFrame {
@@ -161,7 +164,7 @@ impl<'a> PathTracer<'a> {
             };
             if !s.delta {
                 if !may_scatter {
-                    note(log.as_deref_mut(), node, "diffuse depth reached");
+                    TraceLog::note(log.as_deref_mut(), node, "diffuse depth reached");
                     break;
                 }
                 diffuse_bounces += 1;
@@ -177,7 +180,7 @@ impl<'a> PathTracer<'a> {
             if depth > ROULETTE_DEPTH {
                 let q = (beta / eta_scale).max_element().min(1.0);
                 if u_rr >= q {
-                    note(log.as_deref_mut(), node, "ended by Russian roulette");
+                    TraceLog::note(log.as_deref_mut(), node, "ended by Russian roulette");
                     break;
                 }
                 beta /= q;
@@ -204,6 +207,15 @@ impl<'a> PathTracer<'a> {
             parent = node;
             let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
             ray = Ray::new(origin, s.wi);
+        }
+        if let (Some(lg), Some(root)) = (log, root) {
+            // The radiance each logged ray brought back: what the path gathered from it on,
+            // divided by the path weight it carried.
+            for n in &mut lg.nodes[root..] {
+                let gathered = l - n.radiance;
+                n.radiance =
+                    Vec3::select(n.weight.cmpgt(Vec3::ZERO), gathered / n.weight, Vec3::ZERO);
+            }
         }
         l
     }
@@ -263,33 +275,6 @@ impl PathTracer<'_> {
     }
 }
 
-fn push_node(
-    log: &mut TraceLog,
-    depth: u32,
-    kind: RayKind,
-    ray: &Ray,
-    weight: Vec3,
-    parent: Option<usize>,
-) -> usize {
-    let id = log.nodes.len();
-    log.nodes.push(TraceNode {
-        depth,
-        kind,
-        origin: ray.origin,
-        dir: ray.dir,
-        weight,
-        hit: None,
-        shadows: Vec::new(),
-        radiance: Vec3::ZERO,
-        children: Vec::new(),
-        note: None,
-    });
-    if let Some(p) = parent {
-        log.nodes[p].children.push(id);
-    }
-    id
-}
-
 fn record_hit(
     log: &mut TraceLog,
     node: Option<usize>,
@@ -297,7 +282,6 @@ fn record_hit(
     hit: &Hit,
     sp: &SurfacePoint,
     material: &str,
-    radiance: Vec3,
 ) {
     if let Some(me) = node {
         let wo = -log.nodes[me].dir;
@@ -310,18 +294,5 @@ fn record_hit(
             material: material.to_string(),
             entering,
         });
-        log.nodes[me].radiance = radiance;
-    }
-}
-
-fn set_radiance(log: Option<&mut TraceLog>, node: Option<usize>, l: Vec3) {
-    if let (Some(lg), Some(me)) = (log, node) {
-        lg.nodes[me].radiance = l;
-    }
-}
-
-fn note(log: Option<&mut TraceLog>, node: Option<usize>, text: &str) {
-    if let (Some(lg), Some(me)) = (log, node) {
-        lg.nodes[me].note = Some(text.to_string());
     }
 }

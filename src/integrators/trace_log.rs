@@ -2,6 +2,8 @@
 
 use glam::Vec3;
 
+use crate::geometry::Ray;
+
 /// Why a ray was cast.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RayKind {
@@ -84,6 +86,42 @@ fn v3(v: Vec3) -> String {
 }
 
 impl TraceLog {
+    /// Appends the node of a ray cast at path depth `depth` for `kind`, carrying path weight
+    /// `weight`, as a child of `parent`; returns its index.
+    pub fn push(
+        &mut self,
+        depth: u32,
+        kind: RayKind,
+        ray: &Ray,
+        weight: Vec3,
+        parent: Option<usize>,
+    ) -> usize {
+        let id = self.nodes.len();
+        self.nodes.push(TraceNode {
+            depth,
+            kind,
+            origin: ray.origin,
+            dir: ray.dir,
+            weight,
+            hit: None,
+            shadows: Vec::new(),
+            radiance: Vec3::ZERO,
+            children: Vec::new(),
+            note: None,
+        });
+        if let Some(p) = parent {
+            self.nodes[p].children.push(id);
+        }
+        id
+    }
+
+    /// Records why the path stopped at `node` (when there is a log and a node).
+    pub fn note(log: Option<&mut TraceLog>, node: Option<usize>, text: &str) {
+        if let (Some(log), Some(me)) = (log, node) {
+            log.nodes[me].note = Some(text.to_string());
+        }
+    }
+
     /// Indented text, one ray per block.
     #[must_use]
     pub fn to_text(&self) -> String {

@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::Counters;
 use super::shadow::{RayCone, shadow_ray};
-use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog, TraceNode};
+use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{Light, RenderScene, ShadingPoint, SurfacePoint};
@@ -70,7 +70,9 @@ impl<'a> Whitted<'a> {
         mut log: Option<&mut TraceLog>,
         parent: Option<usize>,
     ) -> Vec3 {
-        let me = log.as_deref_mut().map(|l| push_node(l, &path, parent));
+        let me = log
+            .as_deref_mut()
+            .map(|l| l.push(path.depth, path.kind, &path.ray, path.weight, parent));
         let (l, hit_info) = self.shade(&path, rng, counters, log.as_deref_mut(), me);
         if let (Some(log), Some(me)) = (log, me) {
             log.nodes[me].radiance = l;
@@ -143,7 +145,7 @@ impl<'a> Whitted<'a> {
             return (l, info);
         }
         if path.depth >= scene.params.max_depth {
-            note(log, me, "max depth reached: specular rays not traced");
+            TraceLog::note(log, me, "max depth reached: specular rays not traced");
             return (l, info);
         }
         let lobes = material.delta_lobes(wo, ns, ng, entering);
@@ -294,31 +296,5 @@ impl Whitted<'_> {
         }
         // Still crossing surfaces after the limit: keep what has come through so far.
         t
-    }
-}
-
-fn push_node(log: &mut TraceLog, path: &Path, parent: Option<usize>) -> usize {
-    let id = log.nodes.len();
-    log.nodes.push(TraceNode {
-        depth: path.depth,
-        kind: path.kind,
-        origin: path.ray.origin,
-        dir: path.ray.dir,
-        weight: path.weight,
-        hit: None,
-        shadows: Vec::new(),
-        radiance: Vec3::ZERO,
-        children: Vec::new(),
-        note: None,
-    });
-    if let Some(p) = parent {
-        log.nodes[p].children.push(id);
-    }
-    id
-}
-
-fn note(log: Option<&mut TraceLog>, me: Option<usize>, text: &str) {
-    if let (Some(log), Some(me)) = (log, me) {
-        log.nodes[me].note = Some(text.to_string());
     }
 }

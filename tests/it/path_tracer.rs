@@ -289,3 +289,31 @@ fn unknown_integrator_and_sampler_names_are_clear_errors() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+#[test]
+fn a_path_tracer_ray_tree_reports_the_radiance_each_ray_brought_back() {
+    let file = common::root().join("scenes/cornell.ron");
+    let o = cornell_path(64, 64, 4, "Sobol");
+    let prepared = prepare(&file, &o).expect("scene");
+    let mut lit = 0;
+    for (x, y) in [(32, 40), (10, 30), (50, 55), (32, 8)] {
+        for sample in 0..4 {
+            let (log, l) =
+                caustic::render::trace_pixel(&prepared.render_scene, x, y, sample).expect("pixel");
+            // The camera ray's radiance is the sample's value; a chain of rays, each the
+            // child of the one before.
+            assert!(
+                (log.nodes[0].radiance - l).abs().max_element() <= 1e-5 * l.max_element().max(1.0),
+                "({x}, {y}) #{sample}: {} vs {l}",
+                log.nodes[0].radiance
+            );
+            for (i, n) in log.nodes.iter().enumerate().skip(1) {
+                assert!(log.nodes[i - 1].children == vec![i] && n.radiance.is_finite());
+            }
+            if l.max_element() > 0.0 {
+                lit += 1;
+            }
+        }
+    }
+    assert!(lit >= 8, "{lit} lit samples");
+}
