@@ -113,7 +113,7 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
         b.finish_and_clear();
     }
     PassesOutcome {
-        result: Ok(job.output()),
+        result: Ok(job.into_output()),
         checkpoint_spp: saved,
     }
 }

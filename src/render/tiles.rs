@@ -276,23 +276,24 @@ impl<'a> RenderJob<'a> {
     /// As [`RenderJob::render_pass`].
     pub fn finish(mut self) -> Result<RenderOutput, RenderError> {
         self.render_pass(self.samples_per_pixel() - self.done)?;
-        self.progress.finish_and_clear();
-        Ok(self.output())
+        Ok(self.into_output())
     }
 
     /// The image and statistics of the samples done so far (for a render stopped early by a
-    /// time budget: every pixel has the same number of samples).
+    /// time budget: every pixel has the same number of samples). Ends the job; its sums move
+    /// into the output (no copy of the film's statistics).
     #[must_use]
-    pub fn output(&self) -> RenderOutput {
+    pub fn into_output(mut self) -> RenderOutput {
         self.progress.finish_and_clear();
         let mut stats = self.stats;
         stats.samples = u64::from(self.region.width)
             * u64::from(self.region.height)
             * u64::from(self.done - self.first);
         stats.elapsed = self.start.elapsed();
+        let sums = std::mem::replace(&mut self.sums, PixelSums::new(0, 0));
         RenderOutput {
-            film: self.sums.to_film(),
-            sums: self.sums.clone(),
+            film: sums.to_film(),
+            sums,
             stats,
         }
     }

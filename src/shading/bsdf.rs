@@ -265,18 +265,32 @@ impl Bsdf {
     /// have no density; their discrete probabilities are in the samples themselves.
     #[must_use]
     pub fn pdf(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
-        if self.diffuse == 0.0 || fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0 {
+        if self.diffuse == 0.0 {
             return 0.0;
         }
         let (p, lambert) = self.lobe_probabilities(self.sampling_fresnel(wo, fr));
-        if p[0] == 0.0 {
+        self.diffuse_pdf(p[0], lambert, wo, wi, fr)
+    }
+
+    /// [`Bsdf::pdf`] given the diffuse part's probability `p_diffuse` and Lambert's share in
+    /// it (so `sample`, which has them, does not recompute the Fresnel split).
+    #[inline]
+    fn diffuse_pdf(
+        &self,
+        p_diffuse: f32,
+        lambert: f32,
+        wo: Vec3,
+        wi: Vec3,
+        fr: &ShadingFrame,
+    ) -> f32 {
+        if p_diffuse == 0.0 || fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0 {
             return 0.0;
         }
         let mut d = lambert * fr.ns.dot(wi) * FRAC_1_PI;
         if lambert < 1.0 {
             d += (1.0 - lambert) * self.phong_pdf(reflect(wo, fr.ns), wi);
         }
-        p[0] * d
+        p_diffuse * d
     }
 
     /// Samples a direction for a path arriving from `wo`: a lobe chosen with `u_lobe` (the
@@ -313,7 +327,7 @@ impl Bsdf {
                     cos_a,
                 ))
             };
-            let pdf = self.pdf(wo, wi, fr);
+            let pdf = self.diffuse_pdf(p[0], lambert, wo, wi, fr);
             let f = self.eval(wo, wi, fr, mode);
             if !(pdf > 0.0) || f == Vec3::ZERO {
                 return None;
