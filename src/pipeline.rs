@@ -8,6 +8,7 @@ use crate::error::Error;
 use crate::render_scene::RenderScene;
 use crate::scene::load::SourceFile;
 use crate::scene::overrides::apply_overrides;
+use crate::scene::schema::LightSpec;
 use crate::scene::validate::validate;
 use crate::scene::{Diagnostic, SceneError, SceneFile};
 
@@ -26,6 +27,9 @@ pub struct SceneOverrides {
     pub max_depth: Option<u32>,
     /// `render.seed`.
     pub seed: Option<u64>,
+    /// `photons.caustic`, shared by power among all lights (their own `caustic_photons` are
+    /// dropped).
+    pub caustic_photons: Option<u32>,
 }
 
 impl SceneOverrides {
@@ -38,6 +42,19 @@ impl SceneOverrides {
         r.samples_per_pixel = self.samples_per_pixel.unwrap_or(r.samples_per_pixel);
         r.max_depth = self.max_depth.unwrap_or(r.max_depth);
         r.seed = self.seed.unwrap_or(r.seed);
+        if let Some(n) = self.caustic_photons {
+            s.photons.caustic = n;
+            for l in &mut s.lights {
+                match l {
+                    LightSpec::Point {
+                        caustic_photons, ..
+                    }
+                    | LightSpec::Sphere {
+                        caustic_photons, ..
+                    } => *caustic_photons = None,
+                }
+            }
+        }
         Ok(s)
     }
 
@@ -56,6 +73,7 @@ impl SceneOverrides {
             ("render.samples_per_pixel", self.samples_per_pixel.is_some()),
             ("render.max_depth", self.max_depth.is_some()),
             ("render.seed", self.seed.is_some()),
+            ("photons.caustic", self.caustic_photons.is_some()),
         ] {
             if set {
                 p.push(flag.to_string());

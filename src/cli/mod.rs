@@ -60,6 +60,8 @@ enum IntegratorArg {
     Whitted,
     /// Path tracing with next-event estimation and MIS (unbiased global illumination).
     Path,
+    /// Photon mapping: caustic and global photon maps, final gathering.
+    Photon,
 }
 
 /// Samplers, as named on the command line.
@@ -100,6 +102,22 @@ pub struct SceneArgs {
     /// Random-number sampler (the scene's `render.sampler`).
     #[arg(long, value_enum)]
     sampler: Option<SamplerArg>,
+    /// Photons emitted for the global map (`photons.global`; 0: no global map).
+    #[arg(long, value_name = "N")]
+    photons: Option<u32>,
+    /// Caustic photons (`photons.caustic`), shared by power among all lights: replaces the
+    /// lights' own `caustic_photons` (0: no caustic map).
+    #[arg(long, value_name = "N")]
+    caustic_photons: Option<u32>,
+    /// Nearest photons per global estimate (`photons.gather`).
+    #[arg(long, value_name = "K")]
+    gather: Option<u32>,
+    /// Largest photon-estimate radius in scene units (`photons.max_radius`).
+    #[arg(long, value_name = "R")]
+    max_radius: Option<f32>,
+    /// Final-gather rays per camera hit (`photons.final_gather`; 0: read the global map).
+    #[arg(long, value_name = "N")]
+    final_gather: Option<u32>,
 }
 
 impl SceneArgs {
@@ -109,6 +127,7 @@ impl SceneArgs {
             let name = match i {
                 IntegratorArg::Whitted => "Whitted",
                 IntegratorArg::Path => "Path",
+                IntegratorArg::Photon => "Photon",
             };
             sets.push(format!("render.integrator={name}"));
         }
@@ -119,7 +138,20 @@ impl SceneArgs {
             };
             sets.push(format!("render.sampler={name}"));
         }
+        for (field, v) in [
+            ("photons.global", self.photons),
+            ("photons.gather", self.gather),
+            ("photons.final_gather", self.final_gather),
+        ] {
+            if let Some(v) = v {
+                sets.push(format!("{field}={v}"));
+            }
+        }
+        if let Some(r) = self.max_radius {
+            sets.push(format!("photons.max_radius={r:?}"));
+        }
         SceneOverrides {
+            caustic_photons: self.caustic_photons,
             sets,
             width: self.width,
             height: self.height,

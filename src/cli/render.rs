@@ -231,6 +231,11 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         ..RenderOptions::default()
     };
     let job = RenderJob::new(&prepared.render_scene, &options)?;
+    if !args.quiet
+        && let Some(maps) = job.integrator().photon_maps()
+    {
+        eprintln!("{}", maps.summary);
+    }
     let plan = PassPlan {
         checkpoint: args.checkpoint.as_deref().map(|path| CheckpointPlan {
             path,
@@ -295,6 +300,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         st.threads,
         if st.threads == 1 { "" } else { "s" }
     );
+    if st.photon_estimates > 0 && !args.quiet {
+        eprintln!(
+            "photons: {} estimates, {:.1}% cut short by the largest radius",
+            st.photon_estimates,
+            100.0 * st.photon_radius_cut as f64 / st.photon_estimates as f64
+        );
+    }
     if st.nan_samples > 0 {
         eprintln!(
             "warning: {} samples were NaN or infinite and were dropped",

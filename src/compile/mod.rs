@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use crate::accel::BvhStats;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::render_scene::{Camera, Light, ObjectInfo, RenderParams, RenderScene};
-use crate::render_scene::{IntegratorKind, TextureFilter};
+use crate::render_scene::{IntegratorKind, PhotonParams, TextureFilter};
 use crate::sampling::SamplerKind;
 use crate::scene::Diagnostic;
 use crate::scene::schema::{self, CameraSpec, LightSpec, SceneFile};
@@ -51,6 +51,25 @@ pub struct CompileStats {
     pub warnings: Vec<Diagnostic>,
 }
 
+/// The photon settings as the renderer reads them.
+fn photon_params(p: &schema::PhotonSettings, lights: &[LightSpec]) -> PhotonParams {
+    PhotonParams {
+        global: p.global,
+        caustic: p.caustic,
+        caustic_per_light: lights.iter().map(LightSpec::caustic_photons).collect(),
+        gather: p.gather,
+        caustic_gather: p.caustic_gather,
+        max_radius: p.max_radius,
+        caustic_cone: match p.caustic_filter {
+            schema::PhotonFilter::Box => None,
+            schema::PhotonFilter::Cone { k } => Some(k),
+        },
+        min_bounces: p.min_bounces,
+        final_gather: p.final_gather,
+        max_bounces: p.max_bounces,
+    }
+}
+
 /// Compiles a validated scene. Asset paths resolve against `base_dir`. Returns all asset errors.
 pub fn compile(
     scene: &SceneFile,
@@ -85,13 +104,14 @@ pub fn compile(
     let mut lights = Vec::with_capacity(scene.lights.len());
     for (i, l) in scene.lights.iter().enumerate() {
         match *l {
-            LightSpec::Point { position, power } => {
-                lights.push(Light::point(position.into(), power.into()))
-            }
+            LightSpec::Point {
+                position, power, ..
+            } => lights.push(Light::point(position.into(), power.into())),
             LightSpec::Sphere {
                 center,
                 radius,
                 power,
+                ..
             } => {
                 let eye = match scene.camera {
                     CameraSpec::Pinhole { eye, .. } => eye.into(),
@@ -153,6 +173,7 @@ pub fn compile(
         integrator: match r.integrator {
             schema::IntegratorKind::Whitted => IntegratorKind::Whitted,
             schema::IntegratorKind::Path => IntegratorKind::Path,
+            schema::IntegratorKind::Photon => IntegratorKind::Photon,
         },
         sampler: match r.sampler {
             schema::SamplerKind::Independent => SamplerKind::Independent,
@@ -164,6 +185,7 @@ pub fn compile(
             schema::TextureFilter::Trilinear => TextureFilter::Trilinear,
             schema::TextureFilter::Bilinear => TextureFilter::Bilinear,
         },
+        photons: photon_params(&scene.photons, &scene.lights),
     };
     let CameraSpec::Pinhole {
         eye,

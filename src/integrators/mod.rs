@@ -3,11 +3,13 @@
 //! and then asked for the radiance of camera samples by every worker.
 
 pub mod path;
+pub mod photon;
 pub mod shadow;
 pub mod trace_log;
 pub mod whitted;
 
 pub use path::PathTracer;
+pub use photon::PhotonMapper;
 pub use trace_log::TraceLog;
 pub use whitted::Whitted;
 
@@ -23,6 +25,19 @@ use crate::sampling::Sampler;
 pub struct Counters {
     /// Rays traced (camera, scattered and shadow).
     pub rays: u64,
+    /// Photon-map density estimates made.
+    pub photon_estimates: u64,
+    /// Estimates whose k-nearest search the largest radius cut short.
+    pub photon_radius_cut: u64,
+}
+
+impl Counters {
+    /// Adds `other` into `self`.
+    pub fn add(&mut self, other: &Counters) {
+        self.rays += other.rays;
+        self.photon_estimates += other.photon_estimates;
+        self.photon_radius_cut += other.photon_radius_cut;
+    }
 }
 
 /// A prepared integrator: shared, immutable state built once per render (light selection
@@ -33,6 +48,8 @@ pub enum Integrator<'a> {
     Whitted(Whitted<'a>),
     /// Unidirectional path tracing with next-event estimation ([`PathTracer`]).
     Path(PathTracer<'a>),
+    /// Photon mapping ([`PhotonMapper`]); its maps are built by `prepare`.
+    Photon(Box<PhotonMapper<'a>>),
 }
 
 impl<'a> Integrator<'a> {
@@ -42,6 +59,16 @@ impl<'a> Integrator<'a> {
         match scene.params.integrator {
             IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(scene)),
             IntegratorKind::Path => Integrator::Path(PathTracer::new(scene)),
+            IntegratorKind::Photon => Integrator::Photon(Box::new(PhotonMapper::new(scene))),
+        }
+    }
+
+    /// The photon maps and how they were built, for the photon integrator.
+    #[must_use]
+    pub fn photon_maps(&self) -> Option<&photon::PhotonMaps> {
+        match self {
+            Integrator::Photon(p) => Some(p.maps()),
+            _ => None,
         }
     }
 
@@ -59,6 +86,7 @@ impl<'a> Integrator<'a> {
         match self {
             Integrator::Whitted(w) => w.li(ray, sampler, counters, log),
             Integrator::Path(p) => p.li(ray, sampler, counters, log),
+            Integrator::Photon(p) => p.li(ray, sampler, counters, log),
         }
     }
 }

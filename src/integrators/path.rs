@@ -7,10 +7,10 @@ use glam::Vec3;
 
 use super::Counters;
 use super::shadow::{RayCone, shadow_ray};
-use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog};
+use super::trace_log::{RayKind, ShadowRecord, TraceLog};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Hit, Light, LightSampler, RenderScene, SurfacePoint};
+use crate::render_scene::{Light, LightSampler, RenderScene, SurfacePoint};
 use crate::sampling::Sampler;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
@@ -109,7 +109,7 @@ impl<'a> PathTracer<'a> {
                 };
                 l += beta * le;
                 if let Some(lg) = log.as_deref_mut() {
-                    record_hit(lg, node, scene, &hit, &sp, "light");
+                    lg.record_hit(node, scene, &hit, &sp, "light");
                 }
                 break;
             };
@@ -121,7 +121,7 @@ impl<'a> PathTracer<'a> {
             );
             if let Some(lg) = log.as_deref_mut() {
                 let name = scene.material_names[m as usize].clone();
-                record_hit(lg, node, scene, &hit, &sp, &name);
+                lg.record_hit(node, scene, &hit, &sp, &name);
             }
             if depth >= params.max_depth {
                 TraceLog::note(log.as_deref_mut(), node, "max depth reached");
@@ -272,27 +272,5 @@ impl PathTracer<'_> {
             });
         }
         c
-    }
-}
-
-fn record_hit(
-    log: &mut TraceLog,
-    node: Option<usize>,
-    scene: &RenderScene,
-    hit: &Hit,
-    sp: &SurfacePoint,
-    material: &str,
-) {
-    if let Some(me) = node {
-        let wo = -log.nodes[me].dir;
-        let entering = wo.dot(sp.ng) > 0.0;
-        log.nodes[me].hit = Some(TraceHit {
-            t: hit.t,
-            point: sp.p,
-            normal: if entering { sp.ns } else { -sp.ns },
-            object: scene.objects[sp.object as usize].name.clone(),
-            material: material.to_string(),
-            entering,
-        });
     }
 }

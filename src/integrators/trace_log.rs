@@ -3,6 +3,7 @@
 use glam::Vec3;
 
 use crate::geometry::Ray;
+use crate::render_scene::{Hit, RenderScene, SurfacePoint};
 
 /// Why a ray was cast.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -113,6 +114,52 @@ impl TraceLog {
             self.nodes[p].children.push(id);
         }
         id
+    }
+
+    /// Records the surface `sp` that ray `node` hit (object and `material` names, the normal on
+    /// the ray's side).
+    pub fn record_hit(
+        &mut self,
+        node: Option<usize>,
+        scene: &RenderScene,
+        hit: &Hit,
+        sp: &SurfacePoint,
+        material: &str,
+    ) {
+        if let Some(me) = node {
+            let wo = -self.nodes[me].dir;
+            let entering = wo.dot(sp.ng) > 0.0;
+            self.nodes[me].hit = Some(TraceHit {
+                t: hit.t,
+                point: sp.p,
+                normal: if entering { sp.ns } else { -sp.ns },
+                object: scene.objects[sp.object as usize].name.clone(),
+                material: material.to_string(),
+                entering,
+            });
+        }
+    }
+
+    /// For a tree whose nodes from `root` on hold the weighted radiance gathered *at* each ray's
+    /// hit (path weight × what that vertex added), turns each into the radiance the ray
+    /// brought back: its own plus its descendants', divided by its path weight.
+    pub fn finish_tree(&mut self, root: usize) {
+        for i in (root + 1..self.nodes.len()).rev() {
+            let c = self.nodes[i].radiance;
+            if let Some(p) = (root..i)
+                .rev()
+                .find(|&p| self.nodes[p].children.contains(&i))
+            {
+                self.nodes[p].radiance += c;
+            }
+        }
+        for n in &mut self.nodes[root..] {
+            n.radiance = Vec3::select(
+                n.weight.cmpgt(Vec3::ZERO),
+                n.radiance / n.weight,
+                Vec3::ZERO,
+            );
+        }
     }
 
     /// Records why the path stopped at `node` (when there is a log and a node).

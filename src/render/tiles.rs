@@ -59,6 +59,10 @@ pub struct RenderStats {
     pub samples: u64,
     /// Samples whose radiance was NaN or infinite (dropped from the pixel, counted here).
     pub nan_samples: u64,
+    /// Photon-map density estimates made (photon integrator).
+    pub photon_estimates: u64,
+    /// Estimates whose k-nearest search the largest radius cut short.
+    pub photon_radius_cut: u64,
     /// Worker threads used.
     pub threads: usize,
     /// Wall-clock time of the render (excluding scene loading).
@@ -172,6 +176,8 @@ impl<'a> RenderJob<'a> {
             .build()
             .map_err(|e| RenderError::Threads(threads, e.to_string()))?;
         let tiles = tile_grid(region);
+        // Shared state (photon maps) is built on the job's own workers.
+        let integrator = pool.install(|| Integrator::prepare(scene));
         let range = options
             .samples
             .clone()
@@ -187,7 +193,7 @@ impl<'a> RenderJob<'a> {
         let progress = progress_bar(options.progress, tiles.len() as u64 * spp);
         Ok(Self {
             scene,
-            integrator: Integrator::prepare(scene),
+            integrator,
             region,
             tiles,
             pool,
@@ -203,6 +209,12 @@ impl<'a> RenderJob<'a> {
             },
             start: Instant::now(),
         })
+    }
+
+    /// The prepared integrator (e.g. to report how its photon maps were built).
+    #[must_use]
+    pub fn integrator(&self) -> &Integrator<'a> {
+        &self.integrator
     }
 
     /// One past the last sample index of the finished render (its samples per pixel when it
@@ -251,6 +263,8 @@ impl<'a> RenderJob<'a> {
                     .add_pixel(pixel_index(region, tile, i), &r.sums, i);
             }
             self.stats.rays += r.counters.rays;
+            self.stats.photon_estimates += r.counters.photon_estimates;
+            self.stats.photon_radius_cut += r.counters.photon_radius_cut;
             self.stats.nan_samples += r.nan;
         }
         self.done = end;

@@ -49,6 +49,33 @@ pub struct RenderParams {
     pub diffuse_depth: u32,
     /// How image textures are filtered.
     pub texture_filter: TextureFilter,
+    /// Photon-map settings (the `photon` integrator).
+    pub photons: PhotonParams,
+}
+
+/// Photon-map settings after command-line overrides (see the scene schema's `photons`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhotonParams {
+    /// Photons emitted for the global map, shared among lights by power.
+    pub global: u32,
+    /// Caustic photons shared by power among the lights without their own budget.
+    pub caustic: u32,
+    /// Per light (parallel to `RenderScene::lights`): its own caustic photon count, if set.
+    pub caustic_per_light: Vec<Option<u32>>,
+    /// k of global-map estimates.
+    pub gather: u32,
+    /// k of caustic-map estimates.
+    pub caustic_gather: u32,
+    /// Largest estimate radius (scene units); `None`: chosen per map from the scene's size.
+    pub max_radius: Option<f32>,
+    /// Cone-filter constant of caustic estimates; `None`: box filter.
+    pub caustic_cone: Option<f32>,
+    /// Diffuse bounces before the global map stores a photon (≥ 1).
+    pub min_bounces: u32,
+    /// Final-gather rays per camera hit (0: read the global map directly).
+    pub final_gather: u32,
+    /// Most bounces of a photon path.
+    pub max_bounces: u32,
 }
 
 /// Which light-transport algorithm renders the image (see the scene schema's `integrator`).
@@ -58,6 +85,8 @@ pub enum IntegratorKind {
     Whitted,
     /// Path tracing (`integrators::PathTracer`).
     Path,
+    /// Photon mapping (`integrators::PhotonMapper`).
+    Photon,
 }
 
 /// How image textures are filtered (see the scene schema's `texture_filter`).

@@ -42,6 +42,33 @@ pub fn uniform_sphere(u: (f32, f32)) -> Vec3 {
     Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
+/// Point `i` of the `n`-point spherical Fibonacci lattice (González, "Measurement of areas on a
+/// sphere using Fibonacci and latitude–longitude lattices", Math. Geosciences 2010): heights
+/// `z = 1 − (2i + 1)/n` (equal-area bands), longitudes advancing by the golden angle. Every
+/// point stands for the same solid angle `4π/n`, so `n` photons sent along the lattice sample
+/// an isotropic light with density `1/(4π)` and far less clumping than random directions.
+/// `i < n`; computed in f64 so the longitude stays exact for large `i`.
+#[inline]
+#[must_use]
+pub fn spherical_fibonacci(i: u32, n: u32) -> Vec3 {
+    // 2π (1 − 1/φ): the golden angle in radians.
+    const GOLDEN_ANGLE: f64 = 2.399_963_229_728_653;
+    let n = f64::from(n.max(1));
+    let z = 1.0 - (2.0 * f64::from(i) + 1.0) / n;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = (GOLDEN_ANGLE * f64::from(i)) % std::f64::consts::TAU;
+    Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32)
+}
+
+/// A uniformly distributed random rotation from three uniforms (Shoemake, "Uniform random
+/// rotations", Graphics Gems III, 1992): a unit quaternion uniform on the 3-sphere.
+#[must_use]
+pub fn uniform_rotation(u: [f32; 3]) -> glam::Quat {
+    let (a, b) = ((1.0 - u[0]).sqrt(), u[0].sqrt());
+    let (t1, t2) = (TAU * u[1], TAU * u[2]);
+    glam::Quat::from_xyzw(a * t1.sin(), a * t1.cos(), b * t2.sin(), b * t2.cos()).normalize()
+}
+
 /// Cosine-weighted direction in the hemisphere around the unit `n`; density `cos θ / π`.
 #[inline]
 #[must_use]

@@ -29,6 +29,9 @@ pub struct SceneFile {
     /// Named materials, referenced by name from nodes.
     #[serde(deserialize_with = "unique_keys")]
     pub materials: BTreeMap<String, MaterialSpec>,
+    /// Photon-map settings (the `photon` integrator): counts, gathering and filtering.
+    #[serde(default)]
+    pub photons: PhotonSettings,
     /// Light sources. A scene without lights renders black except for what is emissive.
     #[serde(default)]
     pub lights: Vec<LightSpec>,
@@ -99,6 +102,74 @@ pub enum IntegratorKind {
     /// Path tracing with next-event estimation and multiple importance sampling: unbiased
     /// global illumination, the reference the other integrators are checked against.
     Path,
+    /// Photon mapping (Jensen 2001): direct light by shadow rays, caustics from a caustic photon
+    /// map, indirect light from a global map read directly or by final gathering (`photons`).
+    Photon,
+}
+
+/// Photon-map settings: the report's Settings.hpp photon constants, made explicit. Counts are
+/// photons *emitted*; each light gets a share in proportion to its power (equal-flux photons).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct PhotonSettings {
+    /// Photons emitted for the global map (diffuse interreflection); 0 builds no global map.
+    pub global: u32,
+    /// Caustic photons, aimed at objects that reflect or transmit (Jensen's projection maps)
+    /// and stored where they land on a diffuse surface after specular bounces only; 0 builds no
+    /// caustic map. Shared among the lights in proportion to power, except lights that set
+    /// their own `caustic_photons`.
+    pub caustic: u32,
+    /// Nearest photons per global-map estimate (k).
+    pub gather: u32,
+    /// Nearest photons per caustic-map estimate (k).
+    pub caustic_gather: u32,
+    /// Largest radius (scene units) of an estimate's disc; unset: chosen from the scene's size
+    /// and the photon count (reported in the summary).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_radius: Option<f32>,
+    /// The kernel of caustic estimates.
+    pub caustic_filter: PhotonFilter,
+    /// Diffuse bounces a photon must have made before the global map stores it (the report's
+    /// MIN_PHOTON_BOUNCE). At least 1: direct light always comes from shadow rays; more than 1
+    /// drops the first bounces of indirect light.
+    pub min_bounces: u32,
+    /// Final-gather rays per camera hit on a diffuse surface (indirect light sampled from the
+    /// BSDF and read from the maps where those rays land); 0 reads the global map directly.
+    pub final_gather: u32,
+    /// Most bounces a photon path makes before it is dropped.
+    pub max_bounces: u32,
+}
+
+impl Default for PhotonSettings {
+    fn default() -> Self {
+        Self {
+            global: 200_000,
+            caustic: 200_000,
+            gather: 100,
+            caustic_gather: 60,
+            max_radius: None,
+            caustic_filter: PhotonFilter::Cone { k: 1.1 },
+            min_bounces: 1,
+            final_gather: 16,
+            max_bounces: 16,
+        }
+    }
+}
+
+/// The kernel that weighs photons in a density estimate by their distance `d` from the query
+/// point, within the disc of radius `r`; each is normalised so a uniform photon density reads
+/// its true value (the report's CAUSTIC_SHARPNESS made explicit and energy-preserving).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub enum PhotonFilter {
+    /// Every photon counts equally.
+    Box,
+    /// Jensen's cone filter: weight `1 − d/(k·r)`, normalised by `1 − 2/(3k)`; `k ≥ 1`, smaller
+    /// is sharper (1 reaches 0 at the rim).
+    Cone {
+        /// Cone slope constant (≥ 1).
+        k: f32,
+    },
 }
 
 /// Which sequence the integrators draw their random numbers from.
@@ -407,6 +478,10 @@ pub enum LightSpec {
         /// Total emitted flux (W).
         #[serde(deserialize_with = "exact_floats::<_, 3>")]
         power: Rgb,
+        /// Caustic photons this light emits, instead of its power share of
+        /// `photons.caustic` (0: none).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        caustic_photons: Option<u32>,
     },
     /// A spherical area light emitting uniformly from its surface; gives soft shadows.
     Sphere {
@@ -418,7 +493,26 @@ pub enum LightSpec {
         /// Total emitted flux (W).
         #[serde(deserialize_with = "exact_floats::<_, 3>")]
         power: Rgb,
+        /// Caustic photons this light emits, instead of its power share of
+        /// `photons.caustic` (0: none).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        caustic_photons: Option<u32>,
     },
+}
+
+impl LightSpec {
+    /// The light's own caustic photon budget, if it sets one.
+    #[must_use]
+    pub fn caustic_photons(&self) -> Option<u32> {
+        match *self {
+            LightSpec::Point {
+                caustic_photons, ..
+            }
+            | LightSpec::Sphere {
+                caustic_photons, ..
+            } => caustic_photons,
+        }
+    }
 }
 
 /// A node of the scene graph. Transforms apply in list order (the first one first), and a

@@ -4,8 +4,8 @@ use std::collections::BTreeSet;
 
 use super::diagnostic::{Diagnostic, did_you_mean, quoted_list};
 use super::schema::{
-    CameraSpec, ColorSpec, LightSpec, MaterialSpec, NodeSpec, RenderSettings, SceneFile,
-    TextureSpec, TransformStep,
+    CameraSpec, ColorSpec, LightSpec, MaterialSpec, NodeSpec, PhotonFilter, PhotonSettings,
+    RenderSettings, SceneFile, TextureSpec, TransformStep,
 };
 
 /// Largest accepted image side, in pixels.
@@ -32,6 +32,14 @@ pub const MAX_TURBULENCE: f32 = 1e4;
 /// power divided by a constant and `render.exposure` multiplied by it.
 pub const MAX_LIGHT_POWER: f32 = 1e30;
 
+/// Most photons one map may be given: each emitted photon may be stored a few times (once per
+/// diffuse bounce), at 24 bytes each, so this bounds a map to a few GB.
+pub const MAX_PHOTONS: u32 = 50_000_000;
+/// Most photons one density estimate may gather.
+pub const MAX_GATHER: u32 = 10_000;
+/// Most final-gather rays per camera hit.
+pub const MAX_FINAL_GATHER: u32 = 4096;
+
 /// Most ripple centres per texture.
 pub const MAX_RIPPLE_CENTERS: usize = 256;
 
@@ -52,6 +60,7 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
         scene,
     };
     v.render(&scene.render);
+    v.photons(&scene.photons);
     v.camera(&scene.camera);
     for (name, t) in &scene.textures {
         v.texture(&format!("textures.{name}"), t);
@@ -70,6 +79,9 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
     }
     for (i, l) in scene.lights.iter().enumerate() {
         v.light(&format!("lights[{i}]"), l);
+        if let Some(n) = l.caustic_photons() {
+            v.photon_count(&format!("lights[{i}].caustic_photons"), n);
+        }
     }
     if scene.nodes.is_empty() {
         v.out.push(Diagnostic::error(
@@ -505,9 +517,84 @@ impl<'a> Validator<'a> {
         }
     }
 
+    /// A photon count: at most [`MAX_PHOTONS`] (the map's memory is stated in the message).
+    fn photon_count(&mut self, path: &str, n: u32) {
+        if n > MAX_PHOTONS {
+            self.out.push(
+                Diagnostic::error(
+                    path,
+                    format!(
+                        "must be at most {MAX_PHOTONS} photons, found {n} (a map that size could need {:.1} GB)",
+                        f64::from(n) * 24.0 * 4.0 / 1e9
+                    ),
+                )
+                .with_help("photon maps store up to a few photons per emitted photon at 24 bytes each; use `--time` or `ppm` passes for more"),
+            );
+        }
+    }
+
+    fn photons(&mut self, p: &PhotonSettings) {
+        self.photon_count("photons.global", p.global);
+        self.photon_count("photons.caustic", p.caustic);
+        for (field, k) in [("gather", p.gather), ("caustic_gather", p.caustic_gather)] {
+            if k == 0 || k > MAX_GATHER {
+                self.err(
+                    &format!("photons.{field}"),
+                    format!("must be within [1, {MAX_GATHER}] photons, found {k}"),
+                );
+            }
+        }
+        if let Some(r) = p.max_radius {
+            self.positive("photons.max_radius", r, "the radius");
+        }
+        if let PhotonFilter::Cone { k } = p.caustic_filter
+            && self.finite("photons.caustic_filter.k", k)
+            && !(1.0..=1e6).contains(&k)
+        {
+            self.out.push(
+                Diagnostic::error(
+                    "photons.caustic_filter.k",
+                    format!("must be within [1, 1e6], found {k}"),
+                )
+                .with_help(
+                    "k = 1 is the sharpest cone (weight 0 at the rim); larger k tends to `Box`",
+                ),
+            );
+        }
+        if p.min_bounces == 0 || p.min_bounces > p.max_bounces {
+            self.out.push(
+                Diagnostic::error(
+                    "photons.min_bounces",
+                    format!(
+                        "must be within [1, photons.max_bounces = {}], found {}",
+                        p.max_bounces, p.min_bounces
+                    ),
+                )
+                .with_help("direct light always comes from shadow rays, so the global map starts after at least one diffuse bounce"),
+            );
+        }
+        if p.max_bounces > MAX_DEPTH {
+            self.err(
+                "photons.max_bounces",
+                format!("must be at most {MAX_DEPTH}, found {}", p.max_bounces),
+            );
+        }
+        if p.final_gather > MAX_FINAL_GATHER {
+            self.err(
+                "photons.final_gather",
+                format!(
+                    "must be at most {MAX_FINAL_GATHER} rays per hit, found {}",
+                    p.final_gather
+                ),
+            );
+        }
+    }
+
     fn light(&mut self, path: &str, l: &LightSpec) {
         let (power, power_path) = match l {
-            LightSpec::Point { position, power } => {
+            LightSpec::Point {
+                position, power, ..
+            } => {
                 self.finite3(&format!("{path}.position"), *position);
                 (power, format!("{path}.power"))
             }
@@ -515,6 +602,7 @@ impl<'a> Validator<'a> {
                 center,
                 radius,
                 power,
+                ..
             } => {
                 self.finite3(&format!("{path}.center"), *center);
                 self.positive(&format!("{path}.radius"), *radius, "radius");

@@ -1,0 +1,303 @@
+//! Aiming caustic photons at the objects that can focus light: Jensen's projection maps
+//! ("Realistic Image Synthesis Using Photon Mapping", 2001, §5.3), with each specular object's
+//! projection taken as the cone of directions its bounding sphere subtends from the emitting
+//! point.
+//!
+//! Directions are drawn from the mixture of the cones, each chosen in proportion to its solid
+//! angle Ωⱼ and sampled uniformly inside. The mixture's density at a direction `w` is
+//! `Σⱼ (Ωⱼ/ΣΩ)·[w ∈ coneⱼ]/Ωⱼ = count(w)/ΣΩ`, where `count(w)` is how many cones contain `w`, so
+//! overlapping cones stay unbiased. A photon's flux divides by that density: the solid-angle
+//! fraction of the light that the cones cover is in every photon's flux. When the cones cover
+//! the whole sphere (ΣΩ ≥ 4π, e.g. a light inside a bounding sphere) uniform directions are used.
+
+use glam::{DAffine3, Vec3};
+use std::f32::consts::{PI, TAU};
+
+use crate::geometry::Frame;
+use crate::render_scene::RenderScene;
+use crate::sampling::warp::uniform_sphere;
+
+/// Bounding spheres (centre, radius) of every object whose material has a mirror or dielectric
+/// part: where caustic photons are sent.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CausticTargets {
+    spheres: Vec<(Vec3, f32)>,
+}
+
+/// One cone of directions from an emitting point towards a target.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AimCone {
+    /// Unit axis, from the emitting point to the target's centre.
+    pub axis: Vec3,
+    /// `1 − cos θmax` of the half-angle (in `(0, 2]`; 2 is the whole sphere).
+    pub one_minus_cos: f32,
+}
+
+/// Bounds of one object's primitives while they are gathered.
+#[derive(Debug, Clone, Copy)]
+enum ObjectBounds {
+    /// A single sphere primitive (bounded exactly).
+    Sphere(Vec3, f32),
+    /// Several primitives, or triangles: an axis-aligned box.
+    Box(Vec3, Vec3),
+}
+
+impl ObjectBounds {
+    fn add_box(self, lo: Vec3, hi: Vec3) -> Self {
+        let (a, b) = match self {
+            ObjectBounds::Sphere(c, r) => (c - Vec3::splat(r), c + Vec3::splat(r)),
+            ObjectBounds::Box(a, b) => (a, b),
+        };
+        ObjectBounds::Box(a.min(lo), b.max(hi))
+    }
+
+    fn sphere(self) -> (Vec3, f32) {
+        match self {
+            ObjectBounds::Sphere(c, r) => (c, r),
+            ObjectBounds::Box(lo, hi) => ((lo + hi) * 0.5, (hi - lo).length() * 0.5),
+        }
+    }
+}
+
+/// Axis-aligned bounds of a unit sphere under an affine map: the half-extent along world axis
+/// `i` is the length of row `i` of the linear part.
+fn ellipsoid_box(m: &DAffine3) -> (Vec3, Vec3) {
+    let c = m.translation.as_vec3();
+    let rows = m.matrix3.transpose();
+    let half = Vec3::new(
+        rows.x_axis.length() as f32,
+        rows.y_axis.length() as f32,
+        rows.z_axis.length() as f32,
+    );
+    (c - half, c + half)
+}
+
+impl CausticTargets {
+    /// The bounding sphere of every object whose material reflects or transmits (has a delta
+    /// lobe). Emitters and purely diffuse objects are not targets.
+    #[must_use]
+    pub fn new(scene: &RenderScene) -> Self {
+        let is_target: Vec<bool> = scene
+            .objects
+            .iter()
+            .map(|o| {
+                o.material
+                    .is_some_and(|m| scene.materials[m as usize].bsdf.has_delta())
+            })
+            .collect();
+        let mut bounds: Vec<Option<ObjectBounds>> = vec![None; scene.objects.len()];
+        let g = &scene.geometry;
+        let mut add = |object: u32, b: ObjectBounds| {
+            let Some(slot) = bounds.get_mut(object as usize) else {
+                return;
+            };
+            if !is_target[object as usize] {
+                return;
+            }
+            *slot = Some(match (*slot, b) {
+                (None, b) => b,
+                (Some(old), ObjectBounds::Box(lo, hi)) => old.add_box(lo, hi),
+                (Some(old), ObjectBounds::Sphere(c, r)) => {
+                    old.add_box(c - Vec3::splat(r), c + Vec3::splat(r))
+                }
+            });
+        };
+        for (tri, attrs) in g.triangles.iter().zip(&g.tri_attrs) {
+            let lo = tri[0].min(tri[1]).min(tri[2]);
+            let hi = tri[0].max(tri[1]).max(tri[2]);
+            add(attrs.object, ObjectBounds::Box(lo, hi));
+        }
+        for s in &g.spheres {
+            add(s.object, ObjectBounds::Sphere(s.center, s.radius));
+        }
+        for e in &g.ellipsoids {
+            let (lo, hi) = ellipsoid_box(&e.world_from_object);
+            add(e.object, ObjectBounds::Box(lo, hi));
+        }
+        let spheres = bounds
+            .into_iter()
+            .flatten()
+            .map(ObjectBounds::sphere)
+            .filter(|(c, r)| c.is_finite() && r.is_finite())
+            .collect();
+        Self { spheres }
+    }
+
+    /// Targets from explicit bounding spheres (tests, tools).
+    #[must_use]
+    pub fn from_spheres(spheres: Vec<(Vec3, f32)>) -> Self {
+        Self { spheres }
+    }
+
+    /// True if the scene has nothing that can focus light (no caustic map can be built).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.spheres.is_empty()
+    }
+
+    /// Number of targets.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.spheres.len()
+    }
+
+    /// The cones the targets subtend from `from`, written into `out` (cleared first); returns
+    /// their total solid angle ΣΩ (sr). A target that contains `from` gives the whole sphere.
+    pub fn cones(&self, from: Vec3, out: &mut Vec<AimCone>) -> f32 {
+        out.clear();
+        let mut total = 0.0;
+        for &(c, r) in &self.spheres {
+            let d = c - from;
+            let dist2 = d.length_squared();
+            let cone = if dist2 <= r * r || dist2 == 0.0 {
+                AimCone {
+                    axis: Vec3::Z,
+                    one_minus_cos: 2.0,
+                }
+            } else {
+                let sin2 = (r * r / dist2).min(1.0);
+                let cos = (1.0 - sin2).max(0.0).sqrt();
+                AimCone {
+                    axis: d / dist2.sqrt(),
+                    // 1 − cos written as sin²/(1 + cos): exact for tiny cones.
+                    one_minus_cos: sin2 / (1.0 + cos),
+                }
+            };
+            total += TAU * cone.one_minus_cos;
+            out.push(cone);
+        }
+        total
+    }
+}
+
+/// Samples a direction from the mixture of `cones` (of total solid angle `total`, as returned
+/// by [`CausticTargets::cones`]) with `u_pick ∈ [0, 1)` choosing the cone and `u` the direction
+/// in it; returns the direction and the mixture's solid-angle density there (1/sr). Uniform
+/// over the sphere (density 1/(4π)) when the cones cover at least 4π. `None` without cones.
+#[must_use]
+pub fn sample_cones(
+    cones: &[AimCone],
+    total: f32,
+    u_pick: f32,
+    u: (f32, f32),
+) -> Option<(Vec3, f32)> {
+    if cones.is_empty() || !(total > 0.0) {
+        return None;
+    }
+    if total >= 4.0 * PI {
+        return Some((uniform_sphere(u), 1.0 / (4.0 * PI)));
+    }
+    let mut target = u_pick * total;
+    let mut chosen = cones.len() - 1;
+    for (j, c) in cones.iter().enumerate() {
+        let omega = TAU * c.one_minus_cos;
+        if target < omega {
+            chosen = j;
+            break;
+        }
+        target -= omega;
+    }
+    let c = cones[chosen];
+    let one_minus_cos = (u.0 * c.one_minus_cos).min(c.one_minus_cos);
+    let cos_t = 1.0 - one_minus_cos;
+    let sin_t = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+    let phi = TAU * u.1;
+    let dir = Frame::from_normal(c.axis)
+        .to_world(Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t))
+        .normalize();
+    // The chosen cone contains the direction even where rounding puts it a hair outside.
+    let count = cones
+        .iter()
+        .enumerate()
+        .filter(|&(j, k)| j == chosen || contains(k, dir))
+        .count();
+    Some((dir, count as f32 / total))
+}
+
+/// True if unit `dir` lies in cone `c` (with a relative slack of a few ulps at the rim).
+#[inline]
+fn contains(c: &AimCone, dir: Vec3) -> bool {
+    c.one_minus_cos >= 2.0 || 1.0 - dir.dot(c.axis) <= c.one_minus_cos * (1.0 + 1e-5) + 1e-7
+}
+
+/// The density [`sample_cones`] gives direction `dir` (unit): how many cones contain it over
+/// their total solid angle, or 1/(4π) when they cover the sphere.
+#[must_use]
+pub fn cones_pdf(cones: &[AimCone], total: f32, dir: Vec3) -> f32 {
+    if cones.is_empty() || !(total > 0.0) {
+        return 0.0;
+    }
+    if total >= 4.0 * PI {
+        return 1.0 / (4.0 * PI);
+    }
+    cones.iter().filter(|c| contains(c, dir)).count() as f32 / total
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Rng;
+
+    #[test]
+    fn one_cone_has_the_solid_angle_of_its_sphere() {
+        // A sphere of radius 1 at distance 2 subtends a cone of half-angle 30°:
+        // Ω = 2π(1 − cos 30°) = 2π(1 − √3/2).
+        let t = CausticTargets::from_spheres(vec![(Vec3::new(0.0, 0.0, 2.0), 1.0)]);
+        let mut cones = Vec::new();
+        let total = t.cones(Vec3::ZERO, &mut cones);
+        let expected = TAU * (1.0 - 3f32.sqrt() / 2.0);
+        assert!(
+            (total - expected).abs() < 1e-6 * expected,
+            "{total} vs {expected}"
+        );
+    }
+
+    #[test]
+    fn overlapping_cones_sample_with_the_density_they_report() {
+        // Two overlapping cones and a separate one. Estimate ∫ g(w) dw for g = 1 on the
+        // union of the cones by importance sampling: Σ 1/pdf / N must equal the union's solid
+        // angle, computed independently by uniform sphere sampling.
+        let t = CausticTargets::from_spheres(vec![
+            (Vec3::new(0.0, 0.0, 3.0), 1.0),
+            (Vec3::new(0.5, 0.0, 3.0), 1.0),
+            (Vec3::new(-3.0, 1.0, 0.0), 0.5),
+        ]);
+        let mut cones = Vec::new();
+        let total = t.cones(Vec3::ZERO, &mut cones);
+        let mut rng = Rng::new(7, 1);
+        let n = 400_000;
+        let mut est = 0.0f64;
+        for _ in 0..n {
+            let (d, pdf) = sample_cones(
+                &cones,
+                total,
+                rng.next_f32(),
+                (rng.next_f32(), rng.next_f32()),
+            )
+            .expect("cones");
+            assert!((pdf - cones_pdf(&cones, total, d)).abs() < 1e-6 * pdf);
+            est += 1.0 / f64::from(pdf);
+        }
+        est /= f64::from(n);
+        let mut inside = 0u64;
+        for _ in 0..n {
+            let d = uniform_sphere((rng.next_f32(), rng.next_f32()));
+            inside += u64::from(cones_pdf(&cones, total, d) > 0.0);
+        }
+        let union = 4.0 * std::f64::consts::PI * inside as f64 / f64::from(n);
+        // Uniform sampling's standard error: sqrt(p(1-p)/n)·4π ≈ 0.005 sr here.
+        assert!((est - union).abs() < 0.02, "{est} vs {union}");
+        assert!(est < f64::from(total), "overlap must be counted once");
+    }
+
+    #[test]
+    fn a_point_inside_a_target_aims_everywhere() {
+        let t = CausticTargets::from_spheres(vec![(Vec3::ZERO, 2.0)]);
+        let mut cones = Vec::new();
+        let total = t.cones(Vec3::new(0.5, 0.0, 0.0), &mut cones);
+        assert!(total >= 4.0 * PI);
+        let (d, pdf) = sample_cones(&cones, total, 0.3, (0.2, 0.9)).expect("sample");
+        assert!((d.length() - 1.0).abs() < 1e-5);
+        assert_eq!(pdf, 1.0 / (4.0 * PI));
+    }
+}

@@ -1,0 +1,405 @@
+//! Building the caustic and global photon maps: emission budgets per light, photon paths traced
+//! in parallel batches with rayon, and the kd-trees. Deterministic: every photon draws from the
+//! sampler stream keyed by (seed, map, light, photon index), and batches are concatenated in
+//! index order, so the maps are the same for any thread count.
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::aim::CausticTargets;
+use super::emit::{LightEmitter, split_by_power};
+use super::estimate::{Kernel, PhotonMap};
+use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
+use crate::photon::{KdTree, Photon};
+use crate::render_scene::RenderScene;
+use crate::sampling::Sampler;
+
+/// Photons per parallel work item.
+const BATCH: u64 = 2048;
+
+/// How the maps of one render were built, for the summary.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PhotonSummary {
+    /// Per light: caustic-map counts.
+    pub caustic: Vec<TraceCounts>,
+    /// Per light: global-map counts.
+    pub global: Vec<TraceCounts>,
+    /// Why a map was not built (`None`: built).
+    pub caustic_skipped: Option<String>,
+    /// Why the global map was not built.
+    pub global_skipped: Option<String>,
+    /// Specular objects caustic photons were aimed at.
+    pub targets: usize,
+    /// Largest estimate radius of each map (scene units; 0 when not built).
+    pub caustic_radius: f32,
+    /// Largest estimate radius of the global map.
+    pub global_radius: f32,
+    /// True when the radii were chosen from the scene (no `photons.max_radius`).
+    pub auto_radius: bool,
+    /// Time spent tracing photons.
+    pub trace_time: Duration,
+    /// Time spent building kd-trees.
+    pub build_time: Duration,
+    /// Bytes of both maps.
+    pub memory: usize,
+}
+
+impl PhotonSummary {
+    /// Sum over lights of one map's counts.
+    #[must_use]
+    pub fn total(per_light: &[TraceCounts]) -> TraceCounts {
+        let mut t = TraceCounts::default();
+        for c in per_light {
+            t.add(c);
+        }
+        t
+    }
+}
+
+impl std::fmt::Display for PhotonSummary {
+    /// The summary a render prints: per map, per light, photons emitted, (caustic) reaching a
+    /// specular object, stored, and the stored flux; each map's radius, memory and timings.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let map_line = |f: &mut std::fmt::Formatter<'_>,
+                        name: &str,
+                        per_light: &[TraceCounts],
+                        skipped: &Option<String>,
+                        radius: f32|
+         -> std::fmt::Result {
+            if let Some(why) = skipped {
+                return writeln!(f, "photons: no {name} map ({why})");
+            }
+            let t = PhotonSummary::total(per_light);
+            writeln!(
+                f,
+                "photons: {name} map: {} stored of {} emitted, max radius {radius:.4}{}",
+                t.stored,
+                t.emitted,
+                if self.auto_radius {
+                    " (from the scene's size)"
+                } else {
+                    ""
+                }
+            )?;
+            for (i, c) in per_light.iter().enumerate() {
+                if c.emitted == 0 {
+                    continue;
+                }
+                write!(f, "  lights[{i}]: {} emitted", c.emitted)?;
+                if name == "caustic" {
+                    write!(f, ", {} reached a specular object", c.reached_specular)?;
+                }
+                writeln!(
+                    f,
+                    ", {} stored ({:.4} W stored{})",
+                    c.stored,
+                    mean_flux(c.stored_flux),
+                    if c.lost_at_depth > 0 {
+                        format!(", {} cut by max_bounces", c.lost_at_depth)
+                    } else {
+                        String::new()
+                    }
+                )?;
+            }
+            Ok(())
+        };
+        map_line(
+            f,
+            "caustic",
+            &self.caustic,
+            &self.caustic_skipped,
+            self.caustic_radius,
+        )?;
+        map_line(
+            f,
+            "global",
+            &self.global,
+            &self.global_skipped,
+            self.global_radius,
+        )?;
+        write!(
+            f,
+            "photons: traced in {:.3} s, kd-trees built in {:.3} s, {:.1} MB ({} targets for caustic photons)",
+            self.trace_time.as_secs_f64(),
+            self.build_time.as_secs_f64(),
+            self.memory as f64 / 1e6,
+            self.targets
+        )
+    }
+}
+
+/// Stream keys of photon paths: distinct per map and light, never shared with pixels.
+fn stream(kind: MapKind, light: usize) -> u64 {
+    let k = match kind {
+        MapKind::Caustic => 1u64,
+        MapKind::Global => 2,
+    };
+    (k << 40) | light as u64
+}
+
+/// Stream key of the per-(map, light) lattice rotation.
+fn rotation_stream(kind: MapKind, light: usize) -> u64 {
+    stream(kind, light) | (1 << 48)
+}
+
+/// Traces `emitters`' photons into one flat list (in (light, index) order) with per-light
+/// counts.
+fn trace_map(
+    scene: &RenderScene,
+    emitters: &[LightEmitter],
+    targets: &CausticTargets,
+    settings: TraceSettings,
+) -> (Vec<Photon>, Vec<TraceCounts>) {
+    let jobs: Vec<(usize, u64, u64)> = emitters
+        .iter()
+        .enumerate()
+        .flat_map(|(l, e)| {
+            (0..e.count.div_ceil(BATCH))
+                .map(move |b| (l, b * BATCH, ((b + 1) * BATCH).min(e.count)))
+        })
+        .collect();
+    let params = &scene.params;
+    let results: Vec<(usize, Vec<Photon>, TraceCounts)> = jobs
+        .par_iter()
+        .map(|&(l, start, end)| {
+            let mut sampler = Sampler::new(params.sampler, params.seed, 1);
+            let mut out = Vec::new();
+            let mut counts = TraceCounts::default();
+            let mut cones = Vec::new();
+            let e = &emitters[l];
+            for i in start..end {
+                sampler.start_stream(stream(settings.kind, l), i);
+                counts.emitted += 1;
+                let emitted = match settings.kind {
+                    MapKind::Global => e.global(i, &mut sampler),
+                    MapKind::Caustic => e.caustic(targets, &mut sampler, &mut cones),
+                };
+                if let Some((ray, power)) = emitted {
+                    trace_photon(
+                        scene,
+                        ray,
+                        power,
+                        settings,
+                        &mut sampler,
+                        &mut out,
+                        &mut counts,
+                    );
+                }
+            }
+            (l, out, counts)
+        })
+        .collect();
+    let mut per_light = vec![TraceCounts::default(); emitters.len()];
+    let total: usize = results.iter().map(|r| r.1.len()).sum();
+    let mut photons = Vec::with_capacity(total);
+    for (l, out, counts) in results {
+        per_light[l].add(&counts);
+        photons.extend_from_slice(&out);
+    }
+    (photons, per_light)
+}
+
+/// The diffuse surface area (m²) photons can land on: triangles and spheres of objects whose
+/// material has a diffuse part (ellipsoids by their bounding sphere's area, an upper bound).
+fn diffuse_area(scene: &RenderScene) -> f64 {
+    let diffuse = |o: u32| {
+        scene.objects[o as usize]
+            .material
+            .is_some_and(|m| scene.materials[m as usize].bsdf.has_local())
+    };
+    let g = &scene.geometry;
+    let mut area = 0.0f64;
+    for (t, a) in g.triangles.iter().zip(&g.tri_attrs) {
+        if diffuse(a.object) {
+            area += 0.5 * f64::from((t[1] - t[0]).cross(t[2] - t[0]).length());
+        }
+    }
+    for s in &g.spheres {
+        if diffuse(s.object) {
+            area += 4.0 * std::f64::consts::PI * f64::from(s.radius).powi(2);
+        }
+    }
+    for e in &g.ellipsoids {
+        if diffuse(e.object) {
+            let m = e.world_from_object.matrix3;
+            let r = m
+                .x_axis
+                .length()
+                .max(m.y_axis.length())
+                .max(m.z_axis.length());
+            area += 4.0 * std::f64::consts::PI * r * r;
+        }
+    }
+    area
+}
+
+/// The largest radius of a map of `stored` photons gathered `k` at a time: twice the radius of
+/// the disc that holds `k` photons on average when they spread over `area` (so typical regions
+/// are never cut; sparse ones are, rather than blurring a few photons over a wide disc).
+#[must_use]
+pub fn auto_radius(area: f64, stored: u64, k: u32) -> f32 {
+    if stored == 0 || !(area > 0.0) {
+        return 0.0;
+    }
+    (2.0 * (f64::from(k) * area / (std::f64::consts::PI * stored as f64)).sqrt()) as f32
+}
+
+/// Both maps of a render (each `None` when not built) and how they were built.
+#[derive(Debug)]
+pub struct PhotonMaps {
+    /// Light → specular⁺ → diffuse photons.
+    pub caustic: Option<PhotonMap>,
+    /// Photons after at least `min_bounces` diffuse bounces.
+    pub global: Option<PhotonMap>,
+    /// Counts, radii and timings.
+    pub summary: PhotonSummary,
+}
+
+/// Traces and builds the maps the scene's `photons` settings ask for.
+#[must_use]
+pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
+    let p = &scene.params.photons;
+    let mut summary = PhotonSummary::default();
+    let weights: Vec<f64> = scene
+        .lights
+        .iter()
+        .map(|l| {
+            let w = l.power();
+            f64::from((w.x + w.y + w.z) / 3.0)
+        })
+        .collect();
+    let targets = CausticTargets::new(scene);
+    summary.targets = targets.len();
+    let mut sampler = Sampler::new(scene.params.sampler, scene.params.seed, 1);
+
+    // Caustic budgets: lights with their own count keep it; the rest share `caustic` by power.
+    let shared: Vec<f64> = weights
+        .iter()
+        .zip(&p.caustic_per_light)
+        .map(|(&w, own)| if own.is_some() { 0.0 } else { w })
+        .collect();
+    let mut caustic_counts = split_by_power(u64::from(p.caustic), &shared);
+    for (c, own) in caustic_counts.iter_mut().zip(&p.caustic_per_light) {
+        if let Some(n) = own {
+            *c = u64::from(*n);
+        }
+    }
+    let global_counts = split_by_power(u64::from(p.global), &weights);
+    let emitters = |kind: MapKind, counts: &[u64], sampler: &mut Sampler| -> Vec<LightEmitter> {
+        scene
+            .lights
+            .iter()
+            .zip(counts)
+            .enumerate()
+            .map(|(l, (light, &n))| LightEmitter::new(*light, n, sampler, rotation_stream(kind, l)))
+            .collect()
+    };
+    let area = diffuse_area(scene);
+    summary.auto_radius = p.max_radius.is_none();
+
+    let t0 = Instant::now();
+    let mut build_time = Duration::ZERO;
+    let mut memory = 0;
+    let caustic = if targets.is_empty() {
+        summary.caustic_skipped = Some("no object reflects or transmits".into());
+        None
+    } else if caustic_counts.iter().all(|&c| c == 0) {
+        summary.caustic_skipped = Some("0 caustic photons".into());
+        None
+    } else {
+        let e = emitters(MapKind::Caustic, &caustic_counts, &mut sampler);
+        let settings = TraceSettings {
+            kind: MapKind::Caustic,
+            min_bounces: 0,
+            max_bounces: p.max_bounces,
+        };
+        let (photons, counts) = trace_map(scene, &e, &targets, settings);
+        summary.caustic = counts;
+        finish_map(
+            photons,
+            p.caustic_gather,
+            p.max_radius,
+            area,
+            match p.caustic_cone {
+                Some(k) => Kernel::Cone(k),
+                None => Kernel::Box,
+            },
+            &mut summary.caustic_skipped,
+            &mut summary.caustic_radius,
+            &mut build_time,
+            &mut memory,
+        )
+    };
+    let global = if global_counts.iter().all(|&c| c == 0) {
+        summary.global_skipped = Some("0 global photons".into());
+        None
+    } else {
+        let e = emitters(MapKind::Global, &global_counts, &mut sampler);
+        let settings = TraceSettings {
+            kind: MapKind::Global,
+            min_bounces: p.min_bounces,
+            max_bounces: p.max_bounces,
+        };
+        let (photons, counts) = trace_map(scene, &e, &targets, settings);
+        summary.global = counts;
+        finish_map(
+            photons,
+            p.gather,
+            p.max_radius,
+            area,
+            Kernel::Box,
+            &mut summary.global_skipped,
+            &mut summary.global_radius,
+            &mut build_time,
+            &mut memory,
+        )
+    };
+    summary.trace_time = t0.elapsed().saturating_sub(build_time);
+    summary.build_time = build_time;
+    summary.memory = memory;
+    PhotonMaps {
+        caustic,
+        global,
+        summary,
+    }
+}
+
+/// Builds the kd-tree of one map's photons, or says why there is none.
+#[allow(clippy::too_many_arguments)]
+fn finish_map(
+    photons: Vec<Photon>,
+    k: u32,
+    max_radius: Option<f32>,
+    area: f64,
+    kernel: Kernel,
+    skipped: &mut Option<String>,
+    radius: &mut f32,
+    build_time: &mut Duration,
+    memory: &mut usize,
+) -> Option<PhotonMap> {
+    if photons.is_empty() {
+        *skipped = Some("no photon was stored".into());
+        return None;
+    }
+    let r = max_radius.unwrap_or_else(|| auto_radius(area, photons.len() as u64, k));
+    let t = Instant::now();
+    let tree = match KdTree::build(photons) {
+        Ok(t) => t,
+        Err(e) => {
+            *skipped = Some(e.to_string());
+            return None;
+        }
+    };
+    *build_time += t.elapsed();
+    *memory += tree.memory_bytes();
+    *radius = r;
+    Some(PhotonMap::new(tree, k as usize, r, kernel))
+}
+
+/// Mean of a flux's channels (W).
+#[must_use]
+pub fn mean_flux(v: Vec3) -> f32 {
+    (v.x + v.y + v.z) / 3.0
+}

@@ -1,0 +1,461 @@
+//! Photon mapping (Jensen, "Realistic Image Synthesis Using Photon Mapping", 2001): the report's
+//! two passes, done with the one material model.
+//!
+//! Pass 1 ([`maps::build_maps`], once per render): photons leave the lights in proportion to
+//! their power and are traced in importance mode; a caustic map holds light → specular⁺ →
+//! diffuse landings of photons aimed at the specular objects, a global map every diffuse
+//! landing after `min_bounces` diffuse bounces.
+//!
+//! Pass 2 ([`PhotonMapper::li`]): camera paths follow mirror and glass chains; at each vertex
+//! with a diffuse part, the radiance is split without overlap into
+//! - direct light, by a shadow ray to a light chosen by power (as the path tracer's next-event
+//!   estimation, without MIS: emitters hit after a diffuse bounce are never counted);
+//! - caustics (light → specular⁺ → here), from the caustic map;
+//! - the rest of the indirect light (≥ 1 diffuse bounce before here), from the global map read
+//!   directly, or by final gathering: rays sampled from the BSDF, whose landing points report
+//!   their direct light, caustics and global-map radiance.
+
+pub mod aim;
+pub mod emit;
+pub mod estimate;
+pub mod maps;
+pub mod trace;
+
+pub use estimate::{Estimate, Kernel, PhotonMap};
+pub use maps::{PhotonMaps, PhotonSummary, build_maps};
+
+use glam::Vec3;
+
+use super::Counters;
+use super::shadow::{RayCone, shadow_ray};
+use super::trace_log::{RayKind, TraceLog};
+use crate::geometry::Ray;
+use crate::geometry::offset::offset_ray_origin;
+use crate::render_scene::{LightSampler, RenderScene, ShadingPoint, SurfacePoint};
+use crate::sampling::Sampler;
+use crate::shading::{ShadingFrame, TransportMode};
+
+/// Bounces after which Russian roulette may end a camera path's specular chain.
+const ROULETTE_DEPTH: u32 = 3;
+
+/// Delta bounces at which a camera path follows both Fresnel reflection and refraction.
+const SPLIT_DEPTH: u32 = 2;
+
+/// Pending branches of one camera sample (a split adds one; deeper chains sample one lobe).
+const STACK: usize = 8;
+
+/// A camera-path branch waiting to be traced.
+#[derive(Debug, Clone, Copy)]
+struct Branch {
+    ray: Ray,
+    beta: Vec3,
+    eta_scale: f32,
+    depth: u32,
+    cone: RayCone,
+    kind: RayKind,
+    parent: Option<usize>,
+}
+
+impl Default for Branch {
+    fn default() -> Self {
+        Self {
+            ray: Ray::new(Vec3::ZERO, Vec3::Z),
+            beta: Vec3::ZERO,
+            eta_scale: 1.0,
+            depth: 0,
+            cone: RayCone::camera(0.0),
+            kind: RayKind::Camera,
+            parent: None,
+        }
+    }
+}
+
+/// Stores the weighted radiance gathered at `node`'s hit (see [`TraceLog::finish_tree`]).
+fn set_radiance(log: Option<&mut TraceLog>, node: Option<usize>, gathered: Vec3) {
+    if let (Some(lg), Some(me)) = (log, node) {
+        lg.nodes[me].radiance = gathered;
+    }
+}
+
+/// Most mirror or glass bounces a final-gather ray follows before reading the maps.
+const GATHER_SPECULAR_DEPTH: u32 = 4;
+
+/// The photon-mapping integrator: the maps, built once, and the camera-side estimator.
+#[derive(Debug)]
+pub struct PhotonMapper<'a> {
+    scene: &'a RenderScene,
+    lights: LightSampler,
+    pixel_spread: f32,
+    maps: PhotonMaps,
+}
+
+impl<'a> PhotonMapper<'a> {
+    /// Traces the photons and builds the maps (`scene.params.photons`).
+    #[must_use]
+    pub fn new(scene: &'a RenderScene) -> Self {
+        Self {
+            scene,
+            lights: LightSampler::new(&scene.lights),
+            pixel_spread: scene.pixel_spread(),
+            maps: build_maps(scene),
+        }
+    }
+
+    /// The maps and how they were built.
+    #[must_use]
+    pub fn maps(&self) -> &PhotonMaps {
+        &self.maps
+    }
+
+    /// Radiance arriving along camera ray `ray` (module docs for the split). Mirror and glass
+    /// chains are split into both branches for the first [`SPLIT_DEPTH`] delta bounces (as
+    /// Whitted does: no noise from choosing between Fresnel reflection and refraction) and
+    /// followed by sampling one delta lobe after that.
+    pub fn li(
+        &self,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        mut log: Option<&mut TraceLog>,
+    ) -> Vec3 {
+        let scene = self.scene;
+        let params = &scene.params;
+        let mut l = Vec3::ZERO;
+        let mut stack = [Branch::default(); STACK];
+        stack[0] = Branch {
+            ray,
+            beta: Vec3::ONE,
+            eta_scale: 1.0,
+            depth: 0,
+            cone: RayCone::camera(self.pixel_spread),
+            kind: RayKind::Camera,
+            parent: None,
+        };
+        let mut len = 1;
+        let root = log.as_deref().map(|lg| lg.nodes.len());
+        while len > 0 {
+            len -= 1;
+            let b = stack[len];
+            let (ray, beta, depth) = (b.ray, b.beta, b.depth);
+            counters.rays += 1;
+            let node = log
+                .as_deref_mut()
+                .map(|lg| lg.push(depth, b.kind, &ray, beta, b.parent));
+            let mut gathered = Vec3::ZERO;
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                gathered = beta * params.background;
+                l += gathered;
+                set_radiance(log.as_deref_mut(), node, gathered);
+                continue;
+            };
+            let sp = scene.geometry.surface(&ray, &hit);
+            let wo = -ray.dir.normalize();
+            let object = &scene.objects[sp.object as usize];
+            let Some(m) = object.material else {
+                // Reached along a specular chain (or directly): the emitter is seen.
+                if let Some(i) = object.light {
+                    gathered = beta * scene.lights[i as usize].le(sp.ng, wo);
+                    l += gathered;
+                }
+                if let Some(lg) = log.as_deref_mut() {
+                    lg.record_hit(node, scene, &hit, &sp, "light");
+                    set_radiance(Some(lg), node, gathered);
+                }
+                continue;
+            };
+            let sh = scene.shading_point(
+                &scene.materials[m as usize],
+                &sp,
+                wo,
+                b.cone.width_at(&ray, hit.t),
+            );
+            if let Some(lg) = log.as_deref_mut() {
+                let name = scene.material_names[m as usize].clone();
+                lg.record_hit(node, scene, &hit, &sp, &name);
+            }
+            if depth >= params.max_depth {
+                TraceLog::note(log.as_deref_mut(), node, "max depth reached");
+                continue;
+            }
+            if sh.bsdf.has_local() {
+                let (c, note) = self.local(&sp, &sh, wo, sampler, counters, log.is_some());
+                gathered = beta * c;
+                l += gathered;
+                if let Some(text) = note {
+                    TraceLog::note(log.as_deref_mut(), node, &text);
+                }
+            }
+            set_radiance(log.as_deref_mut(), node, gathered);
+            if !sh.bsdf.has_delta() {
+                continue;
+            }
+            let fr = frame(&sh);
+            let curvature = scene.geometry.curvature(&hit);
+            let mut push = |dir: Vec3, weight: Vec3, transmitted: bool, eta_scale: f32| {
+                let beta = beta * weight;
+                if len >= STACK || !beta.is_finite() || beta.max_element() <= 0.0 {
+                    return;
+                }
+                stack[len] = Branch {
+                    ray: Ray::new(offset_ray_origin(sp.p, sp.p_error, fr.ng, dir), dir),
+                    beta,
+                    eta_scale: b.eta_scale * eta_scale,
+                    depth: depth + 1,
+                    cone: b.cone.bounce(
+                        &ray,
+                        hit.t,
+                        curvature,
+                        if transmitted { 1.0 } else { 2.0 },
+                    ),
+                    kind: if transmitted {
+                        RayKind::Refract
+                    } else {
+                        RayKind::Reflect
+                    },
+                    parent: node,
+                };
+                len += 1;
+            };
+            if depth < SPLIT_DEPTH {
+                let lobes = sh.bsdf.delta_lobes(wo, fr.ns, fr.ng, fr.entering);
+                if let Some((dir, w)) = lobes.refract {
+                    let eta = if fr.entering {
+                        1.0 / sh.bsdf.ior
+                    } else {
+                        sh.bsdf.ior
+                    };
+                    push(dir, w, true, eta * eta);
+                }
+                if lobes.reflect_weight.max_element() > 0.0 {
+                    push(lobes.reflect_dir, lobes.reflect_weight, false, 1.0);
+                }
+                continue;
+            }
+            // Deeper: one delta lobe, sampled (the diffuse part was accounted for above).
+            let u_lobe = sampler.next_1d();
+            let u_dir = sampler.next_2d();
+            let u_rr = sampler.next_1d();
+            let Some(s) = sh
+                .bsdf
+                .sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance)
+            else {
+                continue;
+            };
+            if !s.delta {
+                continue;
+            }
+            let mut w = s.weight;
+            if depth + 1 > ROULETTE_DEPTH {
+                let eta_scale = b.eta_scale * if s.transmitted { s.eta_scale } else { 1.0 };
+                let q = (beta * w / eta_scale).max_element().min(1.0);
+                if !(q > 0.0) || u_rr >= q {
+                    TraceLog::note(log.as_deref_mut(), node, "ended by Russian roulette");
+                    continue;
+                }
+                w /= q;
+            }
+            push(
+                s.wi,
+                w,
+                s.transmitted,
+                if s.transmitted { s.eta_scale } else { 1.0 },
+            );
+        }
+        if let (Some(lg), Some(root)) = (log, root) {
+            lg.finish_tree(root);
+        }
+        l
+    }
+
+    /// The radiance a camera-path vertex with a diffuse part sends towards `wo`: direct light,
+    /// caustics and indirect light. With `describe`, also a line for `debug-pixel` naming each
+    /// estimate's photon count and radius.
+    fn local(
+        &self,
+        sp: &SurfacePoint,
+        sh: &ShadingPoint,
+        wo: Vec3,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        describe: bool,
+    ) -> (Vec3, Option<String>) {
+        let fr = frame(sh);
+        let direct = self.direct(sp, &fr, sh, wo, sampler, counters);
+        let caustic = self.maps.caustic.as_ref().map(|m| {
+            counters.photon_estimates += 1;
+            let e = m.estimate(sp.p, wo, &fr, &sh.bsdf);
+            counters.photon_radius_cut += u64::from(e.cut);
+            e
+        });
+        let gather = self.scene.params.photons.final_gather;
+        let (indirect, global) = if gather > 0 {
+            (
+                self.final_gather(sp, &fr, sh, wo, gather, sampler, counters),
+                None,
+            )
+        } else {
+            let e = self.maps.global.as_ref().map(|m| {
+                counters.photon_estimates += 1;
+                let e = m.estimate(sp.p, wo, &fr, &sh.bsdf);
+                counters.photon_radius_cut += u64::from(e.cut);
+                e
+            });
+            (e.map_or(Vec3::ZERO, |e| e.radiance), e)
+        };
+        let caustic_l = caustic.map_or(Vec3::ZERO, |e| e.radiance);
+        let note = describe.then(|| {
+            let show = |name: &str, e: Option<Estimate>| match e {
+                Some(e) => format!(
+                    "{name}: {} photons within r = {:.4}{} → ({:.4}, {:.4}, {:.4})",
+                    e.found,
+                    e.radius,
+                    if e.cut { " (radius-limited)" } else { "" },
+                    e.radiance.x,
+                    e.radiance.y,
+                    e.radiance.z
+                ),
+                None => format!("{name}: no map"),
+            };
+            let global_text = if gather > 0 {
+                format!(
+                    "final gather ({gather} rays) → ({:.4}, {:.4}, {:.4})",
+                    indirect.x, indirect.y, indirect.z
+                )
+            } else {
+                show("global", global)
+            };
+            format!(
+                "direct ({:.4}, {:.4}, {:.4}); {}; {}",
+                direct.x,
+                direct.y,
+                direct.z,
+                show("caustic", caustic),
+                global_text
+            )
+        });
+        (direct + caustic_l + indirect, note)
+    }
+
+    /// Direct light at a vertex by one shadow ray to a light chosen in proportion to power.
+    fn direct(
+        &self,
+        sp: &SurfacePoint,
+        fr: &ShadingFrame,
+        sh: &ShadingPoint,
+        wo: Vec3,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+    ) -> Vec3 {
+        let u_light = sampler.next_1d();
+        let u_point = sampler.next_2d();
+        let Some((index, pmf)) = self.lights.sample(u_light) else {
+            return Vec3::ZERO;
+        };
+        let Some(ls) = self.scene.lights[index].sample_li(sp.p, u_point) else {
+            return Vec3::ZERO;
+        };
+        let f = sh.bsdf.eval(wo, ls.wi, fr, TransportMode::Radiance);
+        if f == Vec3::ZERO || !(ls.pdf > 0.0) {
+            return Vec3::ZERO;
+        }
+        counters.rays += 1;
+        if self
+            .scene
+            .geometry
+            .occluded(&shadow_ray(sp, fr.ng, ls.point))
+        {
+            return Vec3::ZERO;
+        }
+        f * ls.weight * (fr.ns.dot(ls.wi) / pmf)
+    }
+
+    /// Indirect light at a vertex by `n` final-gather rays sampled from the BSDF's diffuse part:
+    /// where each lands, its direct light, caustics and global-map radiance (following up to
+    /// [`GATHER_SPECULAR_DEPTH`] mirror or glass bounces first).
+    #[allow(clippy::too_many_arguments)]
+    fn final_gather(
+        &self,
+        sp: &SurfacePoint,
+        fr: &ShadingFrame,
+        sh: &ShadingPoint,
+        wo: Vec3,
+        n: u32,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+    ) -> Vec3 {
+        let scene = self.scene;
+        let mut sum = Vec3::ZERO;
+        for _ in 0..n {
+            let u_lobe = sampler.next_1d();
+            let u_dir = sampler.next_2d();
+            let Some(s) = sh
+                .bsdf
+                .sample(wo, u_lobe, u_dir, fr, TransportMode::Radiance)
+            else {
+                continue;
+            };
+            if s.delta {
+                continue; // The delta lobes are followed by the camera path itself.
+            }
+            let mut beta = s.weight;
+            let mut ray = Ray::new(offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi), s.wi);
+            for bounce in 0..=GATHER_SPECULAR_DEPTH {
+                counters.rays += 1;
+                let Some(hit) = scene.geometry.intersect(&ray) else {
+                    sum += beta * scene.params.background;
+                    break;
+                };
+                let gp = scene.geometry.surface(&ray, &hit);
+                let gwo = -ray.dir.normalize();
+                let Some(m) = scene.objects[gp.object as usize].material else {
+                    break; // Direct light is the shadow ray's.
+                };
+                let gsh = scene.shading_point(&scene.materials[m as usize], &gp, gwo, 0.0);
+                let gfr = frame(&gsh);
+                if gsh.bsdf.has_local() {
+                    let mut lo = self.direct(&gp, &gfr, &gsh, gwo, sampler, counters);
+                    for map in [&self.maps.caustic, &self.maps.global]
+                        .into_iter()
+                        .flatten()
+                    {
+                        counters.photon_estimates += 1;
+                        let e = map.estimate(gp.p, gwo, &gfr, &gsh.bsdf);
+                        counters.photon_radius_cut += u64::from(e.cut);
+                        lo += e.radiance;
+                    }
+                    sum += beta * lo;
+                }
+                if bounce == GATHER_SPECULAR_DEPTH || !gsh.bsdf.has_delta() {
+                    break;
+                }
+                let u_lobe = sampler.next_1d();
+                let u_dir = sampler.next_2d();
+                let Some(g) = gsh
+                    .bsdf
+                    .sample(gwo, u_lobe, u_dir, &gfr, TransportMode::Radiance)
+                else {
+                    break;
+                };
+                if !g.delta {
+                    break;
+                }
+                beta *= g.weight;
+                if !beta.is_finite() || beta.max_element() <= 0.0 {
+                    break;
+                }
+                ray = Ray::new(offset_ray_origin(gp.p, gp.p_error, gfr.ng, g.wi), g.wi);
+            }
+        }
+        sum / n as f32
+    }
+}
+
+/// The BSDF frame of a shading point.
+#[inline]
+fn frame(sh: &ShadingPoint) -> ShadingFrame {
+    ShadingFrame {
+        ns: sh.ns,
+        ng: sh.ng,
+        entering: sh.entering,
+    }
+}

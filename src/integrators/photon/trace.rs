@@ -1,0 +1,157 @@
+//! Following one photon through the scene (Jensen 2001, ch. 5): the same BSDF as camera paths,
+//! sampled in importance mode (no η² at refraction, Veach's adjoint shading-normal factor), so
+//! photon estimates and path tracing converge to the same image.
+//!
+//! At each hit the BSDF picks a lobe in proportion to the material's normalised diffuse /
+//! reflect / transmit weights times their albedos (Fresnel inside the transmitting part), and
+//! Russian roulette keeps the photon with probability `q = min(1, max channel of the sample's
+//! weight)`, dividing its flux by `q`: photons keep (almost) equal flux, as the report's
+//! "photons either stick or go on". A weight above 1 (the adjoint factor at a bumped surface)
+//! raises the flux, capped at [`MAX_FLUX_GROWTH`] times the emitted flux.
+
+use glam::Vec3;
+
+use crate::geometry::Ray;
+use crate::geometry::offset::offset_ray_origin;
+use crate::photon::Photon;
+use crate::render_scene::RenderScene;
+use crate::sampling::Sampler;
+use crate::shading::{ShadingFrame, TransportMode};
+
+/// Largest factor by which a photon's flux may grow along its path (the adjoint shading-normal
+/// factor can exceed 1 at grazing angles on bumped surfaces; Veach 1997 §5.3). Bounds the
+/// worst photon's flux so one grazing photon cannot leave a bright spot.
+pub const MAX_FLUX_GROWTH: f32 = 10.0;
+
+/// Which map a photon path feeds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MapKind {
+    /// Light → specular⁺ → diffuse: stored once, where it first lands on a diffuse surface.
+    Caustic,
+    /// Every diffuse landing after at least `min_bounces` diffuse bounces.
+    Global,
+}
+
+/// What happened to photon paths (per light, per map), summed over photons.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TraceCounts {
+    /// Photons emitted (including those whose emission direction carried no light).
+    pub emitted: u64,
+    /// Caustic photons whose first hit was an object with a mirror or dielectric part.
+    pub reached_specular: u64,
+    /// Photons stored (a path may store several in the global map).
+    pub stored: u64,
+    /// Total flux stored (W per channel).
+    pub stored_flux: Vec3,
+    /// Photon paths cut by `max_bounces` while they still carried flux.
+    pub lost_at_depth: u64,
+    /// Flux of the paths cut by `max_bounces` (W per channel).
+    pub lost_flux: Vec3,
+}
+
+impl TraceCounts {
+    /// Adds `other` into `self`.
+    pub fn add(&mut self, other: &TraceCounts) {
+        self.emitted += other.emitted;
+        self.reached_specular += other.reached_specular;
+        self.stored += other.stored;
+        self.stored_flux += other.stored_flux;
+        self.lost_at_depth += other.lost_at_depth;
+        self.lost_flux += other.lost_flux;
+    }
+}
+
+/// Settings of photon paths.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TraceSettings {
+    /// Which map the path feeds.
+    pub kind: MapKind,
+    /// Global map: diffuse bounces before a photon is stored.
+    pub min_bounces: u32,
+    /// Most bounces before a path is dropped.
+    pub max_bounces: u32,
+}
+
+/// Traces one photon from `ray` carrying `power`, appending what it stores to `out` and
+/// counting into `counts`; random numbers come from `sampler` (started on this photon).
+pub fn trace_photon(
+    scene: &RenderScene,
+    mut ray: Ray,
+    mut power: Vec3,
+    settings: TraceSettings,
+    sampler: &mut Sampler,
+    out: &mut Vec<Photon>,
+    counts: &mut TraceCounts,
+) {
+    let max_flux = power.max_element() * MAX_FLUX_GROWTH;
+    let mut diffuse_bounces = 0u32;
+    let mut bounces = 0u32;
+    loop {
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            return;
+        };
+        let sp = scene.geometry.surface(&ray, &hit);
+        let object = &scene.objects[sp.object as usize];
+        let Some(m) = object.material else {
+            return; // An emitter absorbs what reaches it.
+        };
+        let dir = ray.dir.normalize();
+        let wo = -dir;
+        let sh = scene.shading_point(&scene.materials[m as usize], &sp, wo, 0.0);
+        let bsdf = sh.bsdf;
+        if bounces == 0 && settings.kind == MapKind::Caustic {
+            if !bsdf.has_delta() {
+                return; // Aimed at a target but blocked by a diffuse object.
+            }
+            counts.reached_specular += 1;
+        }
+        if bsdf.has_local() {
+            let store = match settings.kind {
+                MapKind::Caustic => bounces > 0,
+                MapKind::Global => diffuse_bounces >= settings.min_bounces,
+            };
+            if store {
+                out.push(Photon::new(sp.p, dir, sh.ng, power));
+                counts.stored += 1;
+                counts.stored_flux += power;
+            }
+        }
+        let fr = ShadingFrame {
+            ns: sh.ns,
+            ng: sh.ng,
+            entering: sh.entering,
+        };
+        let u_lobe = sampler.next_1d();
+        let u = sampler.next_2d();
+        let u_rr = sampler.next_1d();
+        let Some(s) = bsdf.sample(wo, u_lobe, u, &fr, TransportMode::Importance) else {
+            return;
+        };
+        if !s.delta {
+            if settings.kind == MapKind::Caustic {
+                return; // No longer a caustic path (and it was stored above if it landed).
+            }
+            diffuse_bounces += 1;
+        }
+        let q = s.weight.max_element().min(1.0);
+        if !(q > 0.0) || u_rr >= q {
+            return;
+        }
+        power *= s.weight / q;
+        let m = power.max_element();
+        if !power.is_finite() {
+            return;
+        }
+        if m > max_flux {
+            power *= max_flux / m;
+        }
+        bounces += 1;
+        if bounces > settings.max_bounces {
+            counts.lost_at_depth += 1;
+            counts.lost_flux += power;
+            return;
+        }
+        let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
+        ray = Ray::new(origin, s.wi);
+    }
+}
