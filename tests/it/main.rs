@@ -12,6 +12,7 @@ mod hard_cases;
 mod interrupt;
 mod kdtree;
 mod light_transport;
+mod models;
 mod mutated_scenes;
 mod passes;
 mod path_tracer;
