@@ -323,3 +323,129 @@ fn the_generators_maths_is_what_std_computes() {
         assert!(sdf::ellipsoid(p, DVec3::ZERO, r).abs() < 1e-12, "{p}");
     }
 }
+
+/// A tetrahedron whose slanted face is group `lid` with `usemtl glaze`, the rest group `base`.
+const TETRA: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\ng base\nf 1 3 2\nf 1 2 4\nf 1 4 3\ng lid\nusemtl glaze\nf 2 3 4\n";
+
+/// Compiles a one-mesh scene over `obj` with the mesh fields `fields` (RON); returns the
+/// material name of each triangle, the slanted face's (normal (1, 1, 1)) first.
+fn materials_per_triangle(obj: &str, fields: &str) -> Vec<String> {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("m.obj");
+    std::fs::write(&path, obj).expect("obj written");
+    let scene = common::scene_from_text(&format!(
+        r#"Scene(
+            camera: Pinhole(eye: (0, 1, 4), look_at: (0, 0, 0), fov_y: 40),
+            materials: {{ "white": (), "red": (color: (0.8, 0, 0)), "blue": (color: (0, 0, 0.8)) }},
+            lights: [Point(position: (0, 3, 2), power: (50, 50, 50))],
+            nodes: [Mesh(file: {:?}, {fields})],
+        )"#,
+        path.display().to_string()
+    ));
+    let g = &scene.geometry;
+    let mut out: Vec<(bool, String)> = g
+        .triangles
+        .iter()
+        .zip(&g.tri_attrs)
+        .map(|(t, a)| {
+            let n = (t[1] - t[0]).cross(t[2] - t[0]);
+            let m = scene.objects[a.object as usize]
+                .material
+                .expect("not a light");
+            (
+                n.x <= 0.0 || n.y <= 0.0,
+                scene.material_names[m as usize].clone(),
+            )
+        })
+        .collect();
+    out.sort();
+    out.into_iter().map(|(_, m)| m).collect()
+}
+
+#[test]
+fn mesh_groups_and_usemtl_names_choose_materials() {
+    let by = |fields: &str| materials_per_triangle(TETRA, fields);
+    // By group; the `usemtl` name of the lid is also a key, and wins over its group.
+    assert_eq!(
+        by(r#"materials: {"base": "red", "lid": "blue"}"#),
+        ["blue", "red", "red", "red"]
+    );
+    assert_eq!(
+        by(r#"materials: {"base": "red", "lid": "red", "glaze": "blue"}"#),
+        ["blue", "red", "red", "red"]
+    );
+    // Faces the map leaves out take the node's `material`.
+    assert_eq!(
+        by(r#"material: "white", materials: {"glaze": "blue"}"#),
+        ["blue", "white", "white", "white"]
+    );
+    assert_eq!(by(r#"material: "white""#), ["white"; 4]);
+}
+
+#[test]
+fn the_duck_and_boat_map_every_group() {
+    for (file, fields, want) in [
+        (
+            "duck.obj",
+            r#"materials: {"body": "white", "beak": "red", "eyes": "blue"}"#,
+            [("white", "body"), ("red", "beak"), ("blue", "eyes")].as_slice(),
+        ),
+        (
+            "boat.obj",
+            r#"material: "white", materials: {"hull": "red", "mast": "blue"}"#,
+            [("red", "hull"), ("blue", "mast")].as_slice(),
+        ),
+    ] {
+        let text = committed(file);
+        let counts: HashMap<String, usize> = groups(&text).into_iter().collect();
+        let got = materials_per_triangle(&text, fields);
+        let total: usize = counts.values().sum();
+        assert_eq!(got.len(), total, "{file}: no triangle dropped");
+        let mut mapped = 0;
+        for (material, group) in want {
+            let n = got.iter().filter(|m| m == material).count();
+            assert_eq!(n, counts[*group], "{file}: {group} → {material}");
+            mapped += n;
+        }
+        let rest = got.iter().filter(|m| *m == "white").count();
+        assert_eq!(
+            rest,
+            total - mapped
+                + if file == "duck.obj" {
+                    counts["body"]
+                } else {
+                    0
+                }
+        );
+    }
+}
+
+#[test]
+fn mesh_materials_read_the_same_in_ron_and_toml() {
+    use caustic::scene::SourceFile;
+    let ron = r#"Scene(
+        camera: Pinhole(eye: (0, 1, 4), look_at: (0, 0, 0), fov_y: 40),
+        materials: { "yellow": (), "orange": () },
+        nodes: [Mesh(file: "duck.obj", material: "yellow", materials: {"beak": "orange", "eyes": "orange"})],
+    )"#;
+    let toml = r#"
+        [camera.Pinhole]
+        eye = [0, 1, 4]
+        look_at = [0, 0, 0]
+        fov_y = 40
+        [materials]
+        yellow = {}
+        orange = {}
+        [[nodes]]
+        [nodes.Mesh]
+        file = "duck.obj"
+        material = "yellow"
+        materials = { beak = "orange", eyes = "orange" }
+    "#;
+    let a = SourceFile::new(std::path::Path::new("a.ron"), ron.into()).expect("ron");
+    let b = SourceFile::new(std::path::Path::new("a.toml"), toml.into()).expect("toml");
+    assert_eq!(
+        a.parse().expect("ron parses"),
+        b.parse().expect("toml parses")
+    );
+}
