@@ -134,43 +134,53 @@ fn boat_sail(p: DVec3) -> f64 {
     d.max(DVec2::ZERO).length() + d.max_element().min(0.0) - 0.006
 }
 
+/// How far the boat's shapes (modelled with the hull's top at y = 0.12) are raised so that the
+/// origin is on the waterline: a toy boat floats high, about a third of its hull under water.
+const BOAT_LIFT: DVec3 = DVec3::new(0.0, 0.07, 0.0);
+
 /// The toy boat's parts, meshed and checked: `hull`, `deck`, `cabin`, `mast`, `sail`.
 pub fn boat() -> Result<Vec<Part>, Vec<String>> {
+    let up = |p: DVec3| p + BOAT_LIFT;
+    let hull = |p: DVec3| boat_hull(p - BOAT_LIFT);
+    let deck = |p: DVec3| boat_deck(p - BOAT_LIFT);
+    let cabin = |p: DVec3| boat_cabin(p - BOAT_LIFT);
+    let mast = |p: DVec3| boat_mast(p - BOAT_LIFT);
+    let sail = |p: DVec3| boat_sail(p - BOAT_LIFT);
     let specs = [
         PartSpec {
             name: "hull",
-            sdf: &boat_hull,
-            bounds: (v(-0.56, -0.2, -0.3), v(0.64, 0.14, 0.3)),
+            sdf: &hull,
+            bounds: (up(v(-0.56, -0.2, -0.3)), up(v(0.64, 0.14, 0.3))),
             cell: 0.02,
-            centre: v(0.0, 0.05, 0.0),
+            centre: up(v(0.0, 0.05, 0.0)),
         },
         PartSpec {
             name: "deck",
-            sdf: &boat_deck,
-            bounds: (v(-0.56, 0.07, -0.3), v(0.64, 0.17, 0.3)),
+            sdf: &deck,
+            bounds: (up(v(-0.56, 0.07, -0.3)), up(v(0.64, 0.17, 0.3))),
             cell: 0.02,
-            centre: v(0.0, 0.12, 0.0),
+            centre: up(v(0.0, 0.12, 0.0)),
         },
         PartSpec {
             name: "cabin",
-            sdf: &boat_cabin,
-            bounds: (v(-0.47, 0.1, -0.2), v(-0.05, 0.39, 0.2)),
+            sdf: &cabin,
+            bounds: (up(v(-0.47, 0.1, -0.2)), up(v(-0.05, 0.39, 0.2))),
             cell: 0.02,
-            centre: v(-0.26, 0.24, 0.0),
+            centre: up(v(-0.26, 0.24, 0.0)),
         },
         PartSpec {
             name: "mast",
-            sdf: &boat_mast,
-            bounds: (v(-0.02, 0.08, -0.04), v(0.06, 0.98, 0.04)),
+            sdf: &mast,
+            bounds: (up(v(-0.02, 0.08, -0.04)), up(v(0.06, 0.98, 0.04))),
             cell: 0.01,
-            centre: v(0.02, 0.5, 0.0),
+            centre: up(v(0.02, 0.5, 0.0)),
         },
         PartSpec {
             name: "sail",
-            sdf: &boat_sail,
-            bounds: (v(0.03, 0.29, -0.03), v(0.52, 0.93, 0.03)),
+            sdf: &sail,
+            bounds: (up(v(0.03, 0.29, -0.03)), up(v(0.52, 0.93, 0.03))),
             cell: 0.011,
-            centre: v(0.2, 0.48, 0.0),
+            centre: up(v(0.2, 0.48, 0.0)),
         },
     ];
     mesh_all(&specs)

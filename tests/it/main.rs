@@ -3,6 +3,7 @@
 mod architecture;
 mod assets;
 mod bad_scenes;
+mod bath;
 mod cli;
 mod common;
 mod determinism;
