@@ -66,3 +66,20 @@ fn the_water_cuts_the_duck_and_the_boat() {
         );
     }
 }
+
+#[test]
+fn the_bath_renders_the_same_bytes_on_one_thread_and_on_three() {
+    let p = prepare(
+        &common::root().join("scenes/bath.ron"),
+        &common::small(40, 30, 2),
+    )
+    .expect("bath.ron");
+    let on = |threads| {
+        let options = RenderOptions {
+            threads: Some(threads),
+            ..RenderOptions::default()
+        };
+        render(&p.render_scene, &options).expect("renders").film
+    };
+    assert!(on(1).pixels == on(3).pixels);
+}
