@@ -3,6 +3,7 @@
 mod architecture;
 mod assets;
 mod bad_scenes;
+mod bath;
 mod cli;
 mod common;
 mod determinism;
@@ -12,6 +13,7 @@ mod hard_cases;
 mod interrupt;
 mod kdtree;
 mod light_transport;
+mod models;
 mod mutated_scenes;
 mod passes;
 mod path_tracer;
