@@ -3,6 +3,9 @@
 mod check;
 mod compare;
 mod debug_pixel;
+mod error_image;
+mod golden;
+mod pixel_font;
 mod render;
 
 use std::path::PathBuf;
@@ -35,7 +38,9 @@ enum Command {
     Schema,
     /// Trace one sample of one pixel and print its ray tree.
     DebugPixel(debug_pixel::DebugPixelArgs),
-    /// Compare an image with a reference (PNG or EXR): RMSE, relative MSE, max difference, bias.
+    /// Compare an image with a reference (PNG or EXR): RMSE, relative MSE, mean absolute error,
+    /// bias and max difference, overall and per channel; optionally over a region, as JSON, and
+    /// with a false-colour error image.
     Compare(compare::CompareArgs),
 }
 

@@ -53,6 +53,15 @@ pub struct RenderArgs {
     /// The final image is the same, bit for bit, as without checkpoints.
     #[arg(long, value_name = "FILE")]
     checkpoint: Option<PathBuf>,
+    /// After writing the image, compare it with this reference (PNG or EXR; for a `--region`
+    /// render the reference may be the whole image or the crop) and print RMSE, relMSE, mean
+    /// absolute error and bias.
+    #[arg(long, value_name = "REF")]
+    compare: Option<PathBuf>,
+    /// With `--compare`: a golden-image check: exit with code 3 (the image is still written)
+    /// when the RMSE against the reference is above this.
+    #[arg(long, value_name = "RMSE", requires = "compare", value_parser = parse_max_rmse)]
+    max_rmse: Option<f64>,
     /// Seconds between checkpoints (0: after every pass).
     #[arg(
         long,
@@ -62,6 +71,14 @@ pub struct RenderArgs {
         value_parser = parse_seconds
     )]
     checkpoint_every: Duration,
+}
+
+fn parse_max_rmse(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| format!("expected a non-negative number, found `{text}`"))
 }
 
 fn parse_seconds(text: &str) -> Result<Duration, String> {
@@ -98,7 +115,8 @@ fn parse_duration(text: &str) -> Result<Duration, String> {
         })
 }
 
-fn parse_region(text: &str) -> Result<Region, Error> {
+/// Parses `X,Y,W,H` (the form of `--region`).
+pub(super) fn parse_region(text: &str) -> Result<Region, Error> {
     let parts: Vec<Result<u32, _>> = text.split(',').map(|p| p.trim().parse::<u32>()).collect();
     match parts.as_slice() {
         [Ok(x), Ok(y), Ok(w), Ok(h)] => Ok(Region {
@@ -206,6 +224,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         caustic::render::output::check_writable(path)?;
     }
     let region = args.region.as_deref().map(parse_region).transpose()?;
+    let reference = super::golden::load(args.compare.as_deref())?;
     if args.threads == Some(0) {
         return Err(Error::Usage("error: --threads must be at least 1".into()));
     }
@@ -300,6 +319,16 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             "warning: {} samples were NaN or infinite and were dropped",
             st.nan_samples
         );
+    }
+    if let Some(reference) = &reference {
+        super::golden::check(
+            reference,
+            &out.film,
+            &output,
+            exposure,
+            region,
+            args.max_rmse,
+        )?;
     }
     Ok(())
 }

@@ -5,6 +5,7 @@ mod assets;
 mod bad_scenes;
 mod cli;
 mod common;
+mod compare;
 mod determinism;
 mod doc_images;
 mod doc_snippets;
