@@ -90,7 +90,7 @@ fn parse_seconds(text: &str) -> Result<Duration, String> {
 }
 
 /// A duration such as `30s`, `2m`, `1.5h`, `250ms` or a bare number of seconds; positive.
-fn parse_duration(text: &str) -> Result<Duration, String> {
+pub(super) fn parse_duration(text: &str) -> Result<Duration, String> {
     let t = text.trim();
     let (number, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
         Some(i) => t.split_at(i),

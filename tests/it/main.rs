@@ -6,6 +6,7 @@ mod bad_scenes;
 mod cli;
 mod common;
 mod compare;
+mod converge;
 mod determinism;
 mod doc_images;
 mod doc_snippets;
