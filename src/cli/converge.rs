@@ -145,9 +145,7 @@ fn progress_bar(show: bool, name: &str, share: Duration) -> ProgressBar {
     }
     let bar =
         ProgressBar::with_draw_target(Some(share.as_millis() as u64), ProgressDrawTarget::stderr());
-    if let Ok(style) =
-        ProgressStyle::with_template("{prefix:>10} [{bar:30}] {elapsed:>4} of its share, {msg}")
-    {
+    if let Ok(style) = ProgressStyle::with_template("{prefix:>8} [{bar:24}] {msg}") {
         bar.set_style(style.progress_chars("=> "));
     }
     bar.set_prefix(name.to_string());
@@ -278,8 +276,13 @@ pub fn run(args: &ConvergeArgs) -> Result<(), Error> {
     if args.threads == Some(0) {
         return Err(Error::Usage("error: --threads must be at least 1".into()));
     }
-    let mut integrators = args.integrators.clone();
-    integrators.dedup_by_key(|i| i.scene_name());
+    // Each integrator once, in the order given.
+    let mut integrators: Vec<IntegratorArg> = Vec::new();
+    for &i in &args.integrators {
+        if !integrators.contains(&i) {
+            integrators.push(i);
+        }
+    }
     std::fs::create_dir_all(&args.output).map_err(|e| {
         Error::Usage(format!(
             "error: cannot create the output folder `{}`: {e}",

@@ -12,7 +12,7 @@ use plotters::prelude::*;
 
 use caustic::render::output::{OutputError, write_atomic};
 
-use super::error_image::{label, write_png};
+use super::error_image::write_png;
 use super::plot_backend::PixelFontBackend;
 
 /// Size of both plots, in pixels.
@@ -79,6 +79,33 @@ fn log_range(v: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     10f64.powf(a) * 0.999..10f64.powf(b.max(a + 1.0))
 }
 
+/// A log axis' tick label: 1, 2 and 5 times a power of ten are labelled (only powers of ten on
+/// an axis of more than four decades), the other grid lines (3, 4, 6, …) are left blank so
+/// labels do not crowd near the top of each decade. Shortest decimal form: `0.002`, `50`.
+fn tick(v: f64, decades: f64) -> String {
+    let exponent = v.log10().floor();
+    let mantissa = v / 10f64.powf(exponent);
+    let marks: &[f64] = if decades > 4.5 {
+        &[1.0, 10.0]
+    } else {
+        &[1.0, 2.0, 5.0, 10.0]
+    };
+    if !marks.iter().any(|m| (mantissa - m).abs() < 1e-6 * m) {
+        return String::new();
+    }
+    let digits = (-exponent).max(0.0) as usize;
+    if digits > 6 || exponent > 6.0 {
+        format!("{v:.0e}")
+    } else {
+        format!("{v:.digits$}")
+    }
+}
+
+/// Decades a log range spans.
+fn decades(r: &std::ops::Range<f64>) -> f64 {
+    (r.end / r.start).log10()
+}
+
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     plot: &Plot,
@@ -87,6 +114,7 @@ fn draw<DB: DrawingBackend>(
     let all = || plot.curves.iter().flat_map(|c| c.points.iter().filter(ok));
     let xs = log_range(all().map(|p| p.0));
     let ys = log_range(all().map(|p| p.1));
+    let (x_decades, y_decades) = (decades(&xs), decades(&ys));
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(root)
         .caption(&plot.title, ("sans-serif", 18))
@@ -99,11 +127,13 @@ fn draw<DB: DrawingBackend>(
         .x_desc(&plot.x_desc)
         .y_desc(&plot.y_desc)
         .label_style(("sans-serif", 18))
-        .x_labels(12)
-        .y_labels(30)
+        .x_labels(40)
+        .y_labels(40)
+        .bold_line_style(BLACK.mix(0.12))
+        .light_line_style(BLACK.mix(0.04))
         .axis_desc_style(("sans-serif", 18))
-        .x_label_formatter(&|v| label(*v as f32))
-        .y_label_formatter(&|v| label(*v as f32))
+        .x_label_formatter(&|v| tick(*v, x_decades))
+        .y_label_formatter(&|v| tick(*v, y_decades))
         .draw()?;
     for (i, curve) in plot.curves.iter().enumerate() {
         let colour = Palette99::pick(i).to_rgba();
@@ -137,6 +167,17 @@ fn draw<DB: DrawingBackend>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ticks_label_one_two_five_in_short_form() {
+        assert_eq!(tick(0.001, 3.0), "0.001");
+        assert_eq!(tick(0.002, 3.0), "0.002");
+        assert_eq!(tick(0.003, 3.0), "");
+        assert_eq!(tick(50.0, 3.0), "50");
+        assert_eq!(tick(50.0, 6.0), "");
+        assert_eq!(tick(100.0, 6.0), "100");
+        assert_eq!(tick(1e-9, 12.0), "1e-9");
+    }
 
     #[test]
     fn both_plots_are_written_and_the_png_has_text_and_curves() {
