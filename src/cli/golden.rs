@@ -15,6 +15,30 @@ pub fn load(path: Option<&Path>) -> Result<Option<Reference>, Error> {
         .transpose()
 }
 
+/// Refuses, before rendering, a reference whose size matches neither the image (`width`×
+/// `height`) nor the crop `region` of it.
+pub fn check_size(
+    reference: &Reference,
+    width: u32,
+    height: u32,
+    region: Option<Region>,
+) -> Result<(), Error> {
+    let size = (reference.film.width, reference.film.height);
+    if size == (width, height) || region.is_some_and(|r| size == (r.width, r.height)) {
+        return Ok(());
+    }
+    let crop = region.map_or_else(String::new, |r| {
+        format!(" or the {}×{} of --region", r.width, r.height)
+    });
+    Err(Error::Usage(format!(
+        "error: --compare: the reference `{}` is {}×{} but the image is {width}×{height}{crop}; \
+         give --width/--height to match it",
+        reference.path.display(),
+        size.0,
+        size.1
+    )))
+}
+
 /// Compares the rendered `film` (written to `output`; a crop at `region` if given) with the
 /// reference, prints the figures on one line, and fails when the RMSE exceeds `max_rmse`.
 pub fn check(

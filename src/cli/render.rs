@@ -239,6 +239,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if args.stats {
         print_stats(&prepared.stats);
     }
+    if let Some(reference) = &reference {
+        let p = &prepared.render_scene.params;
+        super::golden::check_size(reference, p.width, p.height, region)?;
+    }
     let exposure = prepared.render_scene.params.exposure;
     let spp = prepared.render_scene.params.samples_per_pixel;
     let terminal = !args.quiet && std::io::stderr().is_terminal();

@@ -246,6 +246,24 @@ fn render_compare_is_a_golden_image_check_with_exit_code_3() {
     let (out, path) = render(dir.path(), "none.exr", "5", &["--compare", "no_such.exr"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(!path.exists());
+    // A reference of another size fails before rendering (2), writing nothing.
+    let big = dir.path().join("big.exr");
+    let out = caustic(&[
+        "render",
+        "scenes/cornell.ron",
+        "-o",
+        big.to_str().expect("utf8"),
+        "--width",
+        "17",
+        "--height",
+        "16",
+        "--compare",
+        r,
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("16×16") && err.contains("17×16"), "{err}");
+    assert!(!big.exists());
     // --max-rmse needs --compare.
     let (out, _) = render(dir.path(), "x.exr", "5", &["--max-rmse", "1"]);
     assert_eq!(out.status.code(), Some(2));
