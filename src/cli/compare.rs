@@ -135,8 +135,14 @@ pub fn run(args: &CompareArgs) -> Result<(), Error> {
         );
     }
     if let Some((path, s)) = scale {
+        let z = error_image::zoom(region.width);
+        let zoomed = if z > 1 {
+            format!(", each pixel drawn {z}×{z}")
+        } else {
+            String::new()
+        };
         println!(
-            "error image `{}`: per-pixel RMS error over the channels, viridis from 0 to {} ({})",
+            "error image `{}`: per-pixel RMS error over the channels, viridis from 0 to {} ({}){zoomed}",
             path.display(),
             error_image::label(s.max),
             s.source

@@ -72,12 +72,21 @@ pub fn label(v: f32) -> String {
     }
 }
 
-/// The error image: `errors` (row-major, `width`×`height`) in false colour on top, then a colour
-/// bar from 0 to `scale.max` with both ends labelled and the quantity named.
+/// Whole-pixel magnification of a small error image (a `--region` crop, a thumbnail), so that
+/// it is about as wide as the colour bar: 1 for images at least [`MIN_WIDTH`] wide, at most 16.
+#[must_use]
+pub fn zoom(width: u32) -> u32 {
+    (MIN_WIDTH / width.max(1)).clamp(1, 16)
+}
+
+/// The error image: `errors` (row-major, `width`×`height`) in false colour on top, each pixel a
+/// [`zoom`]×zoom square, then a colour bar from 0 to `scale.max` with both ends labelled and the
+/// quantity named.
 #[must_use]
 pub fn render(errors: &[f32], width: u32, height: u32, scale: ErrorScale) -> RgbImage {
-    let canvas_w = width.max(MIN_WIDTH);
-    let bar_top = height + PAD;
+    let z = zoom(width);
+    let canvas_w = (width * z).max(MIN_WIDTH);
+    let bar_top = height * z + PAD;
     let text_top = bar_top + BAR + PAD;
     let canvas_h = text_top + 2 * GLYPH + 2 * PAD;
     let mut img = RgbImage::from_pixel(canvas_w, canvas_h, Rgb(BACKGROUND));
@@ -91,7 +100,9 @@ pub fn render(errors: &[f32], width: u32, height: u32, scale: ErrorScale) -> Rgb
     for (i, e) in errors.iter().enumerate() {
         let (x, y) = (i as u32 % width, i as u32 / width);
         if y < height {
-            img.put_pixel(x, y, Rgb(colour(*e)));
+            for (dx, dy) in (0..z).flat_map(|a| (0..z).map(move |b| (a, b))) {
+                img.put_pixel(x * z + dx, y * z + dy, Rgb(colour(*e)));
+            }
         }
     }
     let bar_w = canvas_w - 2 * PAD;
@@ -149,18 +160,22 @@ mod tests {
             source: "test",
         };
         let img = render(&[0.0, 0.5, 7.0, f32::NAN], 2, 2, scale);
+        // A 2×2 image is drawn 16 times larger: 32×32 pixels.
+        assert_eq!((zoom(2), zoom(100), zoom(240), zoom(1000)), (16, 2, 1, 1));
         assert_eq!(img.width(), MIN_WIDTH);
         // Viridis runs from dark purple (68, 1, 84) to yellow (253, 231, 37).
-        let (low, high) = (img.get_pixel(0, 0).0, img.get_pixel(1, 0).0);
+        let (low, high) = (img.get_pixel(0, 0).0, img.get_pixel(16, 0).0);
         assert!(low[2] > low[1] && low[0] < 100, "{low:?}");
         assert!(high[0] > 200 && high[1] > 200 && high[2] < 100, "{high:?}");
+        assert_eq!(img.get_pixel(15, 15).0, low);
         assert_eq!(
-            img.get_pixel(0, 1).0,
+            img.get_pixel(0, 16).0,
             high,
             "errors above the scale saturate"
         );
-        assert_eq!(img.get_pixel(1, 1).0, NAN_COLOUR);
-        let bar_y = 2 + PAD + BAR / 2;
+        assert_eq!(img.get_pixel(31, 31).0, NAN_COLOUR);
+        assert_eq!(img.get_pixel(32, 0).0, BACKGROUND);
+        let bar_y = 32 + PAD + BAR / 2;
         assert_eq!(img.get_pixel(PAD, bar_y).0, low);
         assert_eq!(img.get_pixel(MIN_WIDTH - PAD - 1, bar_y).0, high);
     }

@@ -126,14 +126,17 @@ fn the_error_image_maps_errors_through_its_labelled_scale() {
         stdout(&out)
     );
     let img = image::open(&png).expect("PNG").into_rgb8();
+    // A 3-pixel-wide image is drawn 16× larger (the cap), then the colour bar and labels.
     assert!(
-        img.width() >= 3 && img.height() > 20,
-        "image + colour bar + labels"
+        stdout(&out).contains("each pixel drawn 16×16"),
+        "{}",
+        stdout(&out)
     );
+    assert!(img.width() >= 48 && img.height() > 16 + 20);
     let (top, mid, zero) = (
         img.get_pixel(0, 0).0,
-        img.get_pixel(1, 0).0,
-        img.get_pixel(2, 0).0,
+        img.get_pixel(16, 0).0,
+        img.get_pixel(47, 15).0,
     );
     assert!(top[0] > 200 && top[1] > 200 && top[2] < 100, "{top:?}");
     assert!(zero[2] > zero[1] && zero[0] < 100, "{zero:?}");
