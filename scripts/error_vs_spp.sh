@@ -24,8 +24,8 @@ for sampler in independent sobol; do
     dims=$(echo "$line" | sed -E 's/.*: ([0-9]+)×([0-9]+),.*/\1 \2/')
     msps=$(echo "$dims $spp $secs" | awk '{printf "%.2f", $1*$2*$3/$4/1e6}')
     err=$("$caustic" compare "$out/img.exr" "$ref")
-    rmse=$(echo "$err" | awk '{print $2}')
-    rel=$(echo "$err" | awk '{print $4}')
+    rmse=$(echo "$err" | awk 'NR==1{print $2}')
+    rel=$(echo "$err" | awk 'NR==1{print $4}')
     echo "| $sampler | $spp | $secs | $msps | $mrays | $rmse | $rel |"
   done
 done

@@ -22,11 +22,15 @@ pub enum Error {
     /// The run was interrupted (Ctrl-C); the message says what, if anything, was kept.
     #[error("{0}")]
     Interrupted(String),
+    /// A golden-image check failed: the image is further from its reference than allowed
+    /// (`render --compare REF --max-rmse X`); the image was still written.
+    #[error("{0}")]
+    Mismatch(String),
 }
 
 impl Error {
     /// Exit code: 2 for bad input (scene, assets, flags), 1 for failures while rendering or
-    /// writing, 130 (128 + SIGINT) when interrupted.
+    /// writing, 3 when a golden-image check fails, 130 (128 + SIGINT) when interrupted.
     #[must_use]
     pub fn exit_code(&self) -> i32 {
         match self {
@@ -34,6 +38,7 @@ impl Error {
             Error::Scene(_) | Error::Usage(_) | Error::Render(_) => 2,
             Error::Output(OutputError::UnknownFormat { .. } | OutputError::Unwritable { .. }) => 2,
             Error::Output(_) => 1,
+            Error::Mismatch(_) => 3,
         }
     }
 }

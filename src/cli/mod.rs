@@ -2,7 +2,13 @@
 
 mod check;
 mod compare;
+mod converge;
 mod debug_pixel;
+mod error_image;
+mod golden;
+mod pixel_font;
+mod plot;
+mod plot_backend;
 mod render;
 
 use std::path::PathBuf;
@@ -35,8 +41,14 @@ enum Command {
     Schema,
     /// Trace one sample of one pixel and print its ray tree.
     DebugPixel(debug_pixel::DebugPixelArgs),
-    /// Compare an image with a reference (PNG or EXR): RMSE, relative MSE, max difference, bias.
+    /// Compare an image with a reference (PNG or EXR): RMSE, relative MSE, mean absolute error,
+    /// bias and max difference, overall and per channel; optionally over a region, as JSON, and
+    /// with a false-colour error image.
     Compare(compare::CompareArgs),
+    /// Measure error against time: each integrator of `--integrators` renders at 1, 2, 4, …
+    /// samples per pixel until its share of `--time` is spent; writes DIR/convergence.csv,
+    /// .json (with the machine and settings), .png and .svg (log-log RMSE against time).
+    Converge(converge::ConvergeArgs),
 }
 
 /// Runs one command.
@@ -50,11 +62,12 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         }
         Command::DebugPixel(args) => debug_pixel::run(&args),
         Command::Compare(args) => compare::run(&args),
+        Command::Converge(args) => converge::run(&args),
     }
 }
 
 /// Light-transport algorithms, as named on the command line.
-#[derive(Clone, Copy, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum IntegratorArg {
     /// Recursive ray tracing: direct light, mirrors and refraction.
     Whitted,
@@ -64,8 +77,27 @@ enum IntegratorArg {
     Photon,
 }
 
+impl IntegratorArg {
+    /// The scene file's name of the integrator (`render.integrator`).
+    fn scene_name(self) -> &'static str {
+        match self {
+            IntegratorArg::Whitted => "Whitted",
+            IntegratorArg::Path => "Path",
+            IntegratorArg::Photon => "Photon",
+        }
+    }
+
+    /// The command line's name (`--integrator NAME`).
+    fn cli_name(self) -> String {
+        self.to_possible_value().map_or_else(
+            || self.scene_name().to_lowercase(),
+            |v| v.get_name().to_string(),
+        )
+    }
+}
+
 /// Samplers, as named on the command line.
-#[derive(Clone, Copy, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum SamplerArg {
     /// Independent uniform random numbers.
     Independent,
@@ -124,12 +156,7 @@ impl SceneArgs {
     fn overrides(&self) -> SceneOverrides {
         let mut sets = self.sets.clone();
         if let Some(i) = self.integrator {
-            let name = match i {
-                IntegratorArg::Whitted => "Whitted",
-                IntegratorArg::Path => "Path",
-                IntegratorArg::Photon => "Photon",
-            };
-            sets.push(format!("render.integrator={name}"));
+            sets.push(format!("render.integrator={}", i.scene_name()));
         }
         if let Some(s) = self.sampler {
             let name = match s {

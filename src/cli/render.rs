@@ -53,6 +53,15 @@ pub struct RenderArgs {
     /// The final image is the same, bit for bit, as without checkpoints.
     #[arg(long, value_name = "FILE")]
     checkpoint: Option<PathBuf>,
+    /// After writing the image, compare it with this reference (PNG or EXR; for a `--region`
+    /// render the reference may be the whole image or the crop) and print RMSE, relMSE, mean
+    /// absolute error and bias.
+    #[arg(long, value_name = "REF")]
+    compare: Option<PathBuf>,
+    /// With `--compare`: a golden-image check: exit with code 3 (the image is still written)
+    /// when the RMSE against the reference is above this.
+    #[arg(long, value_name = "RMSE", requires = "compare", value_parser = parse_max_rmse)]
+    max_rmse: Option<f64>,
     /// Seconds between checkpoints (0: after every pass).
     #[arg(
         long,
@@ -64,6 +73,14 @@ pub struct RenderArgs {
     checkpoint_every: Duration,
 }
 
+fn parse_max_rmse(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| format!("expected a non-negative number, found `{text}`"))
+}
+
 fn parse_seconds(text: &str) -> Result<Duration, String> {
     text.trim()
         .parse::<f64>()
@@ -73,7 +90,7 @@ fn parse_seconds(text: &str) -> Result<Duration, String> {
 }
 
 /// A duration such as `30s`, `2m`, `1.5h`, `250ms` or a bare number of seconds; positive.
-fn parse_duration(text: &str) -> Result<Duration, String> {
+pub(super) fn parse_duration(text: &str) -> Result<Duration, String> {
     let t = text.trim();
     let (number, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
         Some(i) => t.split_at(i),
@@ -98,7 +115,8 @@ fn parse_duration(text: &str) -> Result<Duration, String> {
         })
 }
 
-fn parse_region(text: &str) -> Result<Region, Error> {
+/// Parses `X,Y,W,H` (the form of `--region`).
+pub(super) fn parse_region(text: &str) -> Result<Region, Error> {
     let parts: Vec<Result<u32, _>> = text.split(',').map(|p| p.trim().parse::<u32>()).collect();
     match parts.as_slice() {
         [Ok(x), Ok(y), Ok(w), Ok(h)] => Ok(Region {
@@ -206,6 +224,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         caustic::render::output::check_writable(path)?;
     }
     let region = args.region.as_deref().map(parse_region).transpose()?;
+    let reference = super::golden::load(args.compare.as_deref())?;
     if args.threads == Some(0) {
         return Err(Error::Usage("error: --threads must be at least 1".into()));
     }
@@ -219,6 +238,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     }
     if args.stats {
         print_stats(&prepared.stats);
+    }
+    if let Some(reference) = &reference {
+        let p = &prepared.render_scene.params;
+        super::golden::check_size(reference, p.width, p.height, region)?;
     }
     let exposure = prepared.render_scene.params.exposure;
     let spp = prepared.render_scene.params.samples_per_pixel;
@@ -312,6 +335,16 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             "warning: {} samples were NaN or infinite and were dropped",
             st.nan_samples
         );
+    }
+    if let Some(reference) = &reference {
+        super::golden::check(
+            reference,
+            &out.film,
+            &output,
+            exposure,
+            region,
+            args.max_rmse,
+        )?;
     }
     Ok(())
 }

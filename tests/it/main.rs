@@ -6,6 +6,8 @@ mod bad_scenes;
 mod bath;
 mod cli;
 mod common;
+mod compare;
+mod converge;
 mod determinism;
 mod doc_images;
 mod doc_snippets;
