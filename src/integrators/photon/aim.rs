@@ -4,24 +4,25 @@
 //! point.
 //!
 //! Directions are drawn from the mixture of the cones, each chosen in proportion to its solid
-//! angle Ωⱼ and sampled uniformly inside. The mixture's density at a direction `w` is
-//! `Σⱼ (Ωⱼ/ΣΩ)·[w ∈ coneⱼ]/Ωⱼ = count(w)/ΣΩ`, where `count(w)` is how many cones contain `w`, so
-//! overlapping cones stay unbiased. A photon's flux divides by that density: the solid-angle
-//! fraction of the light that the cones cover is in every photon's flux. When the cones cover
-//! the whole sphere (ΣΩ ≥ 4π, e.g. a light inside a bounding sphere) uniform directions are used.
+//! angle Ωⱼ times the target's specular share wⱼ (reflect + transmit weight: a wall that mirrors
+//! 6 % gets 6 % of a glass ball's photons per steradian) and sampled uniformly inside. The
+//! mixture's density at a direction `w` is `Σⱼ (wⱼΩⱼ/Σ wΩ)·[w ∈ coneⱼ]/Ωⱼ = Σ_{j ∋ w} wⱼ / Σ wΩ`,
+//! so overlapping cones stay unbiased. A photon's flux divides by that density: the solid-angle
+//! fraction of the light that the cones cover is in every photon's flux. A light inside a
+//! bounding sphere gets that target's cone as the whole sphere.
 
 use glam::{DAffine3, Vec3};
-use std::f32::consts::{PI, TAU};
+use std::f32::consts::TAU;
 
 use crate::geometry::Frame;
 use crate::render_scene::RenderScene;
-use crate::sampling::warp::uniform_sphere;
 
 /// Bounding spheres (centre, radius) of every object whose material has a mirror or dielectric
-/// part: where caustic photons are sent.
+/// part, each with the weight of that part (its share of the material's normalised weights):
+/// where caustic photons are sent.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct CausticTargets {
-    spheres: Vec<(Vec3, f32)>,
+    spheres: Vec<(Vec3, f32, f32)>,
 }
 
 /// One cone of directions from an emitting point towards a target.
@@ -31,6 +32,9 @@ pub struct AimCone {
     pub axis: Vec3,
     /// `1 − cos θmax` of the half-angle (in `(0, 2]`; 2 is the whole sphere).
     pub one_minus_cos: f32,
+    /// Relative weight of the target (its specular share): cones are chosen in proportion to
+    /// `weight · Ω`.
+    pub weight: f32,
 }
 
 /// Bounds of one object's primitives while they are gathered.
@@ -77,14 +81,18 @@ impl CausticTargets {
     /// lobe). Emitters and purely diffuse objects are not targets.
     #[must_use]
     pub fn new(scene: &RenderScene) -> Self {
-        let is_target: Vec<bool> = scene
+        // The specular share of each object's material (0: not a target).
+        let share: Vec<f32> = scene
             .objects
             .iter()
             .map(|o| {
-                o.material
-                    .is_some_and(|m| scene.materials[m as usize].bsdf.has_delta())
+                o.material.map_or(0.0, |m| {
+                    let b = &scene.materials[m as usize].bsdf;
+                    b.reflect + b.transmit
+                })
             })
             .collect();
+        let is_target: Vec<bool> = share.iter().map(|&s| s > 0.0).collect();
         let mut bounds: Vec<Option<ObjectBounds>> = vec![None; scene.objects.len()];
         let g = &scene.geometry;
         let mut add = |object: u32, b: ObjectBounds| {
@@ -116,17 +124,20 @@ impl CausticTargets {
         }
         let spheres = bounds
             .into_iter()
-            .flatten()
-            .map(ObjectBounds::sphere)
-            .filter(|(c, r)| c.is_finite() && r.is_finite())
+            .zip(share)
+            .filter_map(|(b, s)| b.map(|b| (b.sphere(), s)))
+            .map(|((c, r), s)| (c, r, s))
+            .filter(|(c, r, _)| c.is_finite() && r.is_finite())
             .collect();
         Self { spheres }
     }
 
-    /// Targets from explicit bounding spheres (tests, tools).
+    /// Targets from explicit bounding spheres of equal weight (tests, tools).
     #[must_use]
     pub fn from_spheres(spheres: Vec<(Vec3, f32)>) -> Self {
-        Self { spheres }
+        Self {
+            spheres: spheres.into_iter().map(|(c, r)| (c, r, 1.0)).collect(),
+        }
     }
 
     /// True if the scene has nothing that can focus light (no caustic map can be built).
@@ -142,17 +153,19 @@ impl CausticTargets {
     }
 
     /// The cones the targets subtend from `from`, written into `out` (cleared first); returns
-    /// their total solid angle ΣΩ (sr). A target that contains `from` gives the whole sphere.
+    /// their weighted total solid angle Σ wⱼΩⱼ (sr). A target that contains `from` gives the
+    /// whole sphere.
     pub fn cones(&self, from: Vec3, out: &mut Vec<AimCone>) -> f32 {
         out.clear();
         let mut total = 0.0;
-        for &(c, r) in &self.spheres {
+        for &(c, r, weight) in &self.spheres {
             let d = c - from;
             let dist2 = d.length_squared();
             let cone = if dist2 <= r * r || dist2 == 0.0 {
                 AimCone {
                     axis: Vec3::Z,
                     one_minus_cos: 2.0,
+                    weight,
                 }
             } else {
                 let sin2 = (r * r / dist2).min(1.0);
@@ -161,19 +174,20 @@ impl CausticTargets {
                     axis: d / dist2.sqrt(),
                     // 1 − cos written as sin²/(1 + cos): exact for tiny cones.
                     one_minus_cos: sin2 / (1.0 + cos),
+                    weight,
                 }
             };
-            total += TAU * cone.one_minus_cos;
+            total += weight * TAU * cone.one_minus_cos;
             out.push(cone);
         }
         total
     }
 }
 
-/// Samples a direction from the mixture of `cones` (of total solid angle `total`, as returned
-/// by [`CausticTargets::cones`]) with `u_pick ∈ [0, 1)` choosing the cone and `u` the direction
-/// in it; returns the direction and the mixture's solid-angle density there (1/sr). Uniform
-/// over the sphere (density 1/(4π)) when the cones cover at least 4π. `None` without cones.
+/// Samples a direction from the mixture of `cones` (of weighted total solid angle `total`, as
+/// returned by [`CausticTargets::cones`]) with `u_pick ∈ [0, 1)` choosing cone j with
+/// probability `wⱼΩⱼ / total` and `u` the direction, uniform in it; returns the direction and
+/// the mixture's solid-angle density there, `Σ_{j ∋ w} wⱼ / total` (1/sr). `None` without cones.
 #[must_use]
 pub fn sample_cones(
     cones: &[AimCone],
@@ -184,13 +198,10 @@ pub fn sample_cones(
     if cones.is_empty() || !(total > 0.0) {
         return None;
     }
-    if total >= 4.0 * PI {
-        return Some((uniform_sphere(u), 1.0 / (4.0 * PI)));
-    }
     let mut target = u_pick * total;
     let mut chosen = cones.len() - 1;
     for (j, c) in cones.iter().enumerate() {
-        let omega = TAU * c.one_minus_cos;
+        let omega = c.weight * TAU * c.one_minus_cos;
         if target < omega {
             chosen = j;
             break;
@@ -206,12 +217,13 @@ pub fn sample_cones(
         .to_world(Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t))
         .normalize();
     // The chosen cone contains the direction even where rounding puts it a hair outside.
-    let count = cones
+    let weight: f32 = cones
         .iter()
         .enumerate()
         .filter(|&(j, k)| j == chosen || contains(k, dir))
-        .count();
-    Some((dir, count as f32 / total))
+        .map(|(_, k)| k.weight)
+        .sum();
+    Some((dir, weight / total))
 }
 
 /// True if unit `dir` lies in cone `c` (with a relative slack of a few ulps at the rim).
@@ -220,23 +232,27 @@ fn contains(c: &AimCone, dir: Vec3) -> bool {
     c.one_minus_cos >= 2.0 || 1.0 - dir.dot(c.axis) <= c.one_minus_cos * (1.0 + 1e-5) + 1e-7
 }
 
-/// The density [`sample_cones`] gives direction `dir` (unit): how many cones contain it over
-/// their total solid angle, or 1/(4π) when they cover the sphere.
+/// The density [`sample_cones`] gives direction `dir` (unit): the weights of the cones that
+/// contain it over their weighted total solid angle.
 #[must_use]
 pub fn cones_pdf(cones: &[AimCone], total: f32, dir: Vec3) -> f32 {
     if cones.is_empty() || !(total > 0.0) {
         return 0.0;
     }
-    if total >= 4.0 * PI {
-        return 1.0 / (4.0 * PI);
-    }
-    cones.iter().filter(|c| contains(c, dir)).count() as f32 / total
+    cones
+        .iter()
+        .filter(|c| contains(c, dir))
+        .map(|c| c.weight)
+        .sum::<f32>()
+        / total
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::sampling::Rng;
+    use crate::sampling::warp::uniform_sphere;
+    use std::f32::consts::PI;
 
     #[test]
     fn one_cone_has_the_solid_angle_of_its_sphere() {
@@ -254,14 +270,16 @@ mod tests {
 
     #[test]
     fn overlapping_cones_sample_with_the_density_they_report() {
-        // Two overlapping cones and a separate one. Estimate ∫ g(w) dw for g = 1 on the
+        // Two overlapping cones and a separate one, of unequal weights. Estimate ∫ g(w) dw for g = 1 on the
         // union of the cones by importance sampling: Σ 1/pdf / N must equal the union's solid
         // angle, computed independently by uniform sphere sampling.
-        let t = CausticTargets::from_spheres(vec![
-            (Vec3::new(0.0, 0.0, 3.0), 1.0),
-            (Vec3::new(0.5, 0.0, 3.0), 1.0),
-            (Vec3::new(-3.0, 1.0, 0.0), 0.5),
-        ]);
+        let t = CausticTargets {
+            spheres: vec![
+                (Vec3::new(0.0, 0.0, 3.0), 1.0, 1.0),
+                (Vec3::new(0.5, 0.0, 3.0), 1.0, 0.3),
+                (Vec3::new(-3.0, 1.0, 0.0), 0.5, 0.06),
+            ],
+        };
         let mut cones = Vec::new();
         let total = t.cones(Vec3::ZERO, &mut cones);
         let mut rng = Rng::new(7, 1);
@@ -295,9 +313,9 @@ mod tests {
         let t = CausticTargets::from_spheres(vec![(Vec3::ZERO, 2.0)]);
         let mut cones = Vec::new();
         let total = t.cones(Vec3::new(0.5, 0.0, 0.0), &mut cones);
-        assert!(total >= 4.0 * PI);
+        assert!((total - 4.0 * PI).abs() < 1e-5);
         let (d, pdf) = sample_cones(&cones, total, 0.3, (0.2, 0.9)).expect("sample");
         assert!((d.length() - 1.0).abs() < 1e-5);
-        assert_eq!(pdf, 1.0 / (4.0 * PI));
+        assert!((pdf - 1.0 / (4.0 * PI)).abs() < 1e-7);
     }
 }

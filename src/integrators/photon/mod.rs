@@ -38,8 +38,14 @@ use crate::shading::{ShadingFrame, TransportMode};
 /// Bounces after which Russian roulette may end a camera path's specular chain.
 const ROULETTE_DEPTH: u32 = 3;
 
-/// Delta bounces at which a camera path follows both Fresnel reflection and refraction.
+/// Delta bounces at which a camera path follows both Fresnel reflection and refraction (at
+/// purely specular surfaces: glass, water, chrome; a glazed diffuse surface samples its mirror
+/// part instead of paying a second diffuse estimate for a few per cent of the light).
 const SPLIT_DEPTH: u32 = 2;
+
+/// Final gathering is done only at vertices whose path weight is at least this; dimmer ones
+/// (seen in a faint reflection) read the precomputed irradiance instead.
+const FINAL_GATHER_MIN_WEIGHT: f32 = 0.25;
 
 /// Pending branches of one camera sample (a split adds one; deeper chains sample one lobe).
 const STACK: usize = 8;
@@ -178,7 +184,8 @@ impl<'a> PhotonMapper<'a> {
                 continue;
             }
             if sh.bsdf.has_local() {
-                let (c, note) = self.local(&sp, &sh, wo, sampler, counters, log.is_some());
+                let full = beta.max_element() >= FINAL_GATHER_MIN_WEIGHT;
+                let (c, note) = self.local(&sp, &sh, wo, full, sampler, counters, log.is_some());
                 gathered = beta * c;
                 l += gathered;
                 if let Some(text) = note {
@@ -216,7 +223,7 @@ impl<'a> PhotonMapper<'a> {
                 };
                 len += 1;
             };
-            if depth < SPLIT_DEPTH {
+            if depth < SPLIT_DEPTH && !sh.bsdf.has_local() {
                 let lobes = sh.bsdf.delta_lobes(wo, fr.ns, fr.ng, fr.entering);
                 if let Some((dir, w)) = lobes.refract {
                     let eta = if fr.entering {
@@ -270,17 +277,28 @@ impl<'a> PhotonMapper<'a> {
     /// The radiance a camera-path vertex with a diffuse part sends towards `wo`: direct light,
     /// caustics and indirect light. With `describe`, also a line for `debug-pixel` naming each
     /// estimate's photon count and radius.
+    #[allow(clippy::too_many_arguments)]
     fn local(
         &self,
         sp: &SurfacePoint,
         sh: &ShadingPoint,
         wo: Vec3,
+        full: bool,
         sampler: &mut Sampler,
         counters: &mut Counters,
         describe: bool,
     ) -> (Vec3, Option<String>) {
         let fr = frame(sh);
         let direct = self.direct(sp, &fr, sh, wo, sampler, counters);
+        if !full && let Some(l) = self.cached_radiance(sp, &fr, sh, wo) {
+            let note = describe.then(|| {
+                format!(
+                    "direct ({:.4}, {:.4}, {:.4}); caustic + indirect from precomputed irradiance ({:.4}, {:.4}, {:.4}) (dim branch)",
+                    direct.x, direct.y, direct.z, l.x, l.y, l.z
+                )
+            });
+            return (direct + l, note);
+        }
         let caustic = self.maps.caustic.as_ref().map(|m| {
             counters.photon_estimates += 1;
             let e = m.estimate(sp.p, wo, &fr, &sh.bsdf);
@@ -334,6 +352,19 @@ impl<'a> PhotonMapper<'a> {
             )
         });
         (direct + caustic_l + indirect, note)
+    }
+
+    /// Caustic and indirect radiance towards `wo` from the precomputed irradiance (both maps),
+    /// `f(ωo, n) · E`, when final gathering built it and a point lies near on the same surface.
+    fn cached_radiance(
+        &self,
+        sp: &SurfacePoint,
+        fr: &ShadingFrame,
+        sh: &ShadingPoint,
+        wo: Vec3,
+    ) -> Option<Vec3> {
+        let e = self.maps.irradiance.as_ref()?.lookup(sp.p, fr.ng)?;
+        Some(sh.bsdf.eval(wo, fr.ns, fr, TransportMode::Radiance) * e)
     }
 
     /// Direct light at a vertex by one shadow ray to a light chosen in proportion to power.
@@ -414,11 +445,7 @@ impl<'a> PhotonMapper<'a> {
                 let gfr = frame(&gsh);
                 if gsh.bsdf.has_local() {
                     let mut lo = self.direct(&gp, &gfr, &gsh, gwo, sampler, counters);
-                    let cached = self.maps.irradiance.as_ref().and_then(|c| {
-                        let e = c.lookup(gp.p, gfr.ng)?;
-                        Some(gsh.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e)
-                    });
-                    if let Some(l) = cached {
+                    if let Some(l) = self.cached_radiance(&gp, &gfr, &gsh, gwo) {
                         lo += l;
                     } else {
                         for map in [&self.maps.caustic, &self.maps.global]
