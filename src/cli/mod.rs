@@ -3,6 +3,7 @@
 mod check;
 mod compare;
 mod debug_pixel;
+mod photons;
 mod render;
 
 use std::path::PathBuf;
@@ -37,6 +38,9 @@ enum Command {
     DebugPixel(debug_pixel::DebugPixelArgs),
     /// Compare an image with a reference (PNG or EXR): RMSE, relative MSE, max difference, bias.
     Compare(compare::CompareArgs),
+    /// Draw the photon maps over a dim render of the scene (caustic photons orange, global
+    /// blue, brighter where more power landed).
+    Photons(photons::PhotonsArgs),
 }
 
 /// Runs one command.
@@ -50,6 +54,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         }
         Command::DebugPixel(args) => debug_pixel::run(&args),
         Command::Compare(args) => compare::run(&args),
+        Command::Photons(args) => photons::run(&args),
     }
 }
 

@@ -44,6 +44,8 @@ pub struct PhotonSummary {
     pub build_time: Duration,
     /// Bytes of both maps.
     pub memory: usize,
+    /// What the photon-map cache did (`--photon-cache`), as the summary's last line.
+    pub cache: Option<String>,
 }
 
 impl PhotonSummary {
@@ -126,7 +128,11 @@ impl std::fmt::Display for PhotonSummary {
             self.build_time.as_secs_f64(),
             self.memory as f64 / 1e6,
             self.targets
-        )
+        )?;
+        match &self.cache {
+            Some(line) => write!(f, "\n{line}"),
+            None => Ok(()),
+        }
     }
 }
 
@@ -203,7 +209,7 @@ fn trace_map(
 
 /// The diffuse surface area (m²) photons can land on: triangles and spheres of objects whose
 /// material has a diffuse part (ellipsoids by their bounding sphere's area, an upper bound).
-fn diffuse_area(scene: &RenderScene) -> f64 {
+pub(super) fn diffuse_area(scene: &RenderScene) -> f64 {
     let diffuse = |o: u32| {
         scene.objects[o as usize]
             .material
