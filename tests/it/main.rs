@@ -15,6 +15,7 @@ mod light_transport;
 mod mutated_scenes;
 mod passes;
 mod path_tracer;
+mod photon_tools;
 mod primitives;
 mod queries;
 mod render_snapshots;
