@@ -4,9 +4,11 @@
 //!
 //! Every photon is projected through the pinhole camera to the pixel it falls in (a one-pixel
 //! splat) if the camera sees it: it lies in front of the camera and inside the image, on the side
-//! of its surface the camera is on (its stored normal faces the eye), and nothing blocks the
-//! segment from the eye to it (a shadow ray). Per map, each pixel sums the mean power of its
-//! photons; the sum `s` is drawn with opacity `1 − exp(−2 s / s₉₅)`, where `s₉₅` is the 95th
+//! of its surface the camera is on (its stored normal faces the eye), and nothing opaque blocks
+//! the segment from the eye to it (a shadow ray that passes through objects with a transmitting
+//! part: caustics under water or behind glass are drawn where they lie, as if the water did not
+//! bend the view). Per map, each pixel sums the mean power of its
+//! photons; the sum `s` is drawn with opacity `1 − exp(−s / s₉₅)`, where `s₉₅` is the 95th
 //! percentile of the map's non-empty pixels, so dense regions saturate and lone photons stay
 //! faint. The global map is drawn first and the caustic map over it.
 
@@ -139,13 +141,17 @@ fn visible_pixel(scene: &RenderScene, p: Vec3, normal: Vec3) -> Option<usize> {
     if !(fx >= 0.0 && fy >= 0.0 && fx < w as f32 && fy < h as f32) {
         return None;
     }
-    // Blockers strictly between the eye and the photon's surface (1 mm per metre of margin).
+    // Opaque blockers strictly between the eye and the photon's surface (1 mm per metre of
+    // margin); glass and water are looked through, without bending the line of sight.
     let ray = Ray {
         origin: cam.eye,
         dir: d,
         t_max: 0.999,
     };
-    if scene.geometry.occluded(&ray) {
+    if scene
+        .geometry
+        .occluded_by(&ray, |prim| scene.is_opaque(scene.geometry.object_of(prim)))
+    {
         return None;
     }
     Some(fy as usize * w as usize + fx as usize)
@@ -183,7 +189,7 @@ fn overlay(display: &mut [Vec3], sums: &[f32], colour: Vec3) {
     let scale = nonzero[(nonzero.len() - 1) * 95 / 100].max(f32::MIN_POSITIVE);
     for (d, &s) in display.iter_mut().zip(sums) {
         if s > 0.0 {
-            let a = 1.0 - (-2.0 * s / scale).exp();
+            let a = 1.0 - (-s / scale).exp();
             *d = *d * (1.0 - a) + colour * a;
         }
     }

@@ -223,7 +223,7 @@ impl<T: HasPosition + Send> KdTree<T> {
     }
 }
 
-impl<T: HasPosition> KdTree<T> {
+impl<T: HasPosition + Sync> KdTree<T> {
     /// Rebuilds a tree from items already in tree order (the [`KdTree::items`] of a tree built
     /// with the same `options`, e.g. read back from a photon-map cache) without moving them:
     /// each node's axis and planes are recomputed from its range, so the result equals the
@@ -281,7 +281,7 @@ impl<T: HasPosition> KdTree<T> {
 
 /// [`build_node`] without the selection: recomputes the stems of a range already split at its
 /// medians. False when a node's halves overlap on its axis.
-fn restore_node<T: HasPosition>(
+fn restore_node<T: HasPosition + Sync>(
     items: &[T],
     stems: &mut [Stem],
     half: usize,
@@ -309,8 +309,17 @@ fn restore_node<T: HasPosition>(
         axis: axis as u32,
     };
     let (left_stems, right_stems) = stems[1..].split_at_mut(half - 1);
-    restore_node(left, left_stems, half / 2, depth + 1, rule)
-        && restore_node(right, right_stems, half / 2, depth + 1, rule)
+    let child = half / 2;
+    if items.len() >= PARALLEL_MIN {
+        let (l, r) = rayon::join(
+            || restore_node(left, left_stems, child, depth + 1, rule),
+            || restore_node(right, right_stems, child, depth + 1, rule),
+        );
+        l && r
+    } else {
+        restore_node(left, left_stems, child, depth + 1, rule)
+            && restore_node(right, right_stems, child, depth + 1, rule)
+    }
 }
 
 /// Splits `items` at its median and recurses; `stems` is this subtree's pre-order run.

@@ -152,7 +152,12 @@ fn the_key_follows_what_photons_depend_on_and_nothing_else() {
         assert_ne!(base, key(&|s| s.replace(from, to)), "{from} -> {to}");
     }
     let sampler = |name: &str| {
-        key(&|s| s.replace("integrator: Photon", &format!("integrator: Photon, sampler: {name}")))
+        key(&|s| {
+            s.replace(
+                "integrator: Photon",
+                &format!("integrator: Photon, sampler: {name}"),
+            )
+        })
     };
     assert_ne!(sampler("Sobol"), sampler("Independent"));
 }
