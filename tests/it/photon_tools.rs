@@ -9,7 +9,7 @@ use caustic::integrators::photon::cache::{
 };
 use caustic::integrators::photon::{PhotonMap, build_maps};
 use caustic::photon::{BuildOptions, KdTree};
-use caustic::render::{Film, RenderJob, RenderOptions, render};
+use caustic::render::{Film, RenderJob, RenderOptions};
 use caustic::render_scene::RenderScene;
 
 use crate::common::{caustic, scene_from_text};
