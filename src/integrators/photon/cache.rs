@@ -429,11 +429,22 @@ pub fn encode(maps: &PhotonMaps, key: u64) -> Vec<u8> {
 /// # Errors
 /// [`CacheError::Io`] when the file cannot be written.
 pub fn save(maps: &PhotonMaps, path: &Path, key: u64) -> Result<(), CacheError> {
+    use std::io::Write as _;
     let bytes = encode(maps, key);
-    crate::render::output::write_atomic(path, &bytes).map_err(|e| CacheError::Io {
+    let io = |source| CacheError::Io {
         path: path.to_path_buf(),
-        source: std::io::Error::other(e.to_string()),
-    })
+        source,
+    };
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".photons-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(io)?;
+    tmp.write_all(&bytes).map_err(io)?;
+    tmp.as_file().sync_all().map_err(io)?;
+    tmp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
 }
 
 /// A little-endian reader over a cache file's body that reports truncation.
