@@ -374,8 +374,9 @@ fn the_viewer_shows_the_caustic_under_the_ball_and_nowhere_else() {
     );
 }
 
-/// Restoring a tree from its tree order against rebuilding it, for 1M photons (run with
-/// `--ignored --nocapture` to see the timings; the figures are in docs/photon_map.md).
+/// Restoring a tree from its tree order against rebuilding it, for 1M photons, and the time
+/// the cache key of each demo scene takes (run with `--ignored --nocapture` to see the timings;
+/// the figures are in docs/photon_map.md).
 #[test]
 #[ignore = "timing (1M photons)"]
 fn restoring_a_million_photons_is_faster_than_building() {
@@ -409,6 +410,18 @@ fn restoring_a_million_photons_is_faster_than_building() {
     let rebuilt = KdTree::build(ordered).expect("tree");
     let rebuild = t.elapsed();
     assert_eq!(restored.items(), built.items());
+    for path in crate::common::scene_files() {
+        let prepared = caustic::pipeline::prepare(&path, &Default::default()).expect("scene");
+        let t = Instant::now();
+        let key = cache_key(&prepared.render_scene);
+        println!(
+            "{}: key {key:016x} in {:.4} s ({} triangles, {} textures)",
+            path.display(),
+            t.elapsed().as_secs_f64(),
+            prepared.render_scene.geometry.triangles.len(),
+            prepared.render_scene.textures.len()
+        );
+    }
     println!(
         "1M photons: build {:.3} s, from_tree_order {:.3} s, build from tree order {:.3} s (same order: {})",
         build.as_secs_f64(),
