@@ -36,6 +36,34 @@ pub struct ObjMesh {
     /// Faces whose shape is suspect (not planar, or crossing themselves), as sentences naming
     /// the OBJ line; the triangles are still made.
     pub warnings: Vec<String>,
+    /// The file's group (`g`/`o`) and `usemtl` names, each once, in order of first use.
+    pub names: Vec<String>,
+    /// Per triangle (parallel to `triangles`): the names of the face it came from.
+    pub triangle_names: Vec<FaceNames>,
+}
+
+/// The names an OBJ face is under, as indices into [`ObjMesh::names`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FaceNames {
+    /// The last `g` or `o` statement before the face (`None` before any, or after an empty one).
+    pub group: Option<u32>,
+    /// The last `usemtl` statement before the face.
+    pub usemtl: Option<u32>,
+}
+
+impl ObjMesh {
+    /// The index of `name` in [`ObjMesh::names`], if the file uses it.
+    #[must_use]
+    pub fn name_index(&self, name: &str) -> Option<u32> {
+        self.names.iter().position(|n| n == name).map(|i| i as u32)
+    }
+}
+
+/// What [`check_obj_text`] learns about each face, in file order.
+struct FaceRecord {
+    /// 1-based line.
+    line: usize,
+    names: FaceNames,
 }
 
 /// Loaded meshes by resolved path (errors are not cached; each node reports its own).
@@ -76,7 +104,9 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
             e.valid_up_to()
         )
     })?;
-    let face_lines = check_obj_text(text).map_err(|e| format!("`{}` {e}", path.display()))?;
+    let mut mesh = ObjMesh::default();
+    let faces =
+        check_obj_text(text, &mut mesh.names).map_err(|e| format!("`{}` {e}", path.display()))?;
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
@@ -89,7 +119,6 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
         Err(tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| format!("`{}` is not a valid OBJ file: {e}", path.display()))?;
-    let mut mesh = ObjMesh::default();
     let mut faces_seen = 0;
     for model in &models {
         let m = &model.mesh;
@@ -133,10 +162,13 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
             }
             let corners: Vec<Corner> = (start..start + arity as usize).map(corner).collect();
             start += arity as usize;
-            let line = face_lines.get(faces_seen).copied();
+            let record = faces.get(faces_seen);
+            let line = record.map(|f| f.line);
+            let names = record.map(|f| f.names).unwrap_or_default();
             faces_seen += 1;
             if corners.len() == 3 {
                 mesh.triangles.push([corners[0], corners[1], corners[2]]);
+                mesh.triangle_names.push(names);
                 continue;
             }
             // Indices are checked against the file's records above, so positions exist.
@@ -166,6 +198,7 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
             }
             mesh.triangles
                 .extend(t.triangles.iter().map(|tri| tri.map(|k| corners[k])));
+            mesh.triangle_names.resize(mesh.triangles.len(), names);
         }
     }
     check_indices(&mesh)
@@ -185,15 +218,34 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
 
 /// Checks the statements tobj relies on, so errors name the OBJ line: vertex records need
 /// numbers, faces need at least three corners whose indices refer to records defined so far.
-/// Returns the 1-based line of each face, in file order (tobj keeps that order).
-fn check_obj_text(text: &str) -> Result<Vec<usize>, String> {
+/// Returns each face's 1-based line and names, in file order (tobj keeps that order); the
+/// group and `usemtl` names are added to `names`.
+fn check_obj_text(text: &str, names: &mut Vec<String>) -> Result<Vec<FaceRecord>, String> {
     let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
-    let mut face_lines = Vec::new();
+    let mut faces = Vec::new();
+    let mut current = FaceNames::default();
+    let mut intern = |name: &str| {
+        if name.is_empty() {
+            return None;
+        }
+        let i = names.iter().position(|n| n == name).unwrap_or_else(|| {
+            names.push(name.to_string());
+            names.len() - 1
+        });
+        Some(i as u32)
+    };
     for (n, raw) in text.lines().enumerate() {
         let line = raw.split('#').next().unwrap_or("").trim();
         let mut words = line.split_whitespace();
         let at = |msg: String| format!("line {}: `{}`: {msg}", n + 1, raw.trim());
+        // The name is the rest of the line, as tobj reads it.
+        let rest = || {
+            line.split_once(char::is_whitespace)
+                .map_or("", |r| r.1.trim())
+        };
         match words.next() {
+            Some("g" | "o") => current.group = intern(rest()),
+            Some("usemtl") => current.usemtl = intern(rest()),
             Some(kind @ ("v" | "vt" | "vn")) => {
                 let need = if kind == "vt" { 1 } else { 3 };
                 let nums: Vec<&str> = words.collect();
@@ -216,7 +268,10 @@ fn check_obj_text(text: &str) -> Result<Vec<usize>, String> {
                 if corners.len() < 3 {
                     return Err(at("a face needs at least three corners".into()));
                 }
-                face_lines.push(n + 1);
+                faces.push(FaceRecord {
+                    line: n + 1,
+                    names: current,
+                });
                 for corner in corners {
                     for (i, (part, count, what)) in corner
                         .split('/')
@@ -252,7 +307,7 @@ fn check_obj_text(text: &str) -> Result<Vec<usize>, String> {
             _ => {}
         }
     }
-    Ok(face_lines)
+    Ok(faces)
 }
 
 fn check_indices(mesh: &ObjMesh) -> Result<(), String> {

@@ -1,17 +1,19 @@
 //! Flattening the node tree: transforms composed and baked into world-space primitives.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 
 use super::materials::MaterialTable;
-use super::mesh::MeshCache;
+use super::mesh::{MeshCache, ObjMesh};
 use crate::geometry::triangle::is_degenerate;
 use crate::render_scene::ObjectInfo;
 use crate::render_scene::geometry::{
     EllipsoidPrim, GeometryBuilder, MAX_PRIMS_PER_KIND, SpherePrim, TriAttrs,
 };
 use crate::scene::Diagnostic;
+use crate::scene::diagnostic::{did_you_mean, quoted_list};
 use crate::scene::schema::{NodeSpec, SceneFile, TransformStep};
 
 pub(super) struct Flattener<'a> {
@@ -50,7 +52,9 @@ impl Flattener<'_> {
                 .resolve(self.scene, self.base_dir, m, self.errors)
         });
         let object = self.objects.len() as u32;
-        if !matches!(node, NodeSpec::Group { .. }) {
+        // A mesh with per-group materials makes its objects once its file is read.
+        let per_group = node.group_materials().is_some_and(|m| !m.is_empty());
+        if !matches!(node, NodeSpec::Group { .. }) && !per_group {
             let name = node.name().map_or_else(|| path.to_string(), str::to_string);
             self.objects.push(ObjectInfo {
                 name,
@@ -85,7 +89,13 @@ impl Flattener<'_> {
                     * DAffine3::from_scale(DVec3::new(f64::from(size[0]), f64::from(size[1]), 1.0));
                 self.quad(&m, QUAD_FACE, object);
             }
-            NodeSpec::Mesh { file, smooth, .. } => {
+            NodeSpec::Mesh {
+                file,
+                smooth,
+                materials,
+                material: mesh_material,
+                ..
+            } => {
                 let full = self.base_dir.join(file);
                 match self.meshes.load(&full) {
                     Ok((mesh, first_load)) => {
@@ -97,7 +107,22 @@ impl Flattener<'_> {
                                 )
                             }));
                         }
-                        self.mesh(&xf, &mesh, *smooth, object);
+                        if per_group {
+                            let node_name =
+                                node.name().map_or_else(|| path.to_string(), str::to_string);
+                            let group_objects = GroupObjects {
+                                path,
+                                node_name: &node_name,
+                                file: &full,
+                                materials,
+                                default: mesh_material,
+                            };
+                            if let Some(objects) = self.group_objects(&group_objects, &mesh) {
+                                self.mesh(&xf, &mesh, *smooth, |t| objects[t]);
+                            }
+                        } else {
+                            self.mesh(&xf, &mesh, *smooth, |_| object);
+                        }
                     }
                     Err(msg) => self
                         .errors
@@ -196,7 +221,105 @@ impl Flattener<'_> {
         }
     }
 
-    fn mesh(&mut self, m: &DAffine3, mesh: &super::mesh::ObjMesh, smooth: bool, object: u32) {
+    /// The object of each triangle of a mesh whose `materials` map its OBJ names, making one
+    /// object per map key used (named `node: key`) plus one for the faces left to the node's
+    /// `material`. `None` after pushing errors: a key the file does not use (with did-you-mean
+    /// and the file's names), or faces that nothing gives a material.
+    fn group_objects(&mut self, g: &GroupObjects, mesh: &ObjMesh) -> Option<Vec<u32>> {
+        let file = g.file.display();
+        let names = mesh.names.iter().map(String::as_str);
+        let mut ok = true;
+        // Per name of the file: the object its faces get if the map has it.
+        let mut by_name: Vec<Option<u32>> = vec![None; mesh.names.len()];
+        for (key, material) in g.materials {
+            let Some(i) = mesh.name_index(key) else {
+                let list = quoted_list(names.clone());
+                let mut d = Diagnostic::error(
+                    format!("{}.materials.{key}", g.path),
+                    if list.is_empty() {
+                        format!(
+                            "`{file}` has no group (`g`, `o`) or `usemtl` names, so `{key}` maps nothing"
+                        )
+                    } else {
+                        format!("`{file}` has no group or `usemtl` name `{key}`; its names: {list}")
+                    },
+                );
+                if let Some(s) = did_you_mean(key, names.clone()) {
+                    d = d.with_help(format!("did you mean `{s}`?"));
+                }
+                self.errors.push(d);
+                ok = false;
+                continue;
+            };
+            let resolved = self
+                .materials
+                .resolve(self.scene, self.base_dir, material, self.errors);
+            by_name[i as usize] = Some(self.objects.len() as u32);
+            self.objects.push(ObjectInfo {
+                name: format!("{}: {key}", g.node_name),
+                material: resolved,
+                light: None,
+            });
+        }
+        let default = g.default.as_deref().map(|m| {
+            let resolved = self
+                .materials
+                .resolve(self.scene, self.base_dir, m, self.errors);
+            (resolved, m)
+        });
+        let mut default_object = None;
+        let mut unmapped: Vec<String> = Vec::new();
+        let mut objects = Vec::with_capacity(mesh.triangles.len());
+        for names in &mesh.triangle_names {
+            let pick = |n: Option<u32>| n.and_then(|i| by_name[i as usize]);
+            if let Some(o) = pick(names.usemtl).or_else(|| pick(names.group)) {
+                objects.push(o);
+                continue;
+            }
+            if let Some((resolved, _)) = default {
+                let o = *default_object.get_or_insert_with(|| {
+                    self.objects.push(ObjectInfo {
+                        name: g.node_name.to_string(),
+                        material: resolved,
+                        light: None,
+                    });
+                    self.objects.len() as u32 - 1
+                });
+                objects.push(o);
+                continue;
+            }
+            let name = |i: u32| mesh.names[i as usize].as_str();
+            let what = match (names.usemtl, names.group) {
+                (Some(m), Some(g)) if m != g => format!("`{}` (in group `{}`)", name(m), name(g)),
+                (Some(n), _) | (None, Some(n)) => format!("`{}`", name(n)),
+                (None, None) => "the faces outside any group".to_string(),
+            };
+            if !unmapped.contains(&what) {
+                unmapped.push(what);
+            }
+            objects.push(0);
+        }
+        if !unmapped.is_empty() {
+            let list = unmapped.join(", ");
+            self.errors.push(
+                Diagnostic::error(
+                    format!("{}.materials", g.path),
+                    format!("faces of `{file}` have no material: {list} (not in `materials`, and the mesh has no `material` for the rest)"),
+                )
+                .with_help("map each of them in `materials`, or give the mesh a `material` for every face the map leaves out"),
+            );
+            ok = false;
+        }
+        ok.then_some(objects)
+    }
+
+    fn mesh(
+        &mut self,
+        m: &DAffine3,
+        mesh: &ObjMesh,
+        smooth: bool,
+        object_of: impl Fn(usize) -> u32,
+    ) {
         let flip = m.matrix3.determinant() < 0.0;
         let nm = normal_matrix(m.matrix3);
         let pos: Vec<Vec3> = mesh
@@ -209,7 +332,8 @@ impl Flattener<'_> {
             .iter()
             .map(|n| (nm * n.as_dvec3()).as_vec3().normalize_or_zero())
             .collect();
-        for tri in &mesh.triangles {
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let object = object_of(t);
             let order = if flip { [0, 2, 1] } else { [0, 1, 2] };
             let c = order.map(|k| tri[k]);
             let normals = if smooth && c.iter().all(|c| c.n.is_some()) {
@@ -242,6 +366,20 @@ impl Flattener<'_> {
         self.builder.triangles.push(p);
         self.builder.tri_attrs.push(attrs);
     }
+}
+
+/// What [`Flattener::group_objects`] needs from a `Mesh` node with `materials`.
+struct GroupObjects<'a> {
+    /// The node's field path.
+    path: &'a str,
+    /// The node's name (or path), for the objects' names.
+    node_name: &'a str,
+    /// The OBJ file as resolved.
+    file: &'a Path,
+    /// OBJ name → material name.
+    materials: &'a BTreeMap<String, String>,
+    /// The node's `material`, for faces the map leaves out.
+    default: &'a Option<String>,
 }
 
 /// Texture coordinates for a triangle of a mesh without `vt`: box (tri-planar) projection in

@@ -579,7 +579,8 @@ pub enum NodeSpec {
         #[serde(deserialize_with = "exact_floats::<_, 2>")]
         size: [f32; 2],
     },
-    /// A triangle mesh from a Wavefront OBJ file (path relative to the scene file).
+    /// A triangle mesh from a Wavefront OBJ file (path relative to the scene file), with one
+    /// material or one per OBJ group.
     Mesh {
         /// Optional name.
         #[serde(default)]
@@ -587,8 +588,20 @@ pub enum NodeSpec {
         /// Transform steps.
         #[serde(default)]
         transform: Vec<TransformStep>,
-        /// Material name.
-        material: String,
+        /// Material name: of every face, or with `materials` of the faces it does not map.
+        /// Required unless `materials` maps every face of the file.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        material: Option<String>,
+        /// Materials by the file's names: each key is a group (`g` or `o`) or a `usemtl` name
+        /// of the OBJ file, each value a material name. A face takes the material of its
+        /// `usemtl` name if that is a key, else of its group, else `material`. A key the file
+        /// does not use is an error (a typo would otherwise go unnoticed).
+        #[serde(
+            default,
+            skip_serializing_if = "BTreeMap::is_empty",
+            deserialize_with = "unique_keys"
+        )]
+        materials: BTreeMap<String, String>,
         /// OBJ file, relative to the scene file.
         file: String,
         /// Interpolate the file's vertex normals when it has them.
@@ -747,15 +760,25 @@ impl NodeSpec {
         }
     }
 
-    /// The material a leaf node references (None for groups).
+    /// The material a leaf node references (None for groups, and for a mesh that gives only
+    /// `materials`).
     #[must_use]
     pub fn material(&self) -> Option<&str> {
         match self {
             NodeSpec::Group { .. } => None,
             NodeSpec::Sphere { material, .. }
             | NodeSpec::Cube { material, .. }
-            | NodeSpec::Quad { material, .. }
-            | NodeSpec::Mesh { material, .. } => Some(material),
+            | NodeSpec::Quad { material, .. } => Some(material),
+            NodeSpec::Mesh { material, .. } => material.as_deref(),
+        }
+    }
+
+    /// The materials a mesh maps its OBJ groups and `usemtl` names to (None for other nodes).
+    #[must_use]
+    pub fn group_materials(&self) -> Option<&BTreeMap<String, String>> {
+        match self {
+            NodeSpec::Mesh { materials, .. } => Some(materials),
+            _ => None,
         }
     }
 }

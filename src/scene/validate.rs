@@ -658,7 +658,28 @@ impl<'a> Validator<'a> {
                     self.positive(&format!("{path}.size[{i}]"), *s, "size");
                 }
             }
-            NodeSpec::Mesh { file, .. } => {
+            NodeSpec::Mesh {
+                file,
+                material,
+                materials,
+                ..
+            } => {
+                for (group, m) in materials {
+                    let at = format!("{path}.materials.{group}");
+                    if group.trim().is_empty() {
+                        self.err(
+                            &at,
+                            "must name an OBJ group or `usemtl` name, found an empty string".into(),
+                        );
+                    }
+                    self.material_ref(&at, m);
+                }
+                if material.is_none() && materials.is_empty() {
+                    self.out.push(
+                        Diagnostic::error(path, "a mesh needs a `material` (or `materials` for its OBJ groups), found neither")
+                            .with_help("add `material: \"name\"`, or `materials: {\"group\": \"name\", ...}` mapping each OBJ group or `usemtl` name"),
+                    );
+                }
                 if file.trim().is_empty() {
                     self.err(
                         &format!("{path}.file"),

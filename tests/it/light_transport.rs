@@ -221,8 +221,8 @@ fn mirror_and_glass_pane_against_a_constant_background() {
 /// then hits the sphere, and weighed by radiance L·(1 − F)·η² (radiance grows by η² entering
 /// the denser medium) times cos θ. The compression of the light's solid angle by refraction is
 /// in which directions hit.
-fn underwater_irradiance(x: [f64; 3], c: [f64; 3], r: f64, l: f64, eta: f64) -> f64 {
-    let (nt, np) = (1500, 720);
+pub(crate) fn underwater_irradiance(x: [f64; 3], c: [f64; 3], r: f64, l: f64, eta: f64) -> f64 {
+    let (nt, np) = (600, 360);
     // Only directions inside the cone towards the sphere's refracted image matter; integrate
     // the hemisphere up to the critical angle (beyond it nothing leaves the water).
     let crit = (1.0 / eta).asin();

@@ -211,15 +211,25 @@ fn a_hit_with_other_gather_settings_equals_a_fresh_build_with_them() {
     let dir = temp_dir("gather");
     let scene = scene_from_text(&ball_scene());
     let _ = render_cached(&scene, Some(&dir));
-    let text = ball_scene().replace(
-        "gather: 30, caustic_gather: 30",
-        "gather: 12, caustic_gather: 45, max_radius: 0.3",
-    );
+    // Other k, a fixed radius, and final gathering (whose precomputed irradiance is rebuilt
+    // from the loaded maps).
+    let text = ball_scene()
+        .replace(
+            "gather: 30, caustic_gather: 30",
+            "gather: 12, caustic_gather: 45, max_radius: 0.3",
+        )
+        .replace("final_gather: 0", "final_gather: 3");
     let other = scene_from_text(&text);
     let (fresh, _) = render_cached(&other, None);
     let (hit, line) = render_cached(&other, Some(&dir));
     assert!(line.is_some_and(|l| l.starts_with("photon cache: hit")));
     assert_eq!(bits(&hit), bits(&fresh));
+    let loaded = build_or_load(&other, Some(&dir));
+    assert!(loaded.summary.irradiance_points > 0);
+    assert_eq!(
+        loaded.summary.irradiance_points,
+        build_maps(&other).summary.irradiance_points
+    );
 }
 
 #[test]

@@ -32,7 +32,9 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 
 use super::estimate::{Kernel, PhotonMap};
-use super::maps::{PhotonMaps, PhotonSummary, auto_radius, build_maps, diffuse_area};
+use super::maps::{
+    PhotonMaps, PhotonSummary, auto_radius, build_maps, diffuse_area, precompute_irradiance,
+};
 use super::trace::TraceCounts;
 use crate::photon::{BuildOptions, KdTree, Photon};
 use crate::render_scene::geometry::{EllipsoidPrim, SpherePrim, TriAttrs};
@@ -605,9 +607,11 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
     summary.memory = memory;
     summary.trace_time = Duration::ZERO;
     summary.build_time = t0.elapsed();
+    let irradiance = precompute_irradiance(scene, &caustic, &global, &mut summary);
     Ok(PhotonMaps {
         caustic,
         global,
+        irradiance,
         summary,
     })
 }

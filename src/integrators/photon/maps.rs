@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::aim::CausticTargets;
 use super::emit::{LightEmitter, split_by_power};
-use super::estimate::{Kernel, PhotonMap};
+use super::estimate::{IrradianceCache, Kernel, PhotonMap};
 use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
 use crate::photon::{KdTree, Photon};
 use crate::render_scene::RenderScene;
@@ -42,6 +42,10 @@ pub struct PhotonSummary {
     pub trace_time: Duration,
     /// Time spent building kd-trees.
     pub build_time: Duration,
+    /// Time spent precomputing irradiance for final gathering.
+    pub irradiance_time: Duration,
+    /// Irradiance points precomputed.
+    pub irradiance_points: usize,
     /// Bytes of both maps.
     pub memory: usize,
     /// What the photon-map cache did (`--photon-cache`), as the summary's last line.
@@ -121,6 +125,14 @@ impl std::fmt::Display for PhotonSummary {
             &self.global_skipped,
             self.global_radius,
         )?;
+        if self.irradiance_points > 0 {
+            writeln!(
+                f,
+                "photons: irradiance precomputed at {} points in {:.3} s (final gathering)",
+                self.irradiance_points,
+                self.irradiance_time.as_secs_f64()
+            )?;
+        }
         write!(
             f,
             "photons: traced in {:.3} s, kd-trees built in {:.3} s, {:.1} MB ({} targets for caustic photons)",
@@ -259,6 +271,9 @@ pub struct PhotonMaps {
     pub caustic: Option<PhotonMap>,
     /// Photons after at least `min_bounces` diffuse bounces.
     pub global: Option<PhotonMap>,
+    /// Both maps' irradiance at a subset of photons, for final gathering (built only when
+    /// `final_gather > 0`).
+    pub irradiance: Option<IrradianceCache>,
     /// Counts, radii and timings.
     pub summary: PhotonSummary,
 }
@@ -365,11 +380,38 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
     summary.trace_time = t0.elapsed().saturating_sub(build_time);
     summary.build_time = build_time;
     summary.memory = memory;
+    let irradiance = precompute_irradiance(scene, &caustic, &global, &mut summary);
     PhotonMaps {
         caustic,
         global,
+        irradiance,
         summary,
     }
+}
+
+/// The irradiance final gathering reads, precomputed from the built (or cached) maps: `None`
+/// when `final_gather` is 0 or no map was built. Adds its time, points and memory to `summary`.
+/// Used by [`build_maps`] and by the photon-map cache after loading the maps.
+pub(super) fn precompute_irradiance(
+    scene: &RenderScene,
+    caustic: &Option<PhotonMap>,
+    global: &Option<PhotonMap>,
+    summary: &mut PhotonSummary,
+) -> Option<IrradianceCache> {
+    let t1 = Instant::now();
+    let irradiance = if scene.params.photons.final_gather > 0 {
+        let maps: Vec<&PhotonMap> = [caustic, global].into_iter().flatten().collect();
+        global
+            .as_ref()
+            .or(caustic.as_ref())
+            .and_then(|sites| IrradianceCache::build(sites, &maps))
+    } else {
+        None
+    };
+    summary.irradiance_time = t1.elapsed();
+    summary.irradiance_points = irradiance.as_ref().map_or(0, IrradianceCache::len);
+    summary.memory += irradiance.as_ref().map_or(0, IrradianceCache::memory_bytes);
+    irradiance
 }
 
 /// Builds the kd-tree of one map's photons, or says why there is none.

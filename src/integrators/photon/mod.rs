@@ -22,7 +22,7 @@ pub mod estimate;
 pub mod maps;
 pub mod trace;
 
-pub use estimate::{Estimate, Kernel, PhotonMap};
+pub use estimate::{Estimate, IrradianceCache, Kernel, PhotonMap};
 pub use maps::{PhotonMaps, PhotonSummary, build_maps};
 
 use glam::Vec3;
@@ -416,14 +416,22 @@ impl<'a> PhotonMapper<'a> {
                 let gfr = frame(&gsh);
                 if gsh.bsdf.has_local() {
                     let mut lo = self.direct(&gp, &gfr, &gsh, gwo, sampler, counters);
-                    for map in [&self.maps.caustic, &self.maps.global]
-                        .into_iter()
-                        .flatten()
-                    {
-                        counters.photon_estimates += 1;
-                        let e = map.estimate(gp.p, gwo, &gfr, &gsh.bsdf);
-                        counters.photon_radius_cut += u64::from(e.cut);
-                        lo += e.radiance;
+                    let cached = self.maps.irradiance.as_ref().and_then(|c| {
+                        let e = c.lookup(gp.p, gfr.ng)?;
+                        Some(gsh.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e)
+                    });
+                    if let Some(l) = cached {
+                        lo += l;
+                    } else {
+                        for map in [&self.maps.caustic, &self.maps.global]
+                            .into_iter()
+                            .flatten()
+                        {
+                            counters.photon_estimates += 1;
+                            let e = map.estimate(gp.p, gwo, &gfr, &gsh.bsdf);
+                            counters.photon_radius_cut += u64::from(e.cut);
+                            lo += e.radiance;
+                        }
                     }
                     sum += beta * lo;
                 }
