@@ -1,10 +1,12 @@
 //! `caustic debug-pixel`: one pixel sample's ray tree, as text or JSON.
 
+use std::path::PathBuf;
+
 use clap::Args;
 
 use caustic::Error;
 use caustic::pipeline::prepare;
-use caustic::render::trace_pixel;
+use caustic::render::tiles::trace_pixel_with;
 
 use super::SceneArgs;
 
@@ -23,12 +25,22 @@ pub struct DebugPixelArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
+    /// Read the photon maps from this folder (saving them there first if missing), as
+    /// `caustic render --photon-cache`.
+    #[arg(long, value_name = "DIR")]
+    photon_cache: Option<PathBuf>,
 }
 
 /// Traces the sample exactly as the renderer does and prints its tree.
 pub fn run(args: &DebugPixelArgs) -> Result<(), Error> {
     let prepared = prepare(&args.scene.scene, &args.scene.overrides())?;
-    let (log, l) = trace_pixel(&prepared.render_scene, args.x, args.y, args.sample)?;
+    let (log, l) = trace_pixel_with(
+        &prepared.render_scene,
+        args.x,
+        args.y,
+        args.sample,
+        args.photon_cache.as_deref(),
+    )?;
     if args.json {
         let mut v = log.to_json();
         v["pixel"] = serde_json::json!([args.x, args.y]);

@@ -9,6 +9,7 @@ mod golden;
 mod pixel_font;
 mod plot;
 mod plot_backend;
+mod photons;
 mod render;
 
 use std::path::PathBuf;
@@ -49,6 +50,9 @@ enum Command {
     /// samples per pixel until its share of `--time` is spent; writes DIR/convergence.csv,
     /// .json (with the machine and settings), .png and .svg (log-log RMSE against time).
     Converge(converge::ConvergeArgs),
+    /// Draw the photon maps over a dim render of the scene (caustic photons orange, global
+    /// blue, brighter where more power landed).
+    Photons(photons::PhotonsArgs),
 }
 
 /// Runs one command.
@@ -63,6 +67,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::DebugPixel(args) => debug_pixel::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Converge(args) => converge::run(&args),
+        Command::Photons(args) => photons::run(&args),
     }
 }
 

@@ -71,6 +71,10 @@ pub struct RenderArgs {
         value_parser = parse_seconds
     )]
     checkpoint_every: Duration,
+    /// Keep the photon maps in this folder and reuse them while only the camera, the image
+    /// size or the samples change (photon integrator; a corrupt file is rebuilt).
+    #[arg(long, value_name = "DIR")]
+    photon_cache: Option<PathBuf>,
 }
 
 fn parse_max_rmse(text: &str) -> Result<f64, String> {
@@ -251,6 +255,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         region,
         progress: terminal && args.time.is_none(),
         cancel: Some(interrupt.start_rendering()),
+        photon_cache: args.photon_cache.clone(),
         ..RenderOptions::default()
     };
     let job = RenderJob::new(&prepared.render_scene, &options)?;

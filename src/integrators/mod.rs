@@ -56,10 +56,19 @@ impl<'a> Integrator<'a> {
     /// Prepares the integrator the scene asks for (`render.integrator`).
     #[must_use]
     pub fn prepare(scene: &'a RenderScene) -> Self {
+        Self::prepare_with(scene, None)
+    }
+
+    /// [`Integrator::prepare`], with photon maps read from and saved to the cache folder
+    /// `photon_cache` (`--photon-cache`; see [`photon::cache`]).
+    #[must_use]
+    pub fn prepare_with(scene: &'a RenderScene, photon_cache: Option<&std::path::Path>) -> Self {
         match scene.params.integrator {
             IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(scene)),
             IntegratorKind::Path => Integrator::Path(PathTracer::new(scene)),
-            IntegratorKind::Photon => Integrator::Photon(Box::new(PhotonMapper::new(scene))),
+            IntegratorKind::Photon => {
+                Integrator::Photon(Box::new(PhotonMapper::new(scene, photon_cache)))
+            }
         }
     }
 

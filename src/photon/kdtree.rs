@@ -113,6 +113,9 @@ pub enum KdTreeError {
         /// The limit.
         max: usize,
     },
+    /// [`KdTree::from_tree_order`] was given items that are not in tree order.
+    #[error("the items are not in kd-tree order (a node's halves overlap on its split axis)")]
+    NotTreeOrder,
     /// `leaf_size` is out of range.
     #[error("leaf size {0} is invalid: it must be between 1 and 256")]
     InvalidLeafSize(usize),
@@ -217,6 +220,105 @@ impl<T: HasPosition + Send> KdTree<T> {
             root_half,
             bounds,
         })
+    }
+}
+
+impl<T: HasPosition + Sync> KdTree<T> {
+    /// Rebuilds a tree from items already in tree order (the [`KdTree::items`] of a tree built
+    /// with the same `options`, e.g. read back from a photon-map cache) without moving them:
+    /// each node's axis and planes are recomputed from its range, so the result equals the
+    /// original tree, stems and slots alike. Cheaper than [`KdTree::build`] (no selection).
+    ///
+    /// # Errors
+    /// As [`KdTree::build_with`], plus [`KdTreeError::NotTreeOrder`] when some node's left half
+    /// reaches past its right half on the node's axis (the items are not in tree order).
+    pub fn from_tree_order(items: Vec<T>, options: BuildOptions) -> Result<Self, KdTreeError> {
+        if !(1..=256).contains(&options.leaf_size) {
+            return Err(KdTreeError::InvalidLeafSize(options.leaf_size));
+        }
+        if items.len() >= MAX_ITEMS {
+            return Err(KdTreeError::TooManyItems {
+                count: items.len(),
+                max: MAX_ITEMS - 1,
+            });
+        }
+        let mut bounds = [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]];
+        for (index, item) in items.iter().enumerate() {
+            let p = item.position();
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(KdTreeError::NonFinitePosition { index, position: p });
+            }
+            for a in 0..3 {
+                bounds[0][a] = bounds[0][a].min(p[a]);
+                bounds[1][a] = bounds[1][a].max(p[a]);
+            }
+        }
+        let n = items.len();
+        let mut leaves = 1usize;
+        while n.div_ceil(leaves) > options.leaf_size {
+            leaves *= 2;
+        }
+        let mut stems = vec![
+            Stem {
+                left_max: 0.0,
+                right_min: 0.0,
+                axis: 0
+            };
+            leaves - 1
+        ];
+        let root_half = leaves / 2;
+        if !restore_node(&items, &mut stems, root_half, 0, options.split_axis) {
+            return Err(KdTreeError::NotTreeOrder);
+        }
+        Ok(Self {
+            items,
+            stems,
+            root_half,
+            bounds,
+        })
+    }
+}
+
+/// [`build_node`] without the selection: recomputes the stems of a range already split at its
+/// medians. False when a node's halves overlap on its axis.
+fn restore_node<T: HasPosition + Sync>(
+    items: &[T],
+    stems: &mut [Stem],
+    half: usize,
+    depth: usize,
+    rule: SplitAxis,
+) -> bool {
+    if half == 0 {
+        return true;
+    }
+    let axis = match rule {
+        SplitAxis::RoundRobin => depth % 3,
+        SplitAxis::Widest => widest_axis(items),
+    };
+    let (left, right) = items.split_at(items.len() / 2);
+    let coord = |i: &T| i.position()[axis];
+    let left_max = left.iter().map(coord).fold(f32::NEG_INFINITY, f32::max);
+    let right_min = right.iter().map(coord).fold(f32::INFINITY, f32::min);
+    // `build_node`'s `right_min` is the median's coordinate: the smallest of the right half.
+    if left_max > right_min {
+        return false;
+    }
+    stems[0] = Stem {
+        left_max,
+        right_min,
+        axis: axis as u32,
+    };
+    let (left_stems, right_stems) = stems[1..].split_at_mut(half - 1);
+    let child = half / 2;
+    if items.len() >= PARALLEL_MIN {
+        let (l, r) = rayon::join(
+            || restore_node(left, left_stems, child, depth + 1, rule),
+            || restore_node(right, right_stems, child, depth + 1, rule),
+        );
+        l && r
+    } else {
+        restore_node(left, left_stems, child, depth + 1, rule)
+            && restore_node(right, right_stems, child, depth + 1, rule)
     }
 }
 
@@ -578,6 +680,35 @@ mod tests {
             }
             check(&t, 0, t.root_half, 0, t.len());
         }
+    }
+
+    #[test]
+    fn from_tree_order_restores_the_built_tree_and_refuses_other_orders() {
+        let mut pts = Vec::new();
+        let mut s = 7u32;
+        for i in 0..3000 {
+            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            let c = (s >> 8) as f32 / (1 << 24) as f32;
+            // Some coincident points, so ties at the medians are exercised.
+            let x = if i % 5 == 0 { 0.5 } else { c };
+            pts.push([x, (c * 7.0).fract(), ((c * 13.0).fract() * 4.0).round()]);
+        }
+        for (leaf_size, split_axis) in [(16, SplitAxis::Widest), (1, SplitAxis::RoundRobin)] {
+            let o = BuildOptions {
+                leaf_size,
+                split_axis,
+            };
+            let t = KdTree::build_with(pts.clone(), o).unwrap();
+            let r = KdTree::from_tree_order(t.items().to_vec(), o).unwrap();
+            assert_eq!(r.items, t.items);
+            assert_eq!(r.stems, t.stems);
+            assert_eq!((r.root_half, r.bounds), (t.root_half, t.bounds));
+        }
+        // The build input's own order is (almost surely) not a tree order.
+        assert_eq!(
+            KdTree::from_tree_order(pts, BuildOptions::default()).unwrap_err(),
+            KdTreeError::NotTreeOrder
+        );
     }
 
     #[test]

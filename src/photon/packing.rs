@@ -76,6 +76,28 @@ impl Photon {
     }
 }
 
+impl Photon {
+    /// The packed record as six words (position bits x, y, z, power, direction, normal), for
+    /// storing photon maps on disk losslessly.
+    #[must_use]
+    pub fn to_words(&self) -> [u32; 6] {
+        let [x, y, z] = self.position;
+        [x, y, z, self.power, self.direction, self.normal]
+    }
+
+    /// The photon whose [`Photon::to_words`] is `w` (any words make a photon; positions are
+    /// checked by the kd-tree).
+    #[must_use]
+    pub fn from_words(w: [u32; 6]) -> Self {
+        Self {
+            position: [w[0], w[1], w[2]],
+            power: w[3],
+            direction: w[4],
+            normal: w[5],
+        }
+    }
+}
+
 impl HasPosition for Photon {
     #[inline]
     fn position(&self) -> [f32; 3] {
@@ -301,5 +323,13 @@ mod tests {
         assert!(angle(p.direction(), -Vec3::Y) < 1e-6);
         assert!(angle(p.normal(), Vec3::Y) < 1e-6);
         assert_eq!(p.power(), Vec3::new(0.5, 0.25, 0.125));
+        let w = p.to_words();
+        assert_eq!(
+            w[..3],
+            [1.5f32.to_bits(), (-2.25f32).to_bits(), 1e-30f32.to_bits()]
+        );
+        assert_eq!(w[3], encode_rgbe([0.5, 0.25, 0.125]));
+        assert_eq!(w[4], encode_octahedral(-Vec3::Y));
+        assert_eq!(Photon::from_words(w), p);
     }
 }

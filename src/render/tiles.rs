@@ -48,6 +48,9 @@ pub struct RenderOptions {
     /// of disjoint ranges merge ([`crate::render::PixelSums::merge`]) into exactly the render
     /// of their union.
     pub samples: Option<Range<u32>>,
+    /// Folder of the photon-map cache (`--photon-cache`): the photon integrator reads its maps
+    /// from there when they were saved for this scene, and saves them there otherwise.
+    pub photon_cache: Option<std::path::PathBuf>,
 }
 
 /// What a render did.
@@ -177,7 +180,8 @@ impl<'a> RenderJob<'a> {
             .map_err(|e| RenderError::Threads(threads, e.to_string()))?;
         let tiles = tile_grid(region);
         // Shared state (photon maps) is built on the job's own workers.
-        let integrator = pool.install(|| Integrator::prepare(scene));
+        let integrator =
+            pool.install(|| Integrator::prepare_with(scene, options.photon_cache.as_deref()));
         let range = options
             .samples
             .clone()
@@ -438,6 +442,17 @@ pub fn trace_pixel(
     y: u32,
     sample: u32,
 ) -> Result<(TraceLog, Vec3), RenderError> {
+    trace_pixel_with(scene, x, y, sample, None)
+}
+
+/// [`trace_pixel`] with photon maps from the cache folder `photon_cache` (`--photon-cache`).
+pub fn trace_pixel_with(
+    scene: &RenderScene,
+    x: u32,
+    y: u32,
+    sample: u32,
+    photon_cache: Option<&std::path::Path>,
+) -> Result<(TraceLog, Vec3), RenderError> {
     let p = &scene.params;
     if x >= p.width || y >= p.height {
         return Err(RenderError::PixelOutside(x, y, p.width, p.height));
@@ -445,7 +460,7 @@ pub fn trace_pixel(
     let mut sampler = Sampler::new(p.sampler, p.seed, p.samples_per_pixel);
     let ray = camera_sample(scene, &mut sampler, x, y, sample);
     let mut log = TraceLog::default();
-    let integrator = Integrator::prepare(scene);
+    let integrator = Integrator::prepare_with(scene, photon_cache);
     let l = integrator.li(ray, &mut sampler, &mut Counters::default(), Some(&mut log));
     Ok((log, l))
 }

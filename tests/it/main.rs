@@ -20,6 +20,7 @@ mod mutated_scenes;
 mod passes;
 mod path_tracer;
 mod photon_map;
+mod photon_tools;
 mod primitives;
 mod queries;
 mod render_snapshots;

@@ -48,6 +48,8 @@ pub struct PhotonSummary {
     pub irradiance_points: usize,
     /// Bytes of both maps.
     pub memory: usize,
+    /// What the photon-map cache did (`--photon-cache`), as the summary's last line.
+    pub cache: Option<String>,
 }
 
 impl PhotonSummary {
@@ -138,7 +140,11 @@ impl std::fmt::Display for PhotonSummary {
             self.build_time.as_secs_f64(),
             self.memory as f64 / 1e6,
             self.targets
-        )
+        )?;
+        match &self.cache {
+            Some(line) => write!(f, "\n{line}"),
+            None => Ok(()),
+        }
     }
 }
 
@@ -215,7 +221,7 @@ fn trace_map(
 
 /// The diffuse surface area (m²) photons can land on: triangles and spheres of objects whose
 /// material has a diffuse part (ellipsoids by their bounding sphere's area, an upper bound).
-fn diffuse_area(scene: &RenderScene) -> f64 {
+pub(super) fn diffuse_area(scene: &RenderScene) -> f64 {
     let diffuse = |o: u32| {
         scene.objects[o as usize]
             .material
@@ -372,9 +378,29 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
         )
     };
     summary.trace_time = t0.elapsed().saturating_sub(build_time);
+    summary.build_time = build_time;
+    summary.memory = memory;
+    let irradiance = precompute_irradiance(scene, &caustic, &global, &mut summary);
+    PhotonMaps {
+        caustic,
+        global,
+        irradiance,
+        summary,
+    }
+}
+
+/// The irradiance final gathering reads, precomputed from the built (or cached) maps: `None`
+/// when `final_gather` is 0 or no map was built. Adds its time, points and memory to `summary`.
+/// Used by [`build_maps`] and by the photon-map cache after loading the maps.
+pub(super) fn precompute_irradiance(
+    scene: &RenderScene,
+    caustic: &Option<PhotonMap>,
+    global: &Option<PhotonMap>,
+    summary: &mut PhotonSummary,
+) -> Option<IrradianceCache> {
     let t1 = Instant::now();
-    let irradiance = if p.final_gather > 0 {
-        let maps: Vec<&PhotonMap> = [&caustic, &global].into_iter().flatten().collect();
+    let irradiance = if scene.params.photons.final_gather > 0 {
+        let maps: Vec<&PhotonMap> = [caustic, global].into_iter().flatten().collect();
         global
             .as_ref()
             .or(caustic.as_ref())
@@ -384,15 +410,8 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
     };
     summary.irradiance_time = t1.elapsed();
     summary.irradiance_points = irradiance.as_ref().map_or(0, IrradianceCache::len);
-    memory += irradiance.as_ref().map_or(0, IrradianceCache::memory_bytes);
-    summary.build_time = build_time;
-    summary.memory = memory;
-    PhotonMaps {
-        caustic,
-        global,
-        irradiance,
-        summary,
-    }
+    summary.memory += irradiance.as_ref().map_or(0, IrradianceCache::memory_bytes);
+    irradiance
 }
 
 /// Builds the kd-tree of one map's photons, or says why there is none.

@@ -16,6 +16,7 @@
 //!   their direct light, caustics and global-map radiance.
 
 pub mod aim;
+pub mod cache;
 pub mod emit;
 pub mod estimate;
 pub mod maps;
@@ -96,14 +97,15 @@ pub struct PhotonMapper<'a> {
 }
 
 impl<'a> PhotonMapper<'a> {
-    /// Traces the photons and builds the maps (`scene.params.photons`).
+    /// Traces the photons and builds the maps (`scene.params.photons`), or reads them from the
+    /// photon-map cache folder `cache` ([`cache::build_or_load`]).
     #[must_use]
-    pub fn new(scene: &'a RenderScene) -> Self {
+    pub fn new(scene: &'a RenderScene, cache: Option<&std::path::Path>) -> Self {
         Self {
             scene,
             lights: LightSampler::new(&scene.lights),
             pixel_spread: scene.pixel_spread(),
-            maps: build_maps(scene),
+            maps: cache::build_or_load(scene, cache),
         }
     }
 
