@@ -6,10 +6,10 @@ mod converge;
 mod debug_pixel;
 mod error_image;
 mod golden;
+mod photons;
 mod pixel_font;
 mod plot;
 mod plot_backend;
-mod photons;
 mod render;
 
 use std::path::PathBuf;

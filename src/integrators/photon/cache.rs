@@ -35,7 +35,7 @@ use super::estimate::{Kernel, PhotonMap};
 use super::maps::{
     PhotonMaps, PhotonSummary, auto_radius, build_maps, diffuse_area, precompute_irradiance,
 };
-use super::trace::TraceCounts;
+use super::trace::{MapKind, TraceCounts};
 use crate::photon::{BuildOptions, KdTree, Photon};
 use crate::render_scene::geometry::{EllipsoidPrim, SpherePrim, TriAttrs};
 use crate::render_scene::{Geometry, ObjectInfo, PhotonParams, RenderParams, RenderScene, Texture};
@@ -577,6 +577,7 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
     let area = diffuse_area(scene);
     let mut memory = 0;
     let mut wrap = |photons: Option<Vec<Photon>>,
+                    kind: MapKind,
                     k: u32,
                     kernel: Kernel,
                     radius: &mut f32|
@@ -586,7 +587,7 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
         };
         let r = p
             .max_radius
-            .unwrap_or_else(|| auto_radius(area, photons.len() as u64, k));
+            .unwrap_or_else(|| auto_radius(area, photons.len() as u64, k, kind));
         let tree =
             KdTree::from_tree_order(photons, BuildOptions::default()).map_err(|e| e.to_string())?;
         memory += tree.memory_bytes();
@@ -599,11 +600,18 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
     };
     let caustic = wrap(
         caustic,
+        MapKind::Caustic,
         p.caustic_gather,
         caustic_kernel,
         &mut summary.caustic_radius,
     )?;
-    let global = wrap(global, p.gather, Kernel::Box, &mut summary.global_radius)?;
+    let global = wrap(
+        global,
+        MapKind::Global,
+        p.gather,
+        Kernel::Box,
+        &mut summary.global_radius,
+    )?;
     summary.memory = memory;
     summary.trace_time = Duration::ZERO;
     summary.build_time = t0.elapsed();

@@ -253,15 +253,22 @@ pub(super) fn diffuse_area(scene: &RenderScene) -> f64 {
     area
 }
 
-/// The largest radius of a map of `stored` photons gathered `k` at a time: twice the radius of
-/// the disc that holds `k` photons on average when they spread over `area` (so typical regions
-/// are never cut; sparse ones are, rather than blurring a few photons over a wide disc).
+/// The largest radius of a `kind` map of `stored` photons gathered `k` at a time, from the
+/// radius of the disc that holds `k` photons on average when they spread over `area`: twice
+/// that for the global map (typical regions are never cut; sparse ones are, rather than
+/// blurring a few photons over a wide disc), once for the caustic map, whose photons crowd
+/// into the few places light is focused (elsewhere a wide search only finds stray photons and
+/// costs time).
 #[must_use]
-pub fn auto_radius(area: f64, stored: u64, k: u32) -> f32 {
+pub fn auto_radius(area: f64, stored: u64, k: u32, kind: MapKind) -> f32 {
     if stored == 0 || !(area > 0.0) {
         return 0.0;
     }
-    (2.0 * (f64::from(k) * area / (std::f64::consts::PI * stored as f64)).sqrt()) as f32
+    let factor = match kind {
+        MapKind::Global => 2.0,
+        MapKind::Caustic => 1.0,
+    };
+    (factor * (f64::from(k) * area / (std::f64::consts::PI * stored as f64)).sqrt()) as f32
 }
 
 /// Both maps of a render (each `None` when not built) and how they were built.
@@ -340,6 +347,7 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
         summary.caustic = counts;
         finish_map(
             photons,
+            MapKind::Caustic,
             p.caustic_gather,
             p.max_radius,
             area,
@@ -367,6 +375,7 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
         summary.global = counts;
         finish_map(
             photons,
+            MapKind::Global,
             p.gather,
             p.max_radius,
             area,
@@ -418,6 +427,7 @@ pub(super) fn precompute_irradiance(
 #[allow(clippy::too_many_arguments)]
 fn finish_map(
     photons: Vec<Photon>,
+    kind: MapKind,
     k: u32,
     max_radius: Option<f32>,
     area: f64,
@@ -431,7 +441,7 @@ fn finish_map(
         *skipped = Some("no photon was stored".into());
         return None;
     }
-    let r = max_radius.unwrap_or_else(|| auto_radius(area, photons.len() as u64, k));
+    let r = max_radius.unwrap_or_else(|| auto_radius(area, photons.len() as u64, k, kind));
     let t = Instant::now();
     let tree = match KdTree::build(photons) {
         Ok(t) => t,
