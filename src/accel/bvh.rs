@@ -3,7 +3,7 @@
 //! (the wide BVH of Wald, Benthin & Boulos 2008, "Getting Rid of Packets", collapsed from a binary
 //! SAH tree as in Embree).
 
-use glam::Vec4;
+use wide::f32x8;
 
 use crate::geometry::Aabb;
 
@@ -24,17 +24,17 @@ pub struct BvhNode {
 /// Children per traversal node.
 pub const WIDTH: usize = 8;
 
-/// A traversal node: the boxes of up to [`WIDTH`] (8) children, one child per SIMD lane in two
-/// four-lane halves, and what each child is. `bounds[axis][0][h]` holds the lower slab planes on
-/// `axis` of children `4h .. 4h + 4`, `bounds[axis][1][h]` the upper ones. A child with
+/// A traversal node: the boxes of up to [`WIDTH`] (8) children, one child per SIMD lane (one AVX
+/// register, or two SSE halves without AVX), and what each child is. `bounds[axis][0]` holds the
+/// lower slab planes of the children on `axis`, `bounds[axis][1]` the upper ones. A child with
 /// `count > 0` is a leaf over slots `index .. index + count`; with `count == 0` it is the node at
 /// `index`. An absent child has the empty box `[+∞, -∞]` on every axis, which the slab test
 /// (near plane chosen by the direction's sign) never enters. 256 bytes, four cache lines.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[repr(C, align(64))]
 pub struct Node8 {
-    /// `[axis][min/max][half]` slab planes, one child per lane.
-    pub bounds: [[[Vec4; 2]; 2]; 3],
+    /// `[axis][min/max]` slab planes, one child per lane.
+    pub bounds: [[f32x8; 2]; 3],
     /// Child node index or first slot, per child.
     pub index: [u32; WIDTH],
     /// Leaf size per child (0 = interior or absent).
@@ -104,7 +104,7 @@ const ABSENT_MAX: f32 = f32::NEG_INFINITY;
 impl Node8 {
     /// A node without children.
     pub const EMPTY: Node8 = Node8 {
-        bounds: [[[Vec4::splat(ABSENT_MIN); 2], [Vec4::splat(ABSENT_MAX); 2]]; 3],
+        bounds: [[f32x8::splat(ABSENT_MIN), f32x8::splat(ABSENT_MAX)]; 3],
         index: [0; WIDTH],
         count: [0; WIDTH],
     };
@@ -112,26 +112,24 @@ impl Node8 {
     /// The bounds of child `i` (0..8).
     #[must_use]
     pub fn child_bounds(&self, i: usize) -> Aabb {
-        let [x, y, z] = self.bounds;
-        let (h, l) = (i / 4, i % 4);
+        let plane = |axis: usize, side: usize| self.bounds[axis][side].as_array()[i];
         Aabb {
-            min: glam::Vec3::new(x[0][h][l], y[0][h][l], z[0][h][l]),
-            max: glam::Vec3::new(x[1][h][l], y[1][h][l], z[1][h][l]),
+            min: glam::Vec3::new(plane(0, 0), plane(1, 0), plane(2, 0)),
+            max: glam::Vec3::new(plane(0, 1), plane(1, 1), plane(2, 1)),
         }
     }
 
     /// True if child `i` exists.
     #[must_use]
     pub fn has_child(&self, i: usize) -> bool {
-        self.bounds[0][0][i / 4][i % 4] != ABSENT_MIN
+        self.bounds[0][0].as_array()[i] != ABSENT_MIN
     }
 
     /// Makes child `c` the (padded) box `[min, max]` referring to `index`/`count`.
     pub fn set_child(&mut self, c: usize, min: [f32; 3], max: [f32; 3], index: u32, count: u32) {
-        let (h, l) = (c / 4, c % 4);
         for axis in 0..3 {
-            self.bounds[axis][0][h][l] = min[axis];
-            self.bounds[axis][1][h][l] = max[axis];
+            self.bounds[axis][0].as_mut_array()[c] = min[axis];
+            self.bounds[axis][1].as_mut_array()[c] = max[axis];
         }
         self.index[c] = index;
         self.count[c] = count;

@@ -1,9 +1,10 @@
 //! Stack-based traversal without allocation: the slabs of a node's eight children tested at once
-//! with SIMD (two four-lane halves), children visited nearest first, far children culled on pop once a closer hit is known.
+//! with SIMD (one AVX register, or two SSE halves without AVX), children visited nearest first, far children culled on pop once a closer hit is known.
 
 use std::cell::RefCell;
 
-use glam::{Vec3, Vec4};
+use glam::Vec3;
+use wide::f32x8;
 
 use super::bvh::{Bvh, Node8, WIDTH};
 use crate::geometry::float::gamma;
@@ -21,8 +22,8 @@ const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
 /// Per-ray constants of the slab test.
 #[derive(Debug, Clone, Copy)]
 pub struct RayBoxTest {
-    o: [Vec4; 3],
-    inv: [Vec4; 3],
+    o: [f32x8; 3],
+    inv: [f32x8; 3],
     /// Per axis, which of a node's planes (0 = min, 1 = max) the ray crosses first.
     near: [usize; 3],
 }
@@ -69,25 +70,28 @@ impl RayBoxTest {
         let near = |i: f32| usize::from(i.is_sign_negative());
         Self {
             o: [
-                Vec4::splat(origin.x),
-                Vec4::splat(origin.y),
-                Vec4::splat(origin.z),
+                f32x8::splat(origin.x),
+                f32x8::splat(origin.y),
+                f32x8::splat(origin.z),
             ],
-            inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            inv: [
+                f32x8::splat(inv.x),
+                f32x8::splat(inv.y),
+                f32x8::splat(inv.z),
+            ],
             near: [near(inv.x), near(inv.y), near(inv.z)],
         }
     }
 
     /// Which children of `node` the ray enters at or before `t_max` (bit `c` for child `c`), and
-    /// the entry distances per lane, children 0..4 then 4..8 (`≥ 0`, never NaN; meaningful only
-    /// for entered lanes).
+    /// the entry distances per child (`≥ 0`, never NaN; meaningful only for entered children).
     ///
-    /// A NaN from `0·∞` is dropped by the min/max chains (SSE `min`/`max` return their second
+    /// A NaN from `0·∞` is dropped by the min/max chains (`maxps`/`minps` return their second
     /// operand), which only ever widens the slab interval: such a box is entered early or
     /// spuriously, never skipped.
     #[inline(always)]
     #[must_use]
-    pub fn entries(&self, node: &Node8, t_max: f32) -> (u32, [Vec4; 2]) {
+    pub fn entries(&self, node: &Node8, t_max: f32) -> (u32, [f32; WIDTH]) {
         self.entries_with(node, t_max, self.near)
     }
 
@@ -98,89 +102,23 @@ impl RayBoxTest {
     }
 
     /// [`RayBoxTest::entries`] with the near planes given (`near[axis]` is 0 or 1); when they are
-    /// constants, the plane loads compile to fixed offsets. With AVX enabled at compile time the
-    /// eight lanes are one 256-bit register ([`RayBoxTest::entries_avx`], the same operations
-    /// lane by lane, so the same bits); otherwise two four-lane halves.
+    /// constants, the plane loads compile to fixed offsets.
     #[inline(always)]
-    fn entries_with(&self, node: &Node8, t_max: f32, near: [usize; 3]) -> (u32, [Vec4; 2]) {
-        #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-        {
-            self.entries_avx(node, t_max, near)
-        }
-        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-        {
-            self.entries_halves(node, t_max, near)
-        }
-    }
-
-    /// [`RayBoxTest::entries_with`] on 256-bit registers: each operation of
-    /// [`RayBoxTest::entries_halves`] in the same order on all eight lanes (`vmaxps`/`vminps`
-    /// return their second operand on NaN, as `maxps`/`minps` do).
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    #[inline(always)]
-    fn entries_avx(&self, node: &Node8, t_max: f32, near: [usize; 3]) -> (u32, [Vec4; 2]) {
-        use std::arch::x86_64::{
-            _CMP_LE_OQ, _mm256_castps256_ps128, _mm256_cmp_ps, _mm256_extractf128_ps,
-            _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set_m128,
-            _mm256_set1_ps, _mm256_setzero_ps, _mm256_sub_ps,
-        };
+    fn entries_with(&self, node: &Node8, t_max: f32, near: [usize; 3]) -> (u32, [f32; WIDTH]) {
         let slab = |axis: usize| {
             let n = near[axis] & 1;
             let b = &node.bounds[axis];
-            let o = _mm256_set_m128(self.o[axis].into(), self.o[axis].into());
-            let inv = _mm256_set_m128(self.inv[axis].into(), self.inv[axis].into());
-            let lo = _mm256_set_m128(b[n][1].into(), b[n][0].into());
-            let hi = _mm256_set_m128(b[n ^ 1][1].into(), b[n ^ 1][0].into());
-            (
-                _mm256_mul_ps(_mm256_sub_ps(lo, o), inv),
-                _mm256_mul_ps(_mm256_sub_ps(hi, o), inv),
-            )
+            let near = (b[n] - self.o[axis]) * self.inv[axis];
+            let far = (b[n ^ 1] - self.o[axis]) * self.inv[axis];
+            (near, far)
         };
         let (nx, fx) = slab(0);
         let (ny, fy) = slab(1);
         let (nz, fz) = slab(2);
-        let near = _mm256_max_ps(
-            _mm256_max_ps(_mm256_max_ps(nx, ny), nz),
-            _mm256_setzero_ps(),
-        );
-        let far = _mm256_min_ps(
-            _mm256_mul_ps(
-                _mm256_min_ps(_mm256_min_ps(fx, fy), fz),
-                _mm256_set1_ps(FAR_SCALE),
-            ),
-            _mm256_set1_ps(t_max),
-        );
-        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32;
-        let halves = [
-            Vec4::from(_mm256_castps256_ps128(near)),
-            Vec4::from(_mm256_extractf128_ps::<1>(near)),
-        ];
-        (mask, halves)
-    }
-
-    /// [`RayBoxTest::entries_with`] on two four-lane halves (SSE).
-    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
-    #[inline(always)]
-    fn entries_halves(&self, node: &Node8, t_max: f32, near: [usize; 3]) -> (u32, [Vec4; 2]) {
-        let t_max = Vec4::splat(t_max);
-        let half = |h: usize| {
-            let slab = |axis: usize| {
-                let n = near[axis] & 1;
-                let b = &node.bounds[axis];
-                let near = (b[n][h] - self.o[axis]) * self.inv[axis];
-                let far = (b[n ^ 1][h] - self.o[axis]) * self.inv[axis];
-                (near, far)
-            };
-            let (nx, fx) = slab(0);
-            let (ny, fy) = slab(1);
-            let (nz, fz) = slab(2);
-            let near = nx.max(ny).max(nz).max(Vec4::ZERO);
-            let far = (fx.min(fy).min(fz) * FAR_SCALE).min(t_max);
-            (near.cmple(far).bitmask(), near)
-        };
-        let (m0, n0) = half(0);
-        let (m1, n1) = half(1);
-        (m0 | (m1 << 4), [n0, n1])
+        let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
+        let far =
+            (fx.fast_min(fy).fast_min(fz) * f32x8::splat(FAR_SCALE)).fast_min(f32x8::splat(t_max));
+        (near.simd_le(far).to_bitmask(), near.to_array())
     }
 }
 
@@ -219,14 +157,14 @@ fn touch(nodes: &[Node8], index: u32, count: u32) {
         && let Some(n) = nodes.get(index as usize)
     {
         // One load per 128-byte half of the node (the adjacent-line prefetcher fetches pairs).
-        std::hint::black_box((n.bounds[0][0][0].x, n.bounds[2][0][0].x));
+        std::hint::black_box((n.bounds[0][0].as_array()[0], n.bounds[2][0].as_array()[0]));
     }
 }
 
-/// The entry distance of lane `c` (0..8) from [`RayBoxTest::entries`]' halves.
+/// The entry distance of child `c` (0..8) from [`RayBoxTest::entries`].
 #[inline(always)]
-fn lane_t(near: &[Vec4; 2], c: usize) -> f32 {
-    near[(c >> 2) & 1][c & 3]
+fn lane_t(near: &[f32; WIDTH], c: usize) -> f32 {
+    near[c & (WIDTH - 1)]
 }
 
 impl Bvh {
@@ -487,7 +425,7 @@ mod tests {
     fn entry(b: Aabb, o: Vec3, d: Vec3, t_max: f32) -> Option<f32> {
         let (mask, near) = RayBoxTest::new(o, d).entries(&node_of(b), t_max);
         assert_eq!(mask & !1, 0, "absent child must never be entered");
-        (mask & 1 != 0).then_some(near[0].x)
+        (mask & 1 != 0).then_some(near[0])
     }
 
     fn unit() -> Aabb {
@@ -526,54 +464,6 @@ mod tests {
         );
         // t_max before the box: no entry.
         assert!(entry(unit(), Vec3::new(-5.0, 0.0, 0.0), Vec3::X, 3.9).is_none());
-    }
-
-    /// The 256-bit slab test gives the same bits as the two-halves one, on random nodes (with
-    /// absent children) and rays, including axis-parallel directions and origins on planes.
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    #[test]
-    fn avx_slab_test_matches_the_four_lane_one_bit_for_bit() {
-        let mut rng = crate::sampling::Rng::new(5, 6);
-        let mut v = || rng.next_f32() * 20.0 - 10.0;
-        let mut checked = 0;
-        for i in 0..20_000 {
-            let mut node = Node8::EMPTY;
-            for c in 0..WIDTH {
-                if (i + c) % 5 == 4 {
-                    continue;
-                }
-                let (a, b) = (Vec3::new(v(), v(), v()), Vec3::new(v(), v(), v()));
-                node.set_child(c, a.min(b).to_array(), a.max(b).to_array(), c as u32, 1);
-            }
-            let mut d = Vec3::new(v(), v(), v());
-            if i % 7 == 0 {
-                d.x = 0.0;
-            }
-            if i % 11 == 0 {
-                d.y = -0.0;
-            }
-            let o = if i % 3 == 0 {
-                node.child_bounds(0).min
-            } else {
-                Vec3::new(v(), v(), v()) * 2.0
-            };
-            let r = RayBoxTest::new(o, d);
-            let t_max = if i % 2 == 0 { f32::INFINITY } else { v().abs() };
-            let (ma, na) = r.entries_avx(&node, t_max, r.near);
-            let (mh, nh) = r.entries_halves(&node, t_max, r.near);
-            assert_eq!(ma, mh, "ray {i}");
-            for c in 0..WIDTH {
-                if ma & (1 << c) != 0 {
-                    assert_eq!(
-                        lane_t(&na, c).to_bits(),
-                        lane_t(&nh, c).to_bits(),
-                        "ray {i}"
-                    );
-                    checked += 1;
-                }
-            }
-        }
-        assert!(checked > 10_000, "{checked} entered lanes");
     }
 
     #[test]
