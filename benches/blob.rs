@@ -267,12 +267,13 @@ fn main() {
         }
         let bs = g.bvh.stats();
         eprintln!(
-            "{name}: bvh {} nodes, {} leaves (mean {:.2} prims), depth {}, SAH {:.1}",
+            "{name}: bvh {} nodes, {} leaves (mean {:.2} prims), depth {}, SAH {:.1}, stack {}",
             bs.nodes,
             bs.leaves,
             g.triangles.len() as f64 / bs.leaves as f64,
             bs.max_depth,
-            bs.sah_cost
+            bs.sah_cost,
+            g.bvh.stack_need()
         );
         eprintln!(
             "{name}: {} triangles; primary hits {hit_count} (sum t {t_sum:.2}); secondary {} rays, hits {sec_count} (sum t {sec_sum:.2}), occluded {occluded}",

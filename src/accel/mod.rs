@@ -4,5 +4,5 @@ pub(crate) mod build;
 pub mod bvh;
 mod traverse;
 
-pub use bvh::{Bvh, BvhNode, BvhStats, Node4};
+pub use bvh::{Bvh, BvhNode, BvhStats, Node8};
 pub use traverse::RayBoxTest;

@@ -1,17 +1,20 @@
-//! Stack-based traversal without allocation: the slabs of a node's four children tested at once
-//! with SIMD, children visited nearest first, far children culled on pop once a closer hit is known.
+//! Stack-based traversal without allocation: the slabs of a node's eight children tested at once
+//! with SIMD (one AVX register, or two SSE halves without AVX), children visited nearest first, far children culled on pop once a closer hit is known.
 
-use glam::{Vec3, Vec4};
+use std::cell::RefCell;
 
-use super::bvh::{Bvh, Node4};
+use glam::Vec3;
+use wide::f32x8;
+
+use super::bvh::{Bvh, Node8, WIDTH};
 use crate::geometry::float::gamma;
 
 /// Traversal stack for ordinary trees; deeper trees (the builder's depth cap is what bounds them)
 /// use [`STACK_MAX`].
-const STACK_SMALL: usize = 48;
+const STACK_SMALL: usize = 64;
 /// Enough for any tree the builder makes: binary depth ≤ 64, so at most 64 wide levels pushing
-/// at most three entries each.
-const STACK_MAX: usize = 3 * 64 + 1;
+/// at most `WIDTH - 1` entries each.
+const STACK_MAX: usize = (WIDTH - 1) * 64 + 1;
 
 /// Widening of the far slab distance that covers the slab computation's rounding (pbrt's 1 + 2γ₃).
 const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
@@ -19,8 +22,8 @@ const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
 /// Per-ray constants of the slab test.
 #[derive(Debug, Clone, Copy)]
 pub struct RayBoxTest {
-    o: [Vec4; 3],
-    inv: [Vec4; 3],
+    o: [f32x8; 3],
+    inv: [f32x8; 3],
     /// Per axis, which of a node's planes (0 = min, 1 = max) the ray crosses first.
     near: [usize; 3],
 }
@@ -31,6 +34,23 @@ struct Entry {
     index: u32,
     count: u32,
     t: f32,
+}
+
+/// The traversal stacks of one thread, kept between queries: a stack made per query would be
+/// zeroed on every ray (the crate forbids `unsafe`, so it cannot be left uninitialised), which
+/// cost about 3 % of the instructions of a query.
+struct Stacks {
+    closest: [Entry; STACK_SMALL],
+    any: [(u32, u32); STACK_SMALL],
+}
+
+thread_local! {
+    static STACKS: RefCell<Stacks> = const {
+        RefCell::new(Stacks {
+            closest: [Entry { index: 0, count: 0, t: 0.0 }; STACK_SMALL],
+            any: [(0, 0); STACK_SMALL],
+        })
+    };
 }
 
 impl RayBoxTest {
@@ -50,24 +70,28 @@ impl RayBoxTest {
         let near = |i: f32| usize::from(i.is_sign_negative());
         Self {
             o: [
-                Vec4::splat(origin.x),
-                Vec4::splat(origin.y),
-                Vec4::splat(origin.z),
+                f32x8::splat(origin.x),
+                f32x8::splat(origin.y),
+                f32x8::splat(origin.z),
             ],
-            inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            inv: [
+                f32x8::splat(inv.x),
+                f32x8::splat(inv.y),
+                f32x8::splat(inv.z),
+            ],
             near: [near(inv.x), near(inv.y), near(inv.z)],
         }
     }
 
     /// Which children of `node` the ray enters at or before `t_max` (bit `c` for child `c`), and
-    /// the entry distances per lane (`≥ 0`, never NaN; meaningful only for entered lanes).
+    /// the entry distances per child (`≥ 0`, never NaN; meaningful only for entered children).
     ///
-    /// A NaN from `0·∞` is dropped by the min/max chains (SSE `min`/`max` return their second
+    /// A NaN from `0·∞` is dropped by the min/max chains (`maxps`/`minps` return their second
     /// operand), which only ever widens the slab interval: such a box is entered early or
     /// spuriously, never skipped.
     #[inline(always)]
     #[must_use]
-    pub fn entries(&self, node: &Node4, t_max: f32) -> (u32, Vec4) {
+    pub fn entries(&self, node: &Node8, t_max: f32) -> (u32, [f32; WIDTH]) {
         self.entries_with(node, t_max, self.near)
     }
 
@@ -80,7 +104,7 @@ impl RayBoxTest {
     /// [`RayBoxTest::entries`] with the near planes given (`near[axis]` is 0 or 1); when they are
     /// constants, the plane loads compile to fixed offsets.
     #[inline(always)]
-    fn entries_with(&self, node: &Node4, t_max: f32, near: [usize; 3]) -> (u32, Vec4) {
+    fn entries_with(&self, node: &Node8, t_max: f32, near: [usize; 3]) -> (u32, [f32; WIDTH]) {
         let slab = |axis: usize| {
             let n = near[axis] & 1;
             let b = &node.bounds[axis];
@@ -91,24 +115,28 @@ impl RayBoxTest {
         let (nx, fx) = slab(0);
         let (ny, fy) = slab(1);
         let (nz, fz) = slab(2);
-        let near = nx.max(ny).max(nz).max(Vec4::ZERO);
-        let far = (fx.min(fy).min(fz) * FAR_SCALE).min(Vec4::splat(t_max));
-        (near.cmple(far).bitmask(), near)
+        let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
+        let far =
+            (fx.fast_min(fy).fast_min(fz) * f32x8::splat(FAR_SCALE)).fast_min(f32x8::splat(t_max));
+        (near.simd_le(far).to_bitmask(), near.to_array())
     }
 }
 
-/// Sort key of child `lane` entered at `t ≥ 0`: the distance's bits with the lane in the two
+/// Low bits of a sort key that name the child lane.
+const LANE_BITS: u32 = WIDTH as u32 - 1;
+
+/// Sort key of child `lane` entered at `t ≥ 0`: the distance's bits with the lane in the three
 /// lowest, so that keys order like distances (up to the dropped bits) and name their lane.
 #[inline(always)]
 fn key(t: f32, lane: u32) -> u32 {
-    (t.to_bits() & !3) | lane
+    (t.to_bits() & !LANE_BITS) | lane
 }
 
 /// The distance a key stands for: never more than the true entry distance, so culling with it
 /// is conservative.
 #[inline(always)]
 fn key_t(k: u32) -> f32 {
-    f32::from_bits(k & !3)
+    f32::from_bits(k & !LANE_BITS)
 }
 
 /// The near planes of octant `oct` (0..8), or the ray's own for `oct == 8` (the generic path).
@@ -124,19 +152,19 @@ fn near_of<const OCT: usize>(ray: &RayBoxTest) -> [usize; 3] {
 /// Starts loading a node that the traversal pushed for later: a plain load whose value is unused
 /// (the crate forbids `unsafe`, so there is no prefetch intrinsic), which the CPU runs ahead.
 #[inline(always)]
-fn touch(nodes: &[Node4], index: u32, count: u32) {
+fn touch(nodes: &[Node8], index: u32, count: u32) {
     if count == 0
         && let Some(n) = nodes.get(index as usize)
     {
-        std::hint::black_box(n.bounds[0][0].x);
+        // One load per 128-byte half of the node (the adjacent-line prefetcher fetches pairs).
+        std::hint::black_box((n.bounds[0][0].as_array()[0], n.bounds[2][0].as_array()[0]));
     }
 }
 
+/// The entry distance of child `c` (0..8) from [`RayBoxTest::entries`].
 #[inline(always)]
-fn sort2(a: &mut u32, b: &mut u32) {
-    let (lo, hi) = ((*a).min(*b), (*a).max(*b));
-    *a = lo;
-    *b = hi;
+fn lane_t(near: &[f32; WIDTH], c: usize) -> f32 {
+    near[c & (WIDTH - 1)]
 }
 
 impl Bvh {
@@ -155,18 +183,44 @@ impl Bvh {
             return t_max;
         }
         if self.stack_need > STACK_SMALL {
-            return self.closest_with::<STACK_MAX, 8>(ray, t_max, test);
+            let stack = &mut [Entry::default(); STACK_MAX];
+            return self.closest_with::<STACK_MAX, 8>(ray, t_max, test, stack);
         }
-        // One copy of the loop per ray octant, so the slab planes are fixed offsets.
+        // The thread's stack, or a fresh one if a `test` callback is itself tracing a ray.
+        let mut test = Some(test);
+        let done = STACKS.try_with(|cell| {
+            let mut stacks = cell.try_borrow_mut().ok()?;
+            let test = test.take()?;
+            Some(self.closest_octant(ray, t_max, test, &mut stacks.closest))
+        });
+        match (done, test) {
+            (Ok(Some(t)), _) => t,
+            (_, Some(test)) => {
+                self.closest_octant(ray, t_max, test, &mut [Entry::default(); STACK_SMALL])
+            }
+            (_, None) => unreachable!("the callback is only taken when the query runs"),
+        }
+    }
+
+    /// [`Bvh::closest`] with one copy of the loop per ray octant, so the slab planes are fixed
+    /// offsets.
+    #[inline(always)]
+    fn closest_octant(
+        &self,
+        ray: &RayBoxTest,
+        t_max: f32,
+        test: impl FnMut(u32, u32, f32) -> Option<f32>,
+        stack: &mut [Entry; STACK_SMALL],
+    ) -> f32 {
         match ray.octant() {
-            0 => self.closest_with::<STACK_SMALL, 0>(ray, t_max, test),
-            1 => self.closest_with::<STACK_SMALL, 1>(ray, t_max, test),
-            2 => self.closest_with::<STACK_SMALL, 2>(ray, t_max, test),
-            3 => self.closest_with::<STACK_SMALL, 3>(ray, t_max, test),
-            4 => self.closest_with::<STACK_SMALL, 4>(ray, t_max, test),
-            5 => self.closest_with::<STACK_SMALL, 5>(ray, t_max, test),
-            6 => self.closest_with::<STACK_SMALL, 6>(ray, t_max, test),
-            _ => self.closest_with::<STACK_SMALL, 7>(ray, t_max, test),
+            0 => self.closest_with::<STACK_SMALL, 0>(ray, t_max, test, stack),
+            1 => self.closest_with::<STACK_SMALL, 1>(ray, t_max, test, stack),
+            2 => self.closest_with::<STACK_SMALL, 2>(ray, t_max, test, stack),
+            3 => self.closest_with::<STACK_SMALL, 3>(ray, t_max, test, stack),
+            4 => self.closest_with::<STACK_SMALL, 4>(ray, t_max, test, stack),
+            5 => self.closest_with::<STACK_SMALL, 5>(ray, t_max, test, stack),
+            6 => self.closest_with::<STACK_SMALL, 6>(ray, t_max, test, stack),
+            _ => self.closest_with::<STACK_SMALL, 7>(ray, t_max, test, stack),
         }
     }
 
@@ -176,10 +230,10 @@ impl Bvh {
         ray: &RayBoxTest,
         mut t_max: f32,
         mut test: impl FnMut(u32, u32, f32) -> Option<f32>,
+        stack: &mut [Entry; N],
     ) -> f32 {
         let nodes = &self.nodes[..];
         let near_planes = near_of::<OCT>(ray);
-        let mut stack = [Entry::default(); N];
         let mut sp = 0usize;
         let (mut index, mut count) = (0u32, 0u32);
         loop {
@@ -189,14 +243,14 @@ impl Bvh {
                 match mask.count_ones() {
                     0 => {}
                     1 => {
-                        let c = (mask.trailing_zeros() & 3) as usize;
+                        let c = (mask.trailing_zeros() & LANE_BITS) as usize;
                         (index, count) = (node.index[c], node.count[c]);
                         continue;
                     }
                     2 => {
-                        let a = (mask.trailing_zeros() & 3) as usize;
-                        let b = ((31 - mask.leading_zeros()) & 3) as usize;
-                        let (ta, tb) = (near[a], near[b]);
+                        let a = (mask.trailing_zeros() & LANE_BITS) as usize;
+                        let b = ((31 - mask.leading_zeros()) & LANE_BITS) as usize;
+                        let (ta, tb) = (lane_t(&near, a), lane_t(&near, b));
                         let (c, f, tf) = if ta <= tb { (a, b, tb) } else { (b, a, ta) };
                         stack[sp] = Entry {
                             index: node.index[f],
@@ -208,27 +262,25 @@ impl Bvh {
                         (index, count) = (node.index[c], node.count[c]);
                         continue;
                     }
-                    n => {
-                        let t = near.to_array();
-                        let mut k = [u32::MAX; 4];
+                    _ => {
+                        // Insertion sort of the entered children's keys, nearest first.
+                        let mut k = [u32::MAX; WIDTH];
+                        let mut n = 0usize;
                         let mut m = mask;
-                        for slot in &mut k {
-                            if m == 0 {
-                                break;
-                            }
-                            let c = m.trailing_zeros();
-                            *slot = key(t[c as usize], c);
+                        while m != 0 {
+                            let c = m.trailing_zeros() & LANE_BITS;
                             m &= m - 1;
+                            let kc = key(lane_t(&near, c as usize), c);
+                            let mut j = n & (WIDTH - 1);
+                            while j > 0 && k[j - 1] > kc {
+                                k[j] = k[j - 1];
+                                j -= 1;
+                            }
+                            k[j] = kc;
+                            n += 1;
                         }
-                        let [mut k0, mut k1, mut k2, mut k3] = k;
-                        sort2(&mut k0, &mut k1);
-                        sort2(&mut k2, &mut k3);
-                        sort2(&mut k0, &mut k2);
-                        sort2(&mut k1, &mut k3);
-                        sort2(&mut k1, &mut k2);
-                        let sorted = [k0, k1, k2, k3];
-                        for &kk in sorted[1..n as usize].iter().rev() {
-                            let c = (kk & 3) as usize;
+                        for &kk in k[1..n.min(WIDTH)].iter().rev() {
+                            let c = (kk & LANE_BITS) as usize;
                             stack[sp] = Entry {
                                 index: node.index[c],
                                 count: node.count[c],
@@ -237,7 +289,7 @@ impl Bvh {
                             touch(nodes, node.index[c], node.count[c]);
                             sp += 1;
                         }
-                        let c = (k0 & 3) as usize;
+                        let c = (k[0] & LANE_BITS) as usize;
                         (index, count) = (node.index[c], node.count[c]);
                         continue;
                     }
@@ -272,17 +324,40 @@ impl Bvh {
             return false;
         }
         if self.stack_need > STACK_SMALL {
-            return self.any_with::<STACK_MAX, 8>(ray, t_max, test);
+            let stack = &mut [(0, 0); STACK_MAX];
+            return self.any_with::<STACK_MAX, 8>(ray, t_max, test, stack);
         }
+        let mut test = Some(test);
+        let done = STACKS.try_with(|cell| {
+            let mut stacks = cell.try_borrow_mut().ok()?;
+            let test = test.take()?;
+            Some(self.any_octant(ray, t_max, test, &mut stacks.any))
+        });
+        match (done, test) {
+            (Ok(Some(hit)), _) => hit,
+            (_, Some(test)) => self.any_octant(ray, t_max, test, &mut [(0, 0); STACK_SMALL]),
+            (_, None) => unreachable!("the callback is only taken when the query runs"),
+        }
+    }
+
+    /// [`Bvh::any`] with one copy of the loop per ray octant.
+    #[inline(always)]
+    fn any_octant(
+        &self,
+        ray: &RayBoxTest,
+        t_max: f32,
+        test: impl FnMut(u32, u32, f32) -> bool,
+        stack: &mut [(u32, u32); STACK_SMALL],
+    ) -> bool {
         match ray.octant() {
-            0 => self.any_with::<STACK_SMALL, 0>(ray, t_max, test),
-            1 => self.any_with::<STACK_SMALL, 1>(ray, t_max, test),
-            2 => self.any_with::<STACK_SMALL, 2>(ray, t_max, test),
-            3 => self.any_with::<STACK_SMALL, 3>(ray, t_max, test),
-            4 => self.any_with::<STACK_SMALL, 4>(ray, t_max, test),
-            5 => self.any_with::<STACK_SMALL, 5>(ray, t_max, test),
-            6 => self.any_with::<STACK_SMALL, 6>(ray, t_max, test),
-            _ => self.any_with::<STACK_SMALL, 7>(ray, t_max, test),
+            0 => self.any_with::<STACK_SMALL, 0>(ray, t_max, test, stack),
+            1 => self.any_with::<STACK_SMALL, 1>(ray, t_max, test, stack),
+            2 => self.any_with::<STACK_SMALL, 2>(ray, t_max, test, stack),
+            3 => self.any_with::<STACK_SMALL, 3>(ray, t_max, test, stack),
+            4 => self.any_with::<STACK_SMALL, 4>(ray, t_max, test, stack),
+            5 => self.any_with::<STACK_SMALL, 5>(ray, t_max, test, stack),
+            6 => self.any_with::<STACK_SMALL, 6>(ray, t_max, test, stack),
+            _ => self.any_with::<STACK_SMALL, 7>(ray, t_max, test, stack),
         }
     }
 
@@ -292,10 +367,10 @@ impl Bvh {
         ray: &RayBoxTest,
         t_max: f32,
         mut test: impl FnMut(u32, u32, f32) -> bool,
+        stack: &mut [(u32, u32); N],
     ) -> bool {
         let nodes = &self.nodes[..];
         let near_planes = near_of::<OCT>(ray);
-        let mut stack = [(0u32, 0u32); N];
         let mut sp = 0usize;
         let (mut index, mut count) = (0u32, 0u32);
         loop {
@@ -303,10 +378,10 @@ impl Bvh {
                 let node = &nodes[index as usize];
                 let (mut mask, _) = ray.entries_with(node, t_max, near_planes);
                 if mask != 0 {
-                    let c = (mask.trailing_zeros() & 3) as usize;
+                    let c = (mask.trailing_zeros() & LANE_BITS) as usize;
                     mask &= mask - 1;
                     while mask != 0 {
-                        let f = ((31 - mask.leading_zeros()) & 3) as usize;
+                        let f = ((31 - mask.leading_zeros()) & LANE_BITS) as usize;
                         stack[sp] = (node.index[f], node.count[f]);
                         touch(nodes, node.index[f], node.count[f]);
                         sp += 1;
@@ -334,7 +409,7 @@ mod tests {
     use crate::geometry::Aabb;
 
     /// A node whose first child is `b` (padded like the builder does) and whose others are absent.
-    fn node_of(b: Aabb) -> Node4 {
+    fn node_of(b: Aabb) -> Node8 {
         let (min, max) = crate::accel::build::padded(b);
         let n = BvhNode {
             min,
@@ -342,7 +417,7 @@ mod tests {
             max,
             count: 1,
         };
-        let mut node = Node4::EMPTY;
+        let mut node = Node8::EMPTY;
         node.set_child(0, n.min, n.max, n.index, n.count);
         node
     }
@@ -350,7 +425,7 @@ mod tests {
     fn entry(b: Aabb, o: Vec3, d: Vec3, t_max: f32) -> Option<f32> {
         let (mask, near) = RayBoxTest::new(o, d).entries(&node_of(b), t_max);
         assert_eq!(mask & !1, 0, "absent child must never be entered");
-        (mask & 1 != 0).then_some(near.x)
+        (mask & 1 != 0).then_some(near[0])
     }
 
     fn unit() -> Aabb {

@@ -158,6 +158,9 @@ pub fn intersect_triangle_k<const KZ: usize>(
     })
 }
 
+mod pack8;
+pub use pack8::{PackHits8, intersect_pack8_k};
+
 /// Four triangles in structure-of-arrays layout for [`intersect_pack_k`]: `v[vertex][axis]` holds
 /// that coordinate of the four triangles, one triangle per SIMD lane (144 bytes). An unused lane
 /// holds NaN coordinates, which the test never reports as a hit.
@@ -490,6 +493,32 @@ mod tests {
                 let simd = h.filter(|_| mask & (1 << lane) != 0).map(|h| h.hit(lane));
                 let bits = |x: Option<TriHit>| x.map(|x| [x.t, x.b0, x.b1, x.b2].map(f32::to_bits));
                 if bits(scalar) != bits(simd) {
+                    bad += 1;
+                }
+            }
+        }
+        for group in tris.chunks(8) {
+            let mut packs = [TriPack4::EMPTY; 2];
+            for (lane, t) in group.iter().enumerate() {
+                packs[lane / 4].set(lane % 4, t[0], t[1], t[2]);
+            }
+            let [a, b] = &packs;
+            let h = match r.dominant_axis() {
+                0 => intersect_pack8_k::<0>(&r, a, b, t_max),
+                1 => intersect_pack8_k::<1>(&r, a, b, t_max),
+                _ => intersect_pack8_k::<2>(&r, a, b, t_max),
+            };
+            let mask = h.map_or(0, |h| h.mask);
+            for lane in 0..8 {
+                let scalar = group
+                    .get(lane)
+                    .and_then(|t| intersect_triangle(&r, t[0], t[1], t[2], t_max))
+                    .map(|x| [x.t, x.b1, x.b2].map(f32::to_bits));
+                let simd = h.filter(|_| mask & (1 << lane) != 0).map(|h| {
+                    let (b1, b2) = h.b12(lane);
+                    [h.t(lane), b1, b2].map(f32::to_bits)
+                });
+                if scalar != simd {
                     bad += 1;
                 }
             }

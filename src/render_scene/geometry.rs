@@ -5,7 +5,9 @@ use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 use crate::accel::bvh::{LEAF_BLOCK, PAD};
 use crate::accel::{Bvh, RayBoxTest};
 use crate::geometry::sphere::{intersect_sphere, intersect_unit_quadric};
-use crate::geometry::triangle::{TriPack4, TriRay, intersect_pack_k, intersect_triangle_k};
+use crate::geometry::triangle::{
+    TriPack4, TriRay, intersect_pack_k, intersect_pack8_k, intersect_triangle_k,
+};
 use crate::geometry::{Aabb, Ray};
 
 /// A primitive reference: kind in the top two bits, index into that kind's array below.
@@ -94,6 +96,10 @@ pub struct EllipsoidPrim {
     /// Owning object.
     pub object: u32,
 }
+
+/// Whether leaves test two triangle packs at a time ([`intersect_pack8_k`]): where AVX is
+/// enabled at build time, so that eight lanes are one register.
+const PACK_PAIRS: bool = cfg!(all(target_arch = "x86_64", target_feature = "avx"));
 
 /// The minimal record of a closest hit; expand it with [`Geometry::surface`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -291,7 +297,35 @@ impl Geometry {
             }
             return found;
         }
-        for pack in first / LEAF_BLOCK..end.div_ceil(LEAF_BLOCK) {
+        let mut packs = first / LEAF_BLOCK..end.div_ceil(LEAF_BLOCK);
+        // With AVX, two packs (eight triangles) per test while two remain.
+        while PACK_PAIRS && packs.len() >= 2 {
+            let pack = packs.start;
+            packs.start += 2;
+            let (a, b) = (&self.tri_packs[pack], &self.tri_packs[pack + 1]);
+            let Some(h) = intersect_pack8_k::<KZ>(tri_ray, a, b, t_max) else {
+                continue;
+            };
+            let mut mask = h.mask;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if found.is_some() && !h.within(lane, t_max) {
+                    continue;
+                }
+                let t = h.t(lane);
+                let (b1, b2) = h.b12(lane);
+                *best = Some(Hit {
+                    t,
+                    prim: self.slots[pack * LEAF_BLOCK + lane],
+                    b1,
+                    b2,
+                });
+                t_max = t;
+                found = Some(t);
+            }
+        }
+        for pack in packs {
             let Some(h) = intersect_pack_k::<KZ>(tri_ray, &self.tri_packs[pack], t_max) else {
                 continue;
             };
@@ -368,7 +402,24 @@ impl Geometry {
                         .is_some()
             });
         }
-        (first / LEAF_BLOCK..end.div_ceil(LEAF_BLOCK)).any(|pack| {
+        let mut packs = first / LEAF_BLOCK..end.div_ceil(LEAF_BLOCK);
+        while PACK_PAIRS && packs.len() >= 2 {
+            let pack = packs.start;
+            packs.start += 2;
+            let (a, b) = (&self.tri_packs[pack], &self.tri_packs[pack + 1]);
+            let Some(h) = intersect_pack8_k::<KZ>(tri_ray, a, b, t_max) else {
+                continue;
+            };
+            let mut mask = h.mask;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if counts(self.slots[pack * LEAF_BLOCK + lane]) {
+                    return true;
+                }
+            }
+        }
+        packs.any(|pack| {
             let Some(h) = intersect_pack_k::<KZ>(tri_ray, &self.tri_packs[pack], t_max) else {
                 return false;
             };
