@@ -8,7 +8,7 @@
 //!   the aiming density, so the fraction of the light's directions that the targets cover is in
 //!   every photon's flux.
 
-use glam::{Quat, Vec3};
+use glam::{Mat3, Vec3};
 
 use super::aim::{AimCone, CausticTargets, sample_cones};
 use crate::geometry::Ray;
@@ -56,8 +56,11 @@ pub struct LightEmitter {
     pub light: Light,
     /// Photons this light emits into the map.
     pub count: u64,
-    /// Random rotation of the Fibonacci lattice (point lights, global map).
-    pub rotation: Quat,
+    /// Random rotation of the Fibonacci lattice (point lights, global map), as a matrix: its
+    /// product with a vector is plain multiplies and adds in every build (glam's quaternion
+    /// product fuses them into FMAs when the target has FMA, which would change the photons
+    /// with the compiler flags).
+    pub rotation: Mat3,
 }
 
 impl LightEmitter {
@@ -71,7 +74,7 @@ impl LightEmitter {
         Self {
             light,
             count,
-            rotation: uniform_rotation([a, b, c]),
+            rotation: Mat3::from_quat(uniform_rotation([a, b, c])),
         }
     }
 
