@@ -179,40 +179,7 @@ impl<T: HasPosition + Send> KdTree<T> {
     /// # Errors
     /// As [`KdTree::build`], plus [`KdTreeError::InvalidLeafSize`].
     pub fn build_with(mut items: Vec<T>, options: BuildOptions) -> Result<Self, KdTreeError> {
-        if !(1..=256).contains(&options.leaf_size) {
-            return Err(KdTreeError::InvalidLeafSize(options.leaf_size));
-        }
-        if items.len() >= MAX_ITEMS {
-            return Err(KdTreeError::TooManyItems {
-                count: items.len(),
-                max: MAX_ITEMS - 1,
-            });
-        }
-        let mut bounds = [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]];
-        for (index, item) in items.iter().enumerate() {
-            let p = item.position();
-            if !p.iter().all(|c| c.is_finite()) {
-                return Err(KdTreeError::NonFinitePosition { index, position: p });
-            }
-            for a in 0..3 {
-                bounds[0][a] = bounds[0][a].min(p[a]);
-                bounds[1][a] = bounds[1][a].max(p[a]);
-            }
-        }
-        let n = items.len();
-        let mut leaves = 1usize;
-        while n.div_ceil(leaves) > options.leaf_size {
-            leaves *= 2;
-        }
-        let mut stems = vec![
-            Stem {
-                left_max: 0.0,
-                right_min: 0.0,
-                axis: 0
-            };
-            leaves - 1
-        ];
-        let root_half = leaves / 2;
+        let (bounds, mut stems, root_half) = layout(&items, options)?;
         build_node(&mut items, &mut stems, root_half, 0, options.split_axis);
         Ok(Self {
             items,
@@ -233,40 +200,7 @@ impl<T: HasPosition + Sync> KdTree<T> {
     /// As [`KdTree::build_with`], plus [`KdTreeError::NotTreeOrder`] when some node's left half
     /// reaches past its right half on the node's axis (the items are not in tree order).
     pub fn from_tree_order(items: Vec<T>, options: BuildOptions) -> Result<Self, KdTreeError> {
-        if !(1..=256).contains(&options.leaf_size) {
-            return Err(KdTreeError::InvalidLeafSize(options.leaf_size));
-        }
-        if items.len() >= MAX_ITEMS {
-            return Err(KdTreeError::TooManyItems {
-                count: items.len(),
-                max: MAX_ITEMS - 1,
-            });
-        }
-        let mut bounds = [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]];
-        for (index, item) in items.iter().enumerate() {
-            let p = item.position();
-            if !p.iter().all(|c| c.is_finite()) {
-                return Err(KdTreeError::NonFinitePosition { index, position: p });
-            }
-            for a in 0..3 {
-                bounds[0][a] = bounds[0][a].min(p[a]);
-                bounds[1][a] = bounds[1][a].max(p[a]);
-            }
-        }
-        let n = items.len();
-        let mut leaves = 1usize;
-        while n.div_ceil(leaves) > options.leaf_size {
-            leaves *= 2;
-        }
-        let mut stems = vec![
-            Stem {
-                left_max: 0.0,
-                right_min: 0.0,
-                axis: 0
-            };
-            leaves - 1
-        ];
-        let root_half = leaves / 2;
+        let (bounds, mut stems, root_half) = layout(&items, options)?;
         if !restore_node(&items, &mut stems, root_half, 0, options.split_axis) {
             return Err(KdTreeError::NotTreeOrder);
         }
@@ -623,6 +557,49 @@ impl<T: HasPosition> Within<'_, T> {
             self.node(p + half, half / 2, mid, hi, &rr, visit);
         }
     }
+}
+
+/// What [`KdTree::build_with`] and [`KdTree::from_tree_order`] share: the options and items
+/// checked (leaf size, count, finite positions), the items' bounds, and the stems of a tree with
+/// a power-of-two number of leaves of at most `leaf_size` items (unset), with the root's half.
+#[allow(clippy::type_complexity)]
+fn layout<T: HasPosition>(
+    items: &[T],
+    options: BuildOptions,
+) -> Result<([[f32; 3]; 2], Vec<Stem>, usize), KdTreeError> {
+    if !(1..=256).contains(&options.leaf_size) {
+        return Err(KdTreeError::InvalidLeafSize(options.leaf_size));
+    }
+    if items.len() >= MAX_ITEMS {
+        return Err(KdTreeError::TooManyItems {
+            count: items.len(),
+            max: MAX_ITEMS - 1,
+        });
+    }
+    let mut bounds = [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]];
+    for (index, item) in items.iter().enumerate() {
+        let p = item.position();
+        if !p.iter().all(|c| c.is_finite()) {
+            return Err(KdTreeError::NonFinitePosition { index, position: p });
+        }
+        for a in 0..3 {
+            bounds[0][a] = bounds[0][a].min(p[a]);
+            bounds[1][a] = bounds[1][a].max(p[a]);
+        }
+    }
+    let mut leaves = 1usize;
+    while items.len().div_ceil(leaves) > options.leaf_size {
+        leaves *= 2;
+    }
+    let stems = vec![
+        Stem {
+            left_max: 0.0,
+            right_min: 0.0,
+            axis: 0
+        };
+        leaves - 1
+    ];
+    Ok((bounds, stems, leaves / 2))
 }
 
 #[cfg(test)]

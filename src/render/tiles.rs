@@ -115,6 +115,19 @@ pub fn render(scene: &RenderScene, options: &RenderOptions) -> Result<RenderOutp
     RenderJob::new(scene, options)?.finish()
 }
 
+/// Checks that `region` is non-empty and inside a `w` × `h` image.
+fn check_region(region: Region, w: u32, h: u32) -> Result<(), RenderError> {
+    if region.width == 0 || region.height == 0 {
+        return Err(RenderError::EmptyRegion);
+    }
+    if u64::from(region.x) + u64::from(region.width) > u64::from(w)
+        || u64::from(region.y) + u64::from(region.height) > u64::from(h)
+    {
+        return Err(RenderError::RegionOutside(region, w, h));
+    }
+    Ok(())
+}
+
 /// A render done in passes over sample indices: pass after pass adds samples `[done, done + n)`
 /// to every pixel, in ascending sample order, so the finished film is bit-identical to the
 /// one-pass [`render`] whatever the pass sizes. Between passes the image so far can be read
@@ -162,14 +175,7 @@ impl<'a> RenderJob<'a> {
             width: w,
             height: h,
         });
-        if region.width == 0 || region.height == 0 {
-            return Err(RenderError::EmptyRegion);
-        }
-        if u64::from(region.x) + u64::from(region.width) > u64::from(w)
-            || u64::from(region.y) + u64::from(region.height) > u64::from(h)
-        {
-            return Err(RenderError::RegionOutside(region, w, h));
-        }
+        check_region(region, w, h)?;
         let threads = options
             .threads
             .unwrap_or_else(rayon::current_num_threads)
@@ -288,6 +294,28 @@ impl<'a> RenderJob<'a> {
         &self.sums
     }
 
+    /// Renders every sample of another `region` of the same image with this job's prepared
+    /// integrator (its photon maps are built once, by [`RenderJob::new`]) and returns that
+    /// region's output; the job can then render further regions. For tools that render many
+    /// crops of one image, such as the doc-image test's row strips.
+    ///
+    /// # Errors
+    /// When the region is empty or outside the image, or as [`RenderJob::render_pass`].
+    pub fn render_region(&mut self, region: Region) -> Result<RenderOutput, RenderError> {
+        check_region(region, self.scene.params.width, self.scene.params.height)?;
+        self.region = region;
+        self.tiles = tile_grid(region);
+        self.sums = PixelSums::new(region.width, region.height);
+        self.done = self.first;
+        self.stats = RenderStats {
+            threads: self.stats.threads,
+            ..Default::default()
+        };
+        self.start = Instant::now();
+        self.render_pass(self.end - self.done)?;
+        Ok(self.take_output())
+    }
+
     /// Takes the remaining samples in one pass and returns the finished film.
     ///
     /// # Errors
@@ -303,6 +331,11 @@ impl<'a> RenderJob<'a> {
     #[must_use]
     pub fn into_output(mut self) -> RenderOutput {
         self.progress.finish_and_clear();
+        self.take_output()
+    }
+
+    /// The output of the samples done so far, moving the sums out (the job keeps empty ones).
+    fn take_output(&mut self) -> RenderOutput {
         let mut stats = self.stats;
         stats.samples = u64::from(self.region.width)
             * u64::from(self.region.height)

@@ -26,7 +26,7 @@ use std::path::PathBuf;
 
 use caustic::pipeline::{SceneOverrides, prepare};
 use caustic::render::output::to_srgb8;
-use caustic::render::{Region, RenderOptions, render};
+use caustic::render::{Region, RenderJob, RenderOptions};
 use image::RgbImage;
 
 use crate::common;
@@ -184,6 +184,17 @@ fn compare_rows(e: &Entry, image: &RgbImage) -> Comparison {
     );
     let exposure = prepared.render_scene.params.exposure;
     let mut c = Comparison::default();
+    // One job for all strips: the integrator (photon maps) is prepared once.
+    let first = Region {
+        height: STRIP.min(crop.height),
+        ..crop
+    };
+    let options = RenderOptions {
+        region: Some(first),
+        ..RenderOptions::default()
+    };
+    let mut job = RenderJob::new(&prepared.render_scene, &options)
+        .unwrap_or_else(|err| panic!("{at}: {err}"));
     for y0 in (0..crop.height).step_by(STRIDE as usize) {
         let region = Region {
             x: crop.x,
@@ -191,12 +202,9 @@ fn compare_rows(e: &Entry, image: &RgbImage) -> Comparison {
             width: crop.width,
             height: STRIP.min(crop.height - y0),
         };
-        let options = RenderOptions {
-            region: Some(region),
-            ..RenderOptions::default()
-        };
-        let out =
-            render(&prepared.render_scene, &options).unwrap_or_else(|err| panic!("{at}: {err}"));
+        let out = job
+            .render_region(region)
+            .unwrap_or_else(|err| panic!("{at}: {err}"));
         let fresh = to_srgb8(&out.film, exposure);
         for (x, y, p) in fresh.enumerate_pixels() {
             let q = image.get_pixel(x, y0 + y);
