@@ -68,7 +68,7 @@ pub struct RenderSettings {
     pub sampler: SamplerKind,
     /// Path tracing: most diffuse or glossy bounces a path may make (unset: up to `max_depth`);
     /// 0 keeps only direct light and mirror/glass chains (Whitted's light transport).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub diffuse_depth: Option<u32>,
     /// How image textures are filtered.
     pub texture_filter: TextureFilter,
@@ -125,7 +125,7 @@ pub struct PhotonSettings {
     pub caustic_gather: u32,
     /// Largest radius (scene units) of an estimate's disc; unset: chosen from the scene's size
     /// and the photon count (reported in the summary).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub max_radius: Option<f32>,
     /// The kernel of caustic estimates.
     pub caustic_filter: PhotonFilter,
@@ -480,7 +480,7 @@ pub enum LightSpec {
         power: Rgb,
         /// Caustic photons this light emits, instead of its power share of
         /// `photons.caustic` (0: none).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(default)]
         caustic_photons: Option<u32>,
     },
     /// A spherical area light emitting uniformly from its surface; gives soft shadows.
@@ -495,7 +495,7 @@ pub enum LightSpec {
         power: Rgb,
         /// Caustic photons this light emits, instead of its power share of
         /// `photons.caustic` (0: none).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(default)]
         caustic_photons: Option<u32>,
     },
 }
@@ -590,7 +590,7 @@ pub enum NodeSpec {
         transform: Vec<TransformStep>,
         /// Material name: of every face, or with `materials` of the faces it does not map.
         /// Required unless `materials` maps every face of the file.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(default)]
         material: Option<String>,
         /// Materials by the file's names: each key is a group (`g` or `o`) or a `usemtl` name
         /// of the OBJ file, each value a material name. A face takes the material of its

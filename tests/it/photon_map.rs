@@ -678,3 +678,47 @@ fn photon_caustic_of_a_small_sphere_light_through_glass_agrees_with_path_tracing
         "caustic block: photon {ph} vs path {best}"
     );
 }
+
+#[test]
+fn photon_flags_and_unset_optional_fields_can_be_overridden() {
+    // `--max-radius` and `--set` on fields a scene leaves unset (they are optional in the
+    // schema) must work; a typo must still be refused with a suggestion.
+    for args in [
+        vec!["check", "scenes/water.ron", "--max-radius", "0.05"],
+        vec![
+            "check",
+            "scenes/water.ron",
+            "--set",
+            "lights[0].caustic_photons=1000",
+        ],
+        vec![
+            "check",
+            "scenes/cornell.ron",
+            "--set",
+            "render.diffuse_depth=2",
+        ],
+        vec![
+            "check",
+            "scenes/water.ron",
+            "--photons",
+            "0",
+            "--caustic-photons",
+            "0",
+            "--gather",
+            "7",
+            "--final-gather",
+            "0",
+        ],
+    ] {
+        let out = crate::common::caustic(&args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let out = crate::common::caustic(&["check", "scenes/water.ron", "--set", "photons.gathr=7"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("did you mean `gather`?"), "{err}");
+}

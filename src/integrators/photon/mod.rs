@@ -116,7 +116,7 @@ impl<'a> PhotonMapper<'a> {
     }
 
     /// Radiance arriving along camera ray `ray` (module docs for the split). Mirror and glass
-    /// chains are split into both branches for the first [`SPLIT_DEPTH`] delta bounces (as
+    /// chains are split into both branches for the first two delta bounces (as
     /// Whitted does: no noise from choosing between Fresnel reflection and refraction) and
     /// followed by sampling one delta lobe after that.
     pub fn li(
@@ -404,7 +404,7 @@ impl<'a> PhotonMapper<'a> {
 
     /// Indirect light at a vertex by `n` final-gather rays sampled from the BSDF's diffuse part:
     /// where each lands, its direct light, caustics and global-map radiance (following up to
-    /// [`GATHER_SPECULAR_DEPTH`] mirror or glass bounces first).
+    /// four mirror or glass bounces first).
     #[allow(clippy::too_many_arguments)]
     fn final_gather(
         &self,
