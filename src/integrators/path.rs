@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use super::Counters;
-use super::shadow::{RayCone, shadow_ray};
+use super::shadow::{LightConnection, RayCone, connect_light};
 use super::trace_log::{RayKind, ShadowRecord, TraceLog};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
@@ -241,17 +241,14 @@ impl PathTracer<'_> {
         log: Option<&mut TraceLog>,
         node: Option<usize>,
     ) -> Vec3 {
-        let scene = self.scene;
-        let Some(ls) = scene.lights[index].sample_li(sp.p, u) else {
+        let Some(LightConnection {
+            ls,
+            f,
+            occluded: blocked,
+        }) = connect_light(self.scene, index, sp, wo, fr, bsdf, u, counters)
+        else {
             return Vec3::ZERO;
         };
-        let f = bsdf.eval(wo, ls.wi, fr, TransportMode::Radiance);
-        if f == Vec3::ZERO || !(ls.pdf > 0.0) {
-            return Vec3::ZERO;
-        }
-        let shadow = shadow_ray(sp, fr.ng, ls.point);
-        counters.rays += 1;
-        let blocked = scene.geometry.occluded(&shadow);
         let w = if ls.delta || !may_scatter {
             1.0
         } else {

@@ -2,9 +2,11 @@
 
 use glam::Vec3;
 
+use super::Counters;
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::SurfacePoint;
+use crate::render_scene::{LightSample, RenderScene, SurfacePoint};
+use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
 /// Fraction of a shadow ray's length left unchecked at the light end (so the light's own
 /// surface never occludes the point sampled on it).
@@ -30,6 +32,45 @@ pub fn shadow_ray(sp: &SurfacePoint, ng: Vec3, target: Vec3) -> Ray {
         dir: target - origin,
         t_max: 1.0 - SHADOW_EPSILON,
     }
+}
+
+/// A light sample connected to a shaded point by next-event estimation: the sample, the BSDF
+/// value towards it, and whether its shadow ray was blocked.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightConnection {
+    /// The incident-light sample (direction, radiance, solid-angle pdf).
+    pub ls: LightSample,
+    /// The non-delta BSDF value `f(wo, wi)` in radiance mode (non-zero).
+    pub f: Vec3,
+    /// True when the shadow ray hit something before the light.
+    pub occluded: bool,
+}
+
+/// Next-event estimation's shared step, for every integrator: samples light `light` of the
+/// scene from surface point `sp` with `u`, evaluates `bsdf` (frame `fr`, outgoing `wo`) towards
+/// it and, when that is non-zero, traces the shadow ray (counted in `counters`). `None` when the
+/// light gives no sample or the BSDF is zero there (no ray is traced). The estimate itself
+/// (`f · L · cos θ / pdf`, with or without an MIS weight) is the caller's.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn connect_light(
+    scene: &RenderScene,
+    light: usize,
+    sp: &SurfacePoint,
+    wo: Vec3,
+    fr: &ShadingFrame,
+    bsdf: &Bsdf,
+    u: (f32, f32),
+    counters: &mut Counters,
+) -> Option<LightConnection> {
+    let ls = scene.lights[light].sample_li(sp.p, u)?;
+    let f = bsdf.eval(wo, ls.wi, fr, TransportMode::Radiance);
+    if f == Vec3::ZERO || !(ls.pdf > 0.0) {
+        return None;
+    }
+    counters.rays += 1;
+    let occluded = scene.geometry.occluded(&shadow_ray(sp, fr.ng, ls.point));
+    Some(LightConnection { ls, f, occluded })
 }
 
 /// The pixel footprint carried along a path as a cone (Akenine-Möller et al., "Texture Level of

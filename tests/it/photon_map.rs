@@ -5,8 +5,10 @@
 use glam::Vec3;
 
 use caustic::geometry::Ray;
+use caustic::integrators::photon::aim::CausticTargets;
 use caustic::integrators::photon::emit::LightEmitter;
-use caustic::integrators::photon::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
+use caustic::integrators::photon::maps::trace_map;
+use caustic::integrators::photon::trace::{MapKind, TraceCounts, TraceSettings};
 use caustic::integrators::photon::{Kernel, PhotonMap, build_maps};
 use caustic::integrators::{Counters, Integrator};
 use caustic::photon::{KdTree, Photon};
@@ -29,7 +31,8 @@ const PLANE: &str = r#"Scene(
 )"#;
 
 /// Traces `n` photons of the scene's light 0 into one list, storing every diffuse landing
-/// (`min_bounces` 0: direct photons included), as the global map's tracer does.
+/// (`min_bounces` 0: direct photons included) and nothing after it (`max_bounces` 0), with the
+/// tracer the global map uses.
 fn direct_photons(scene: &RenderScene, n: u64) -> (Vec<Photon>, TraceCounts) {
     let p = &scene.params;
     let mut sampler = Sampler::new(p.sampler, p.seed, 1);
@@ -39,24 +42,8 @@ fn direct_photons(scene: &RenderScene, n: u64) -> (Vec<Photon>, TraceCounts) {
         min_bounces: 0,
         max_bounces: 0,
     };
-    let mut out = Vec::new();
-    let mut counts = TraceCounts::default();
-    for i in 0..n {
-        sampler.start_stream(7, i);
-        counts.emitted += 1;
-        if let Some((ray, power)) = emitter.global(i, &mut sampler) {
-            trace_photon(
-                scene,
-                ray,
-                power,
-                settings,
-                &mut sampler,
-                &mut out,
-                &mut counts,
-            );
-        }
-    }
-    (out, counts)
+    let (photons, counts) = trace_map(scene, &[emitter], &CausticTargets::default(), settings);
+    (photons, counts[0])
 }
 
 fn lambert() -> Bsdf {

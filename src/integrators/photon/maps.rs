@@ -162,9 +162,10 @@ fn rotation_stream(kind: MapKind, light: usize) -> u64 {
     stream(kind, light) | (1 << 48)
 }
 
-/// Traces `emitters`' photons into one flat list (in (light, index) order) with per-light
-/// counts.
-fn trace_map(
+/// Traces `emitters`' photons (light `l`'s from stream (settings' map, `l`), caustic ones aimed
+/// at `targets`) into one flat list in (light, index) order, with per-light counts. Parallel
+/// batches; the same result for any thread count.
+pub fn trace_map(
     scene: &RenderScene,
     emitters: &[LightEmitter],
     targets: &CausticTargets,

@@ -28,7 +28,7 @@ pub use maps::{PhotonMaps, PhotonSummary, build_maps};
 use glam::Vec3;
 
 use super::Counters;
-use super::shadow::{RayCone, shadow_ray};
+use super::shadow::{RayCone, connect_light};
 use super::trace_log::{RayKind, TraceLog};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
@@ -301,12 +301,11 @@ impl<'a> PhotonMapper<'a> {
             });
             return (direct + l, note);
         }
-        let caustic = self.maps.caustic.as_ref().map(|m| {
-            counters.photon_estimates += 1;
-            let e = m.estimate(sp.p, wo, &fr, &sh.bsdf);
-            counters.photon_radius_cut += u64::from(e.cut);
-            e
-        });
+        let caustic = self
+            .maps
+            .caustic
+            .as_ref()
+            .map(|m| counted(m, sp.p, wo, &fr, sh, counters));
         let gather = self.scene.params.photons.final_gather;
         let (indirect, global) = if gather > 0 {
             (
@@ -314,12 +313,11 @@ impl<'a> PhotonMapper<'a> {
                 None,
             )
         } else {
-            let e = self.maps.global.as_ref().map(|m| {
-                counters.photon_estimates += 1;
-                let e = m.estimate(sp.p, wo, &fr, &sh.bsdf);
-                counters.photon_radius_cut += u64::from(e.cut);
-                e
-            });
+            let e = self
+                .maps
+                .global
+                .as_ref()
+                .map(|m| counted(m, sp.p, wo, &fr, sh, counters));
             (e.map_or(Vec3::ZERO, |e| e.radiance), e)
         };
         let caustic_l = caustic.map_or(Vec3::ZERO, |e| e.radiance);
@@ -384,22 +382,10 @@ impl<'a> PhotonMapper<'a> {
         let Some((index, pmf)) = self.lights.sample(u_light) else {
             return Vec3::ZERO;
         };
-        let Some(ls) = self.scene.lights[index].sample_li(sp.p, u_point) else {
-            return Vec3::ZERO;
-        };
-        let f = sh.bsdf.eval(wo, ls.wi, fr, TransportMode::Radiance);
-        if f == Vec3::ZERO || !(ls.pdf > 0.0) {
-            return Vec3::ZERO;
+        match connect_light(self.scene, index, sp, wo, fr, &sh.bsdf, u_point, counters) {
+            Some(c) if !c.occluded => c.f * c.ls.weight * (fr.ns.dot(c.ls.wi) / pmf),
+            _ => Vec3::ZERO,
         }
-        counters.rays += 1;
-        if self
-            .scene
-            .geometry
-            .occluded(&shadow_ray(sp, fr.ng, ls.point))
-        {
-            return Vec3::ZERO;
-        }
-        f * ls.weight * (fr.ns.dot(ls.wi) / pmf)
     }
 
     /// Indirect light at a vertex by `n` final-gather rays sampled from the BSDF's diffuse part:
@@ -454,10 +440,7 @@ impl<'a> PhotonMapper<'a> {
                             .into_iter()
                             .flatten()
                         {
-                            counters.photon_estimates += 1;
-                            let e = map.estimate(gp.p, gwo, &gfr, &gsh.bsdf);
-                            counters.photon_radius_cut += u64::from(e.cut);
-                            lo += e.radiance;
+                            lo += counted(map, gp.p, gwo, &gfr, &gsh, counters).radiance;
                         }
                     }
                     sum += beta * lo;
@@ -485,6 +468,23 @@ impl<'a> PhotonMapper<'a> {
         }
         sum / n as f32
     }
+}
+
+/// `map`'s estimate at `p` towards `wo` through `sh`'s BSDF, counted in `counters` (estimates
+/// made, and those the largest radius cut short).
+#[inline]
+fn counted(
+    map: &PhotonMap,
+    p: Vec3,
+    wo: Vec3,
+    fr: &ShadingFrame,
+    sh: &ShadingPoint,
+    counters: &mut Counters,
+) -> Estimate {
+    let e = map.estimate(p, wo, fr, &sh.bsdf);
+    counters.photon_estimates += 1;
+    counters.photon_radius_cut += u64::from(e.cut);
+    e
 }
 
 /// The BSDF frame of a shading point.
