@@ -80,6 +80,10 @@ enum IntegratorArg {
     Path,
     /// Photon mapping: caustic and global photon maps, final gathering.
     Photon,
+    /// Progressive photon mapping: fresh maps every pass, shrinking radius (consistent).
+    Ppm,
+    /// Path tracing with caustics from progressive photon maps (consistent).
+    PathPpm,
 }
 
 impl IntegratorArg {
@@ -89,6 +93,8 @@ impl IntegratorArg {
             IntegratorArg::Whitted => "Whitted",
             IntegratorArg::Path => "Path",
             IntegratorArg::Photon => "Photon",
+            IntegratorArg::Ppm => "Ppm",
+            IntegratorArg::PathPpm => "PathPpm",
         }
     }
 

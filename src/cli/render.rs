@@ -328,7 +328,20 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         st.threads,
         if st.threads == 1 { "" } else { "s" }
     );
-    if st.photon_estimates > 0 && !args.quiet {
+    if let Some(pr) = &st.progressive
+        && !args.quiet
+    {
+        let t = &pr.totals;
+        eprintln!(
+            "photons: {} passes of fresh maps, {} photons emitted and {} stored in all ({:.2} s), {} estimates; the last pass read {:.3} of each k-nearest radius",
+            t.passes,
+            t.emitted,
+            t.stored,
+            t.time.as_secs_f64(),
+            st.photon_estimates,
+            pr.last_shrink
+        );
+    } else if st.photon_estimates > 0 && !args.quiet {
         eprintln!(
             "photons: {} estimates, {:.1}% cut short by the largest radius",
             st.photon_estimates,

@@ -60,6 +60,7 @@ fn photon_params(p: &schema::PhotonSettings, lights: &[LightSpec]) -> PhotonPara
         gather: p.gather,
         caustic_gather: p.caustic_gather,
         max_radius: p.max_radius,
+        alpha: p.alpha,
         caustic_cone: match p.caustic_filter {
             schema::PhotonFilter::Box => None,
             schema::PhotonFilter::Cone { k } => Some(k),
@@ -174,6 +175,8 @@ pub fn compile(
             schema::IntegratorKind::Whitted => IntegratorKind::Whitted,
             schema::IntegratorKind::Path => IntegratorKind::Path,
             schema::IntegratorKind::Photon => IntegratorKind::Photon,
+            schema::IntegratorKind::Ppm => IntegratorKind::Ppm,
+            schema::IntegratorKind::PathPpm => IntegratorKind::PathPpm,
         },
         sampler: match r.sampler {
             schema::SamplerKind::Independent => SamplerKind::Independent,

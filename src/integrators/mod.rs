@@ -3,13 +3,17 @@
 //! and then asked for the radiance of camera samples by every worker.
 
 pub mod path;
+pub mod path_ppm;
 pub mod photon;
+pub mod ppm;
 pub mod shadow;
 pub mod trace_log;
 pub mod whitted;
 
 pub use path::PathTracer;
+pub use path_ppm::PathPpm;
 pub use photon::PhotonMapper;
+pub use ppm::Ppm;
 pub use trace_log::TraceLog;
 pub use whitted::Whitted;
 
@@ -50,6 +54,10 @@ pub enum Integrator<'a> {
     Path(PathTracer<'a>),
     /// Photon mapping ([`PhotonMapper`]); its maps are built by `prepare`.
     Photon(Box<PhotonMapper<'a>>),
+    /// Progressive photon mapping ([`Ppm`]); fresh maps every pass.
+    Ppm(Box<Ppm<'a>>),
+    /// Path tracing with progressive photon-mapped caustics ([`PathPpm`]).
+    PathPpm(Box<PathPpm<'a>>),
 }
 
 impl<'a> Integrator<'a> {
@@ -69,15 +77,47 @@ impl<'a> Integrator<'a> {
             IntegratorKind::Photon => {
                 Integrator::Photon(Box::new(PhotonMapper::new(scene, photon_cache)))
             }
+            IntegratorKind::Ppm => Integrator::Ppm(Box::new(Ppm::new(scene))),
+            IntegratorKind::PathPpm => Integrator::PathPpm(Box::new(PathPpm::new(scene))),
         }
     }
 
-    /// The photon maps and how they were built, for the photon integrator.
+    /// The photon maps and how they were built: the photon integrator's, or the current pass's
+    /// of a progressive one.
     #[must_use]
     pub fn photon_maps(&self) -> Option<&photon::PhotonMaps> {
         match self {
             Integrator::Photon(p) => Some(p.maps()),
+            Integrator::Ppm(p) => Some(p.photons().maps()),
+            Integrator::PathPpm(p) => Some(p.photons().maps()),
             _ => None,
+        }
+    }
+
+    /// The per-pass photon maps of a progressive integrator (`None` for the others).
+    #[must_use]
+    pub fn progressive(&self) -> Option<&photon::ProgressivePhotons<'a>> {
+        match self {
+            Integrator::Ppm(p) => Some(p.photons()),
+            Integrator::PathPpm(p) => Some(p.photons()),
+            _ => None,
+        }
+    }
+
+    /// True when every sample index is a pass with its own shared state (photon maps), which
+    /// [`Integrator::begin_pass`] must set up before that sample of any pixel is taken.
+    #[must_use]
+    pub fn is_progressive(&self) -> bool {
+        self.progressive().is_some()
+    }
+
+    /// Sets up the shared state of pass `sample` (progressive integrators: that pass's photon
+    /// maps, built in parallel on the calling thread pool); a no-op for the others.
+    pub fn begin_pass(&mut self, sample: u32) {
+        match self {
+            Integrator::Ppm(p) => p.begin_pass(sample),
+            Integrator::PathPpm(p) => p.begin_pass(sample),
+            _ => {}
         }
     }
 
@@ -96,6 +136,8 @@ impl<'a> Integrator<'a> {
             Integrator::Whitted(w) => w.li(ray, sampler, counters, log),
             Integrator::Path(p) => p.li(ray, sampler, counters, log),
             Integrator::Photon(p) => p.li(ray, sampler, counters, log),
+            Integrator::Ppm(p) => p.li(ray, sampler, counters, log),
+            Integrator::PathPpm(p) => p.li(ray, sampler, counters, log),
         }
     }
 }

@@ -6,6 +6,7 @@
 use glam::Vec3;
 
 use super::Counters;
+use super::photon::PhotonMap;
 use super::shadow::{LightConnection, RayCone, connect_light};
 use super::trace_log::{RayKind, ShadowRecord, TraceLog};
 use crate::geometry::Ray;
@@ -16,6 +17,23 @@ use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
 /// Bounces after which Russian roulette may end a path.
 const ROULETTE_DEPTH: u32 = 3;
+
+/// With a caustic map: the vertices after fewer than this many diffuse bounces read it (and
+/// the one that reads the global map); deeper ones (dim, after several diffuse bounces) leave
+/// their caustics to emitters hit by chance.
+pub const CAUSTIC_MAP_DEPTH: u32 = 2;
+
+/// Photon maps a camera path reads ([`PathTracer::li_with_maps`]); none by default.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PathMaps<'m> {
+    /// Light → specular⁺ → diffuse photons.
+    pub caustic: Option<&'m PhotonMap>,
+    /// Photons after at least one diffuse bounce.
+    pub global: Option<&'m PhotonMap>,
+    /// Diffuse bounces a path makes before the vertex that reads `global` (0: the first
+    /// diffuse hit, as progressive photon mapping; 1: after one bounce, as final gathering).
+    pub global_at: u32,
+}
 
 /// The path tracer over a compiled scene.
 #[derive(Debug)]
@@ -57,6 +75,30 @@ impl<'a> PathTracer<'a> {
         ray: Ray,
         sampler: &mut Sampler,
         counters: &mut Counters,
+        log: Option<&mut TraceLog>,
+    ) -> Vec3 {
+        self.li_with_maps(PathMaps::default(), ray, sampler, counters, log)
+    }
+
+    /// [`PathTracer::li`] reading photon maps (the progressive integrators):
+    /// - `maps.caustic` (light → specular⁺ → diffuse photons) at the first
+    ///   [`CAUSTIC_MAP_DEPTH`] vertices with a non-delta part (where the path may still
+    ///   scatter); an emitter reached by delta bounces after such a vertex is then not
+    ///   counted, since the map holds exactly those paths;
+    /// - `maps.global` at the vertices after `maps.global_at` diffuse bounces: there direct
+    ///   light (next-event estimation, without MIS), caustics and the global map (light that
+    ///   made at least one diffuse bounce) account for all the light of the scene's emitters
+    ///   leaving through the non-delta part, so a path that scatters on from there counts only
+    ///   the background it escapes to (the maps hold no light from it).
+    ///
+    /// The parts are disjoint and together make every path, so the image converges to the
+    /// path tracer's as the maps' radii shrink.
+    pub fn li_with_maps(
+        &self,
+        maps: PathMaps<'_>,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
         mut log: Option<&mut TraceLog>,
     ) -> Vec3 {
         let scene = self.scene;
@@ -72,6 +114,14 @@ impl<'a> PathTracer<'a> {
         let mut prev_pdf = 0.0f32;
         let mut prev_p = ray.origin;
         let mut diffuse_bounces = 0u32;
+        // Delta bounces since the last non-delta one (`None` before any): an emitter hit with
+        // at least one is a caustic path, which `caustics` accounts for when it was read at
+        // that non-delta vertex (`map_read`).
+        let mut since_local: Option<u32> = None;
+        let mut map_read = false;
+        // After a non-delta bounce from a vertex that read the global map, the emitters' light
+        // is accounted for: only the background still counts.
+        let mut background_only = false;
         let mut kind = RayKind::Camera;
         let mut parent: Option<usize> = None;
         let mut depth = 0u32;
@@ -95,6 +145,8 @@ impl<'a> PathTracer<'a> {
             let Some(m) = object.material else {
                 // An emitter (seen from outside only); it absorbs what reaches it.
                 let le = match object.light.map(|i| (i, scene.lights[i as usize])) {
+                    Some(_) if background_only => Vec3::ZERO,
+                    Some(_) if map_read && since_local.is_some_and(|n| n > 0) => Vec3::ZERO,
                     Some((i, Light::Sphere { radiance, .. })) if wo.dot(sp.ng) > 0.0 => {
                         let w = if specular {
                             1.0
@@ -134,12 +186,13 @@ impl<'a> PathTracer<'a> {
             };
             let bsdf = sh.bsdf;
             let may_scatter = diffuse_bounces < params.diffuse_depth;
+            let local = bsdf.has_local() && !background_only;
+            let read_global =
+                local && may_scatter && maps.global.is_some() && diffuse_bounces == maps.global_at;
             // Next-event estimation through the non-delta part.
             let u_light = sampler.next_1d();
             let u_point = sampler.next_2d();
-            if bsdf.has_local()
-                && let Some((index, pmf)) = self.lights.sample(u_light)
-            {
+            if local && let Some((index, pmf)) = self.lights.sample(u_light) {
                 let c = self.direct(
                     &sp,
                     wo,
@@ -148,12 +201,33 @@ impl<'a> PathTracer<'a> {
                     index,
                     pmf,
                     u_point,
-                    may_scatter,
+                    may_scatter && !read_global,
                     counters,
                     log.as_deref_mut(),
                     node,
                 );
                 l += beta * c;
+            }
+            let read_caustic = local
+                && may_scatter
+                && maps.caustic.is_some()
+                && (diffuse_bounces < CAUSTIC_MAP_DEPTH || read_global);
+            if read_caustic || read_global {
+                let caustic = maps.caustic.filter(|_| read_caustic);
+                let global = maps.global.filter(|_| read_global);
+                for (name, map) in [("caustic", caustic), ("global", global)] {
+                    let Some(map) = map else { continue };
+                    let e = map.estimate(sp.p, wo, &fr, &bsdf);
+                    counters.photon_estimates += 1;
+                    l += beta * e.radiance;
+                    if log.is_some() {
+                        let text = format!(
+                            "{name} map: {} photons within r = {:.4} → ({:.4}, {:.4}, {:.4})",
+                            e.found, e.radius, e.radiance.x, e.radiance.y, e.radiance.z
+                        );
+                        TraceLog::note(log.as_deref_mut(), node, &text);
+                    }
+                }
             }
             // Continue the path by sampling the BSDF.
             let u_lobe = sampler.next_1d();
@@ -197,6 +271,13 @@ impl<'a> PathTracer<'a> {
                 cone.scatter(&ray, hit.t, s.pdf)
             };
             specular = s.delta;
+            since_local = if s.delta {
+                since_local.map(|n| n + 1)
+            } else {
+                map_read = read_caustic;
+                background_only |= read_global;
+                Some(0)
+            };
             prev_pdf = s.pdf;
             prev_p = sp.p;
             kind = match (s.delta, s.transmitted) {

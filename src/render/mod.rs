@@ -10,5 +10,6 @@ pub mod tiles;
 pub use film::Film;
 pub use pixel_sums::PixelSums;
 pub use tiles::{
-    Region, RenderError, RenderJob, RenderOptions, RenderOutput, RenderStats, render, trace_pixel,
+    ProgressiveStats, Region, RenderError, RenderJob, RenderOptions, RenderOutput, RenderStats,
+    render, trace_pixel,
 };

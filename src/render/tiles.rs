@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use super::Film;
 use super::pixel_sums::PixelSums;
 use crate::geometry::Ray;
+use crate::integrators::photon::PassTotals;
 use crate::integrators::{Counters, Integrator, TraceLog};
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
@@ -66,10 +67,22 @@ pub struct RenderStats {
     pub photon_estimates: u64,
     /// Estimates whose k-nearest search the largest radius cut short.
     pub photon_radius_cut: u64,
+    /// Progressive integrators: the passes' photon maps.
+    pub progressive: Option<ProgressiveStats>,
     /// Worker threads used.
     pub threads: usize,
     /// Wall-clock time of the render (excluding scene loading).
     pub elapsed: Duration,
+}
+
+/// What the passes of a progressive integrator traced.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ProgressiveStats {
+    /// Photon maps built, photons emitted and stored over all passes, and the time it took.
+    pub totals: PassTotals,
+    /// The fraction of the k-nearest radius the last pass taken read (1 for the first pass;
+    /// it shrinks by Knaus & Zwicker's schedule).
+    pub last_shrink: f32,
 }
 
 /// A rendered film with its statistics.
@@ -185,13 +198,17 @@ impl<'a> RenderJob<'a> {
             .build()
             .map_err(|e| RenderError::Threads(threads, e.to_string()))?;
         let tiles = tile_grid(region);
-        // Shared state (photon maps) is built on the job's own workers.
-        let integrator =
-            pool.install(|| Integrator::prepare_with(scene, options.photon_cache.as_deref()));
         let range = options
             .samples
             .clone()
             .unwrap_or(0..scene.params.samples_per_pixel);
+        // Shared state (photon maps; a progressive integrator's first pass) is built on the
+        // job's own workers.
+        let integrator = pool.install(|| {
+            let mut i = Integrator::prepare_with(scene, options.photon_cache.as_deref());
+            i.begin_pass(range.start);
+            i
+        });
         if range.end > scene.params.samples_per_pixel || range.start > range.end {
             return Err(RenderError::SampleRange(
                 range.start,
@@ -240,16 +257,32 @@ impl<'a> RenderJob<'a> {
         self.done
     }
 
-    /// Takes the next `n` samples of every pixel (fewer if fewer remain; none is a no-op).
+    /// Takes the next `n` samples of every pixel (fewer if fewer remain; none is a no-op). A
+    /// progressive integrator takes them one sample index (one pass) at a time, setting up
+    /// each pass's shared state first.
     ///
     /// # Errors
     /// [`RenderError::Cancelled`] when the cancel flag is raised before the pass ends; the job
-    /// then still holds the image of its previous complete pass.
+    /// then still holds the image of the samples it completed before (whole sample indices).
     pub fn render_pass(&mut self, n: u32) -> Result<(), RenderError> {
         let end = self.done + n.min(self.samples_per_pixel() - self.done);
         if self.is_cancelled() {
             return Err(RenderError::Cancelled);
         }
+        if !self.integrator.is_progressive() {
+            return self.sweep(end);
+        }
+        while self.done < end {
+            let integrator = &mut self.integrator;
+            let sample = self.done;
+            self.pool.install(|| integrator.begin_pass(sample));
+            self.sweep(sample + 1)?;
+        }
+        Ok(())
+    }
+
+    /// Takes samples `done..end` of every pixel in one sweep over the tiles.
+    fn sweep(&mut self, end: u32) -> Result<(), RenderError> {
         if end == self.done {
             return Ok(());
         }
@@ -341,6 +374,10 @@ impl<'a> RenderJob<'a> {
             * u64::from(self.region.height)
             * u64::from(self.done - self.first);
         stats.elapsed = self.start.elapsed();
+        stats.progressive = self.integrator.progressive().map(|p| ProgressiveStats {
+            totals: p.totals(),
+            last_shrink: p.shrink(self.done.saturating_sub(1)),
+        });
         let sums = std::mem::replace(&mut self.sums, PixelSums::new(0, 0));
         RenderOutput {
             film: sums.to_film(),
@@ -493,7 +530,8 @@ pub fn trace_pixel_with(
     let mut sampler = Sampler::new(p.sampler, p.seed, p.samples_per_pixel);
     let ray = camera_sample(scene, &mut sampler, x, y, sample);
     let mut log = TraceLog::default();
-    let integrator = Integrator::prepare_with(scene, photon_cache);
+    let mut integrator = Integrator::prepare_with(scene, photon_cache);
+    integrator.begin_pass(sample);
     let l = integrator.li(ray, &mut sampler, &mut Counters::default(), Some(&mut log));
     Ok((log, l))
 }

@@ -67,7 +67,10 @@ pub struct PhotonParams {
     /// k of caustic-map estimates.
     pub caustic_gather: u32,
     /// Largest estimate radius (scene units); `None`: chosen per map from the scene's size.
+    /// Progressive integrators: the first pass's radius.
     pub max_radius: Option<f32>,
+    /// Progressive integrators: Knaus & Zwicker's radius shrink α, in (0, 1).
+    pub alpha: f32,
     /// Cone-filter constant of caustic estimates; `None`: box filter.
     pub caustic_cone: Option<f32>,
     /// Diffuse bounces before the global map stores a photon (≥ 1).
@@ -87,6 +90,10 @@ pub enum IntegratorKind {
     Path,
     /// Photon mapping (`integrators::PhotonMapper`).
     Photon,
+    /// Progressive photon mapping (`integrators::Ppm`).
+    Ppm,
+    /// Path tracing with progressive photon-mapped caustics (`integrators::PathPpm`).
+    PathPpm,
 }
 
 /// How image textures are filtered (see the scene schema's `texture_filter`).

@@ -547,6 +547,15 @@ impl<'a> Validator<'a> {
         if let Some(r) = p.max_radius {
             self.positive("photons.max_radius", r, "the radius");
         }
+        if self.finite("photons.alpha", p.alpha) && !(p.alpha > 0.0 && p.alpha < 1.0) {
+            self.out.push(
+                Diagnostic::error(
+                    "photons.alpha",
+                    format!("must be within (0, 1), found {}", p.alpha),
+                )
+                .with_help("Knaus and Zwicker suggest 2/3: each pass keeps (i + α)/(i + 1) of the previous radius²"),
+            );
+        }
         if let PhotonFilter::Cone { k } = p.caustic_filter
             && self.finite("photons.caustic_filter.k", k)
             && !(1.0..=1e6).contains(&k)

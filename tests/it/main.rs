@@ -22,6 +22,7 @@ mod path_tracer;
 mod photon_map;
 mod photon_tools;
 mod primitives;
+mod progressive;
 mod queries;
 mod render_snapshots;
 mod reported;

@@ -41,6 +41,7 @@ fn direct_photons(scene: &RenderScene, n: u64) -> (Vec<Photon>, TraceCounts) {
         kind: MapKind::Global,
         min_bounces: 0,
         max_bounces: 0,
+        pass: None,
     };
     let (photons, counts) = trace_map(scene, &[emitter], &CausticTargets::default(), settings);
     (photons, counts[0])

@@ -182,6 +182,7 @@ fn hash_params(h: &mut Fnv, params: &RenderParams) {
         gather: _,
         caustic_gather: _,
         max_radius: _,
+        alpha: _,
         caustic_cone: _,
         min_bounces,
         final_gather: _,

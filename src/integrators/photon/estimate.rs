@@ -15,6 +15,15 @@
 //!   stored normal must face the query's normal (`nₚ·ng > 0.1`) and their direction must arrive
 //!   from the side of `ωo` (`ωₚ·ng > 10⁻²`), the tests of Mitsuba 0.6's photon map (hard case 12).
 //!
+//! Progressive passes ([`PhotonMap::set_shrink`], `integrators::photon::progressive`) read
+//! only the photons strictly inside `s·r`, `s` ∈ (0, 1], over the area `π (s r)² c`. Given
+//! `r`, the k − 1 photons inside the k-nearest disc are independent draws from the density
+//! restricted to it, so the count inside `s·r` is (k − 1)·P(inside `s·r` | inside `r`) on
+//! average: for a uniform density the estimate stays unbiased, and in general it is the
+//! density averaged over the smaller disc. As `s` shrinks by Knaus & Zwicker's schedule the
+//! blur vanishes, while the disc still follows the local photon density (sharp where photons
+//! crowd, wide where they are sparse), which a single radius per pass cannot do.
+//!
 //! A radius of 0 (all k photons at one point) is raised to [`MIN_RADIUS_FRACTION`] of the
 //! largest radius, so coincident photons give a finite estimate.
 
@@ -64,6 +73,9 @@ pub struct PhotonMap {
     k: usize,
     max_radius: f32,
     kernel: Kernel,
+    /// Progressive passes: estimates use only the photons within this fraction of the k-nearest
+    /// radius (1: the plain k-nearest estimate).
+    shrink: f32,
 }
 
 /// One radiance estimate and how it was made (for `debug-pixel` and the summary).
@@ -93,7 +105,21 @@ impl PhotonMap {
             k: k.max(1),
             max_radius,
             kernel,
+            shrink: 1.0,
         }
+    }
+
+    /// Makes every later estimate a progressive pass's: it reads only the photons within
+    /// `shrink` ∈ (0, 1] times the k-nearest radius `r` (the largest radius when fewer than k
+    /// are found), over the area of that smaller disc (see the module docs).
+    pub fn set_shrink(&mut self, shrink: f32) {
+        self.shrink = shrink.clamp(f32::MIN_POSITIVE, 1.0);
+    }
+
+    /// The fraction of the k-nearest radius estimates read (1 unless a progressive pass).
+    #[must_use]
+    pub fn shrink(&self) -> f32 {
+        self.shrink
     }
 
     /// The stored photons.
@@ -167,25 +193,18 @@ impl PhotonMap {
                 (heap.max_dist2().unwrap_or(max2), far.map(|n| n.index))
             };
             let min_r = self.max_radius * MIN_RADIUS_FRACTION;
-            let r2 = r2.max(min_r * min_r);
+            let r2 = r2.max(min_r * min_r) * self.shrink * self.shrink;
             let r = r2.sqrt();
             let photons = self.tree.items();
             let mut sum = Vec3::ZERO;
             for n in heap.iter() {
-                if Some(n.index) == skip {
+                if Some(n.index) == skip || (self.shrink < 1.0 && n.dist2 >= r2) {
                     continue;
                 }
                 let ph = &photons[n.index as usize];
-                if ph.normal().dot(ng) <= 0.1 {
-                    continue;
+                if let Some((wi, cos_g)) = accept(ph, ng) {
+                    sum += value(ph, wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r);
                 }
-                let wi = -ph.direction();
-                let cos_g = wi.dot(ng);
-                if cos_g <= 1e-2 {
-                    continue;
-                }
-                let w = self.kernel.weight(n.dist2.sqrt(), r);
-                sum += value(ph, wi, cos_g) * w;
             }
             let area = std::f32::consts::PI * r2 * self.kernel.normalisation();
             Estimate {
@@ -196,6 +215,19 @@ impl PhotonMap {
             }
         })
     }
+}
+
+/// The side tests of an estimate at a point of geometric normal `ng`: the photon's incoming
+/// direction `ωₚ` and `cos θg = ωₚ·ng`, or `None` when it landed on another surface (stored
+/// normal `nₚ·ng ≤ 0.1`) or arrived from the other side (`ωₚ·ng ≤ 10⁻²`).
+#[inline]
+fn accept(ph: &Photon, ng: Vec3) -> Option<(Vec3, f32)> {
+    if ph.normal().dot(ng) <= 0.1 {
+        return None;
+    }
+    let wi = -ph.direction();
+    let cos_g = wi.dot(ng);
+    (cos_g > 1e-2).then_some((wi, cos_g))
 }
 
 /// Precomputed irradiance for final gathering (Christensen, "Faster Photon Map Global

@@ -15,6 +15,7 @@ use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
 use crate::photon::{KdTree, Photon};
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
+use crate::sampling::rng::mix64;
 
 /// Photons per parallel work item.
 const BATCH: u64 = 2048;
@@ -148,18 +149,23 @@ impl std::fmt::Display for PhotonSummary {
     }
 }
 
-/// Stream keys of photon paths: distinct per map and light, never shared with pixels.
-fn stream(kind: MapKind, light: usize) -> u64 {
+/// Stream keys of photon paths: distinct per map, light and progressive pass, never shared
+/// with pixels.
+fn stream(kind: MapKind, light: usize, pass: Option<u32>) -> u64 {
     let k = match kind {
         MapKind::Caustic => 1u64,
         MapKind::Global => 2,
     };
-    (k << 40) | light as u64
+    let key = (k << 40) | light as u64;
+    match pass {
+        None => key,
+        Some(p) => key ^ mix64(u64::from(p).wrapping_add(0x9E37_79B9_7F4A_7C15)) & !(1 << 48),
+    }
 }
 
-/// Stream key of the per-(map, light) lattice rotation.
-fn rotation_stream(kind: MapKind, light: usize) -> u64 {
-    stream(kind, light) | (1 << 48)
+/// Stream key of the per-(map, light, pass) lattice rotation.
+fn rotation_stream(kind: MapKind, light: usize, pass: Option<u32>) -> u64 {
+    stream(kind, light, pass) | (1 << 48)
 }
 
 /// Traces `emitters`' photons (light `l`'s from stream (settings' map, `l`), caustic ones aimed
@@ -189,7 +195,7 @@ pub fn trace_map(
             let mut cones = Vec::new();
             let e = &emitters[l];
             for i in start..end {
-                sampler.start_stream(stream(settings.kind, l), i);
+                sampler.start_stream(stream(settings.kind, l, settings.pass), i);
                 counts.emitted += 1;
                 let emitted = match settings.kind {
                     MapKind::Global => e.global(i, &mut sampler),
@@ -273,7 +279,7 @@ pub fn auto_radius(area: f64, stored: u64, k: u32, kind: MapKind) -> f32 {
 }
 
 /// Both maps of a render (each `None` when not built) and how they were built.
-#[derive(Debug)]
+#[derive(Debug, Default)]
 pub struct PhotonMaps {
     /// Light → specular⁺ → diffuse photons.
     pub caustic: Option<PhotonMap>,
@@ -289,6 +295,20 @@ pub struct PhotonMaps {
 /// Traces and builds the maps the scene's `photons` settings ask for.
 #[must_use]
 pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
+    build_maps_with(scene, None, true, true)
+}
+
+/// Traces and builds the caustic and/or global maps of the scene's `photons` settings from the
+/// photon streams of progressive pass `pass` (`None`: the photon integrator's one set; only
+/// then is irradiance precomputed for final gathering). Maps estimate from k nearest photons
+/// within an automatic or given largest radius; progressive integrators then fix the radius.
+#[must_use]
+pub fn build_maps_with(
+    scene: &RenderScene,
+    pass: Option<u32>,
+    want_caustic: bool,
+    want_global: bool,
+) -> PhotonMaps {
     let p = &scene.params.photons;
     let mut summary = PhotonSummary::default();
     let weights: Vec<f64> = scene
@@ -322,7 +342,9 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
             .iter()
             .zip(counts)
             .enumerate()
-            .map(|(l, (light, &n))| LightEmitter::new(*light, n, sampler, rotation_stream(kind, l)))
+            .map(|(l, (light, &n))| {
+                LightEmitter::new(*light, n, sampler, rotation_stream(kind, l, pass))
+            })
             .collect()
     };
     let area = diffuse_area(scene);
@@ -331,7 +353,10 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
     let t0 = Instant::now();
     let mut build_time = Duration::ZERO;
     let mut memory = 0;
-    let caustic = if targets.is_empty() {
+    let caustic = if !want_caustic {
+        summary.caustic_skipped = Some("not used by this integrator".into());
+        None
+    } else if targets.is_empty() {
         summary.caustic_skipped = Some("no object reflects or transmits".into());
         None
     } else if caustic_counts.iter().all(|&c| c == 0) {
@@ -343,6 +368,7 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
             kind: MapKind::Caustic,
             min_bounces: 0,
             max_bounces: p.max_bounces,
+            pass,
         };
         let (photons, counts) = trace_map(scene, &e, &targets, settings);
         summary.caustic = counts;
@@ -362,15 +388,20 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
             &mut memory,
         )
     };
-    let global = if global_counts.iter().all(|&c| c == 0) {
+    let global = if !want_global {
+        summary.global_skipped = Some("not used by this integrator".into());
+        None
+    } else if global_counts.iter().all(|&c| c == 0) {
         summary.global_skipped = Some("0 global photons".into());
         None
     } else {
         let e = emitters(MapKind::Global, &global_counts, &mut sampler);
         let settings = TraceSettings {
             kind: MapKind::Global,
-            min_bounces: p.min_bounces,
+            // Progressive integrators read the global map for all light after a diffuse bounce.
+            min_bounces: if pass.is_some() { 1 } else { p.min_bounces },
             max_bounces: p.max_bounces,
+            pass,
         };
         let (photons, counts) = trace_map(scene, &e, &targets, settings);
         summary.global = counts;
@@ -390,7 +421,11 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
     summary.trace_time = t0.elapsed().saturating_sub(build_time);
     summary.build_time = build_time;
     summary.memory = memory;
-    let irradiance = precompute_irradiance(scene, &caustic, &global, &mut summary);
+    let irradiance = if pass.is_none() {
+        precompute_irradiance(scene, &caustic, &global, &mut summary)
+    } else {
+        None
+    };
     PhotonMaps {
         caustic,
         global,

@@ -20,10 +20,12 @@ pub mod cache;
 pub mod emit;
 pub mod estimate;
 pub mod maps;
+pub mod progressive;
 pub mod trace;
 
 pub use estimate::{Estimate, IrradianceCache, Kernel, PhotonMap};
 pub use maps::{PhotonMaps, PhotonSummary, build_maps};
+pub use progressive::{MapSet, PassTotals, ProgressivePhotons, RadiusSchedule};
 
 use glam::Vec3;
 
@@ -93,6 +95,8 @@ pub struct PhotonMapper<'a> {
     scene: &'a RenderScene,
     lights: LightSampler,
     pixel_spread: f32,
+    /// Final-gather rays per camera hit (0: read the global map directly).
+    final_gather: u32,
     maps: PhotonMaps,
 }
 
@@ -105,6 +109,7 @@ impl<'a> PhotonMapper<'a> {
             scene,
             lights: LightSampler::new(&scene.lights),
             pixel_spread: scene.pixel_spread(),
+            final_gather: scene.params.photons.final_gather,
             maps: cache::build_or_load(scene, cache),
         }
     }
@@ -121,6 +126,18 @@ impl<'a> PhotonMapper<'a> {
     /// followed by sampling one delta lobe after that.
     pub fn li(
         &self,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        log: Option<&mut TraceLog>,
+    ) -> Vec3 {
+        self.li_from(&self.maps, ray, sampler, counters, log)
+    }
+
+    /// [`PhotonMapper::li`] reading `maps` instead of the integrator's own.
+    pub fn li_from(
+        &self,
+        maps: &PhotonMaps,
         ray: Ray,
         sampler: &mut Sampler,
         counters: &mut Counters,
@@ -187,7 +204,8 @@ impl<'a> PhotonMapper<'a> {
             }
             if sh.bsdf.has_local() {
                 let full = beta.max_element() >= FINAL_GATHER_MIN_WEIGHT;
-                let (c, note) = self.local(&sp, &sh, wo, full, sampler, counters, log.is_some());
+                let (c, note) =
+                    self.local(maps, &sp, &sh, wo, full, sampler, counters, log.is_some());
                 gathered = beta * c;
                 l += gathered;
                 if let Some(text) = note {
@@ -282,6 +300,7 @@ impl<'a> PhotonMapper<'a> {
     #[allow(clippy::too_many_arguments)]
     fn local(
         &self,
+        maps: &PhotonMaps,
         sp: &SurfacePoint,
         sh: &ShadingPoint,
         wo: Vec3,
@@ -292,7 +311,7 @@ impl<'a> PhotonMapper<'a> {
     ) -> (Vec3, Option<String>) {
         let fr = frame(sh);
         let direct = self.direct(sp, &fr, sh, wo, sampler, counters);
-        if !full && let Some(l) = self.cached_radiance(sp, &fr, sh, wo) {
+        if !full && let Some(l) = cached_radiance(maps, sp, &fr, sh, wo) {
             let note = describe.then(|| {
                 format!(
                     "direct ({:.4}, {:.4}, {:.4}); caustic + indirect from precomputed irradiance ({:.4}, {:.4}, {:.4}) (dim branch)",
@@ -301,20 +320,18 @@ impl<'a> PhotonMapper<'a> {
             });
             return (direct + l, note);
         }
-        let caustic = self
-            .maps
+        let caustic = maps
             .caustic
             .as_ref()
             .map(|m| counted(m, sp.p, wo, &fr, sh, counters));
-        let gather = self.scene.params.photons.final_gather;
+        let gather = self.final_gather;
         let (indirect, global) = if gather > 0 {
             (
-                self.final_gather(sp, &fr, sh, wo, gather, sampler, counters),
+                self.final_gather(maps, sp, &fr, sh, wo, gather, sampler, counters),
                 None,
             )
         } else {
-            let e = self
-                .maps
+            let e = maps
                 .global
                 .as_ref()
                 .map(|m| counted(m, sp.p, wo, &fr, sh, counters));
@@ -354,19 +371,6 @@ impl<'a> PhotonMapper<'a> {
         (direct + caustic_l + indirect, note)
     }
 
-    /// Caustic and indirect radiance towards `wo` from the precomputed irradiance (both maps),
-    /// `f(ωo, n) · E`, when final gathering built it and a point lies near on the same surface.
-    fn cached_radiance(
-        &self,
-        sp: &SurfacePoint,
-        fr: &ShadingFrame,
-        sh: &ShadingPoint,
-        wo: Vec3,
-    ) -> Option<Vec3> {
-        let e = self.maps.irradiance.as_ref()?.lookup(sp.p, fr.ng)?;
-        Some(sh.bsdf.eval(wo, fr.ns, fr, TransportMode::Radiance) * e)
-    }
-
     /// Direct light at a vertex by one shadow ray to a light chosen in proportion to power.
     fn direct(
         &self,
@@ -394,6 +398,7 @@ impl<'a> PhotonMapper<'a> {
     #[allow(clippy::too_many_arguments)]
     fn final_gather(
         &self,
+        maps: &PhotonMaps,
         sp: &SurfacePoint,
         fr: &ShadingFrame,
         sh: &ShadingPoint,
@@ -433,13 +438,10 @@ impl<'a> PhotonMapper<'a> {
                 let gfr = frame(&gsh);
                 if gsh.bsdf.has_local() {
                     let mut lo = self.direct(&gp, &gfr, &gsh, gwo, sampler, counters);
-                    if let Some(l) = self.cached_radiance(&gp, &gfr, &gsh, gwo) {
+                    if let Some(l) = cached_radiance(maps, &gp, &gfr, &gsh, gwo) {
                         lo += l;
                     } else {
-                        for map in [&self.maps.caustic, &self.maps.global]
-                            .into_iter()
-                            .flatten()
-                        {
+                        for map in [&maps.caustic, &maps.global].into_iter().flatten() {
                             lo += counted(map, gp.p, gwo, &gfr, &gsh, counters).radiance;
                         }
                     }
@@ -468,6 +470,19 @@ impl<'a> PhotonMapper<'a> {
         }
         sum / n as f32
     }
+}
+
+/// Caustic and indirect radiance towards `wo` from the precomputed irradiance (both maps),
+/// `f(ωo, n) · E`, when final gathering built it and a point lies near on the same surface.
+fn cached_radiance(
+    maps: &PhotonMaps,
+    sp: &SurfacePoint,
+    fr: &ShadingFrame,
+    sh: &ShadingPoint,
+    wo: Vec3,
+) -> Option<Vec3> {
+    let e = maps.irradiance.as_ref()?.lookup(sp.p, fr.ng)?;
+    Some(sh.bsdf.eval(wo, fr.ns, fr, TransportMode::Radiance) * e)
 }
 
 /// `map`'s estimate at `p` towards `wo` through `sh`'s BSDF, counted in `counters` (estimates

@@ -70,6 +70,9 @@ pub struct TraceSettings {
     pub min_bounces: u32,
     /// Most bounces before a path is dropped.
     pub max_bounces: u32,
+    /// The progressive pass whose independent photon streams to draw (`None`: the photon
+    /// integrator's one set of maps).
+    pub pass: Option<u32>,
 }
 
 /// Traces one photon from `ray` carrying `power`, appending what it stores to `out` and
