@@ -44,6 +44,85 @@ impl Counters {
     }
 }
 
+/// How the light of a camera sample reached the camera, by the non-delta (diffuse or glossy)
+/// scattering events on its way, counted from the camera: the EXR layers of `--layers`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LightPath {
+    /// None: emitters and the background seen directly or through mirrors and glass.
+    Specular = 0,
+    /// One, lit straight from an emitter or the background (seen directly or in a mirror).
+    Direct = 1,
+    /// One, lit through mirrors or glass (light → specular⁺ → diffuse: caustics).
+    Caustic = 2,
+    /// Two or more.
+    Indirect = 3,
+}
+
+impl LightPath {
+    /// Every kind, in layer order.
+    pub const ALL: [LightPath; 4] = [
+        LightPath::Specular,
+        LightPath::Direct,
+        LightPath::Caustic,
+        LightPath::Indirect,
+    ];
+
+    /// The kind of light that reached the camera after `k` non-delta scattering events,
+    /// `via_specular` when it arrived at the first of them through a mirror or glass.
+    #[inline]
+    #[must_use]
+    pub fn classify(k: u32, via_specular: bool) -> Self {
+        match k {
+            0 => LightPath::Specular,
+            1 if via_specular => LightPath::Caustic,
+            1 => LightPath::Direct,
+            _ => LightPath::Indirect,
+        }
+    }
+
+    /// The layer's name (`--layers` and the EXR channel prefix).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            LightPath::Specular => "specular",
+            LightPath::Direct => "direct",
+            LightPath::Caustic => "caustic",
+            LightPath::Indirect => "indirect",
+        }
+    }
+}
+
+/// A camera sample's radiance (W·m⁻²·sr⁻¹ per channel) split by [`LightPath`]; the parts sum
+/// to the sample's value.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Radiance {
+    /// Indexed by `LightPath as usize`.
+    pub parts: [Vec3; 4],
+}
+
+impl Radiance {
+    /// Adds `v` to the part `kind`.
+    #[inline]
+    pub fn add(&mut self, kind: LightPath, v: Vec3) {
+        self.parts[kind as usize] += v;
+    }
+
+    /// The sum of the parts.
+    #[inline]
+    #[must_use]
+    pub fn total(&self) -> Vec3 {
+        self.parts[0] + self.parts[1] + self.parts[2] + self.parts[3]
+    }
+
+    /// Adds every part of `other` scaled by `w`.
+    #[inline]
+    pub fn add_scaled(&mut self, other: &Radiance, w: Vec3) {
+        for (a, b) in self.parts.iter_mut().zip(&other.parts) {
+            *a += *b * w;
+        }
+    }
+}
+
 /// A prepared integrator: shared, immutable state built once per render (light selection
 /// tables today; photon maps later), read by every worker.
 #[derive(Debug)]
@@ -132,6 +211,18 @@ impl<'a> Integrator<'a> {
         counters: &mut Counters,
         log: Option<&mut TraceLog>,
     ) -> Vec3 {
+        self.li_parts(ray, sampler, counters, log).total()
+    }
+
+    /// [`Integrator::li`] split by how the light reached the camera ([`LightPath`]).
+    #[inline]
+    pub fn li_parts(
+        &self,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        log: Option<&mut TraceLog>,
+    ) -> Radiance {
         match self {
             Integrator::Whitted(w) => w.li(ray, sampler, counters, log),
             Integrator::Path(p) => p.li(ray, sampler, counters, log),

@@ -5,10 +5,10 @@
 
 use glam::Vec3;
 
-use super::Counters;
 use super::photon::PhotonMap;
 use super::shadow::{LightConnection, RayCone, connect_light};
 use super::trace_log::{RayKind, ShadowRecord, TraceLog};
+use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{Light, LightSampler, RenderScene, SurfacePoint};
@@ -76,7 +76,7 @@ impl<'a> PathTracer<'a> {
         sampler: &mut Sampler,
         counters: &mut Counters,
         log: Option<&mut TraceLog>,
-    ) -> Vec3 {
+    ) -> Radiance {
         self.li_with_maps(PathMaps::default(), ray, sampler, counters, log)
     }
 
@@ -100,12 +100,12 @@ impl<'a> PathTracer<'a> {
         sampler: &mut Sampler,
         counters: &mut Counters,
         mut log: Option<&mut TraceLog>,
-    ) -> Vec3 {
+    ) -> Radiance {
         let scene = self.scene;
         let params = &scene.params;
         let mut ray = ray;
         let mut cone = RayCone::camera(self.pixel_spread);
-        let mut l = Vec3::ZERO;
+        let mut l = Radiance::default();
         let mut beta = Vec3::ONE;
         // Radiance scale from refraction so far, undone for Russian roulette (pbrt's etaScale).
         let mut eta_scale = 1.0f32;
@@ -131,12 +131,16 @@ impl<'a> PathTracer<'a> {
             counters.rays += 1;
             let node = log.as_deref_mut().map(|lg| {
                 let id = lg.push(depth, kind, &ray, beta, parent);
-                lg.nodes[id].radiance = l;
+                lg.nodes[id].radiance = l.total();
                 id
             });
             root = root.or(node);
             let Some(hit) = scene.geometry.intersect(&ray) else {
-                l += beta * params.background;
+                let via = since_local.is_some_and(|n| n > 0);
+                l.add(
+                    LightPath::classify(diffuse_bounces, via),
+                    beta * params.background,
+                );
                 break;
             };
             let sp = scene.geometry.surface(&ray, &hit);
@@ -159,7 +163,8 @@ impl<'a> PathTracer<'a> {
                     }
                     _ => Vec3::ZERO,
                 };
-                l += beta * le;
+                let via = since_local.is_some_and(|n| n > 0);
+                l.add(LightPath::classify(diffuse_bounces, via), beta * le);
                 if let Some(lg) = log.as_deref_mut() {
                     lg.record_hit(node, scene, &hit, &sp, "light");
                 }
@@ -206,7 +211,7 @@ impl<'a> PathTracer<'a> {
                     log.as_deref_mut(),
                     node,
                 );
-                l += beta * c;
+                l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
             }
             let read_caustic = local
                 && may_scatter
@@ -215,11 +220,15 @@ impl<'a> PathTracer<'a> {
             if read_caustic || read_global {
                 let caustic = maps.caustic.filter(|_| read_caustic);
                 let global = maps.global.filter(|_| read_global);
-                for (name, map) in [("caustic", caustic), ("global", global)] {
+                let first = LightPath::classify(diffuse_bounces + 1, true);
+                for (name, map, kind) in [
+                    ("caustic", caustic, first),
+                    ("global", global, LightPath::Indirect),
+                ] {
                     let Some(map) = map else { continue };
                     let e = map.estimate(sp.p, wo, &fr, &bsdf);
                     counters.photon_estimates += 1;
-                    l += beta * e.radiance;
+                    l.add(kind, beta * e.radiance);
                     if log.is_some() {
                         let text = format!(
                             "{name} map: {} photons within r = {:.4} → ({:.4}, {:.4}, {:.4})",
@@ -292,8 +301,9 @@ impl<'a> PathTracer<'a> {
         if let (Some(lg), Some(root)) = (log, root) {
             // The radiance each logged ray brought back: what the path gathered from it on,
             // divided by the path weight it carried.
+            let total = l.total();
             for n in &mut lg.nodes[root..] {
-                let gathered = l - n.radiance;
+                let gathered = total - n.radiance;
                 n.radiance =
                     Vec3::select(n.weight.cmpgt(Vec3::ZERO), gathered / n.weight, Vec3::ZERO);
             }

@@ -10,11 +10,9 @@
 //! shrinks by Knaus & Zwicker's schedule ([`ProgressivePhotons`]), so the image converges to
 //! the path tracer's expectation.
 
-use glam::Vec3;
-
 use super::path::PathMaps;
 use super::photon::{MapSet, ProgressivePhotons};
-use super::{Counters, PathTracer, TraceLog};
+use super::{Counters, PathTracer, Radiance, TraceLog};
 use crate::geometry::Ray;
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
@@ -60,7 +58,7 @@ impl<'a> PathPpm<'a> {
         sampler: &mut Sampler,
         counters: &mut Counters,
         log: Option<&mut TraceLog>,
-    ) -> Vec3 {
+    ) -> Radiance {
         let m = self.photons.maps();
         let maps = PathMaps {
             caustic: m.caustic.as_ref(),

@@ -8,11 +8,9 @@
 //! emitters' light). The image, the mean of the passes, converges to the exact one, caustics
 //! of point lights included.
 
-use glam::Vec3;
-
 use super::path::PathMaps;
 use super::photon::{MapSet, ProgressivePhotons};
-use super::{Counters, PathTracer, TraceLog};
+use super::{Counters, PathTracer, Radiance, TraceLog};
 use crate::geometry::Ray;
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
@@ -58,7 +56,7 @@ impl<'a> Ppm<'a> {
         sampler: &mut Sampler,
         counters: &mut Counters,
         log: Option<&mut TraceLog>,
-    ) -> Vec3 {
+    ) -> Radiance {
         let m = self.photons.maps();
         let maps = PathMaps {
             caustic: m.caustic.as_ref(),

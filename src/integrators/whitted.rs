@@ -3,9 +3,9 @@
 
 use glam::Vec3;
 
-use super::Counters;
 use super::shadow::{RayCone, shadow_ray};
 use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog};
+use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{Light, RenderScene, ShadingPoint, SurfacePoint};
@@ -51,7 +51,7 @@ impl<'a> Whitted<'a> {
         rng: &mut Sampler,
         counters: &mut Counters,
         log: Option<&mut TraceLog>,
-    ) -> Vec3 {
+    ) -> Radiance {
         let path = Path {
             ray,
             depth: 0,
@@ -69,13 +69,13 @@ impl<'a> Whitted<'a> {
         counters: &mut Counters,
         mut log: Option<&mut TraceLog>,
         parent: Option<usize>,
-    ) -> Vec3 {
+    ) -> Radiance {
         let me = log
             .as_deref_mut()
             .map(|l| l.push(path.depth, path.kind, &path.ray, path.weight, parent));
         let (l, hit_info) = self.shade(&path, rng, counters, log.as_deref_mut(), me);
         if let (Some(log), Some(me)) = (log, me) {
-            log.nodes[me].radiance = l;
+            log.nodes[me].radiance = l.total();
             log.nodes[me].hit = hit_info;
         }
         l
@@ -88,12 +88,12 @@ impl<'a> Whitted<'a> {
         counters: &mut Counters,
         mut log: Option<&mut TraceLog>,
         me: Option<usize>,
-    ) -> (Vec3, Option<TraceHit>) {
+    ) -> (Radiance, Option<TraceHit>) {
         let scene = self.scene;
         counters.rays += 1;
         let ray = &path.ray;
         let Some(hit) = scene.geometry.intersect(ray) else {
-            return (scene.params.background, None);
+            return (seen(scene.params.background), None);
         };
         let sp = scene.geometry.surface(ray, &hit);
         let object = &scene.objects[sp.object as usize];
@@ -125,11 +125,11 @@ impl<'a> Whitted<'a> {
                 Some(Light::Sphere { radiance, .. }) if entering => radiance,
                 _ => Vec3::ZERO,
             };
-            return (l, info);
+            return (seen(l), info);
         };
-        let mut l = Vec3::ZERO;
+        let mut l = Radiance::default();
         if material.has_local() {
-            l += self.direct(
+            let direct = self.direct(
                 &sp,
                 &material,
                 wo,
@@ -140,6 +140,7 @@ impl<'a> Whitted<'a> {
                 log.as_deref_mut(),
                 me,
             );
+            l.add(LightPath::Direct, direct);
         }
         if !material.has_delta() {
             return (l, info);
@@ -151,10 +152,10 @@ impl<'a> Whitted<'a> {
         let lobes = material.delta_lobes(wo, ns, ng, entering);
         let min = scene.params.min_contribution;
         let curvature = scene.geometry.curvature(&hit);
-        let mut spawn = |dir: Vec3, w: Vec3, kind: RayKind, log: Option<&mut TraceLog>| -> Vec3 {
+        let mut spawn = |dir: Vec3, w: Vec3, kind: RayKind, log: Option<&mut TraceLog>| {
             let weight = path.weight * w;
             if weight.max_element() < min || weight.max_element() <= 0.0 {
-                return Vec3::ZERO;
+                return;
             }
             let origin = offset_ray_origin(sp.p, sp.p_error, ng, dir);
             let child = Path {
@@ -169,16 +170,17 @@ impl<'a> Whitted<'a> {
                     if kind == RayKind::Reflect { 2.0 } else { 1.0 },
                 ),
             };
-            w * self.trace(child, rng, counters, log, me)
+            let seen = self.trace(child, rng, counters, log, me);
+            l.add_scaled(&seen, w);
         };
-        l += spawn(
+        spawn(
             lobes.reflect_dir,
             lobes.reflect_weight,
             RayKind::Reflect,
             log.as_deref_mut(),
         );
         if let Some((dir, w)) = lobes.refract {
-            l += spawn(dir, w, RayKind::Refract, log);
+            spawn(dir, w, RayKind::Refract, log);
         }
         (l, info)
     }
@@ -297,4 +299,11 @@ impl Whitted<'_> {
         // Still crossing surfaces after the limit: keep what has come through so far.
         t
     }
+}
+
+/// Radiance of an emitter or the background seen along a camera ray's mirror and glass chain.
+fn seen(l: Vec3) -> Radiance {
+    let mut r = Radiance::default();
+    r.add(LightPath::Specular, l);
+    r
 }

@@ -1,6 +1,7 @@
 //! Rendering: integrators, the tile scheduler, the film and image output.
 
 pub mod film;
+pub mod layers;
 pub mod metrics;
 pub mod output;
 pub mod pixel_sums;
@@ -8,6 +9,7 @@ pub mod progressive;
 pub mod tiles;
 
 pub use film::Film;
+pub use layers::{Layer, UnknownLayer, encode_layers, write_layers};
 pub use pixel_sums::PixelSums;
 pub use tiles::{
     ProgressiveStats, Region, RenderError, RenderJob, RenderOptions, RenderOutput, RenderStats,

@@ -35,6 +35,14 @@ pub enum OutputError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// The EXR layers could not be written.
+    #[error("error: cannot write the layers of `{}`: {reason}", path.display())]
+    Layers {
+        /// The requested path.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
     /// Encoding failed.
     #[error("error: cannot encode `{}`: {source}", path.display())]
     Encode {

@@ -14,7 +14,7 @@ use super::Film;
 use super::pixel_sums::PixelSums;
 use crate::geometry::Ray;
 use crate::integrators::photon::PassTotals;
-use crate::integrators::{Counters, Integrator, TraceLog};
+use crate::integrators::{Counters, Integrator, LightPath, TraceLog};
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
 
@@ -49,6 +49,9 @@ pub struct RenderOptions {
     /// of disjoint ranges merge ([`crate::render::PixelSums::merge`]) into exactly the render
     /// of their union.
     pub samples: Option<Range<u32>>,
+    /// Also keep the radiance of each kind of light path ([`LightPath`]) per pixel, for EXR
+    /// layers (`--layers`).
+    pub light_paths: bool,
     /// Folder of the photon-map cache (`--photon-cache`): the photon integrator reads its maps
     /// from there when they were saved for this scene, and saves them there otherwise.
     pub photon_cache: Option<std::path::PathBuf>,
@@ -92,6 +95,9 @@ pub struct RenderOutput {
     pub film: Film,
     /// The per-pixel sums, squares and counts the image was made from (mergeable).
     pub sums: PixelSums,
+    /// With [`RenderOptions::light_paths`]: the same sums for each kind of light path, in
+    /// [`LightPath::ALL`] order (they add up to `sums`' means).
+    pub parts: Option<Vec<PixelSums>>,
     /// Counters and timing.
     pub stats: RenderStats,
 }
@@ -155,6 +161,8 @@ pub struct RenderJob<'a> {
     progress: ProgressBar,
     /// Per-pixel sample statistics over the samples done, row-major over the region.
     sums: PixelSums,
+    /// The same per kind of light path, when kept.
+    parts: Option<Vec<PixelSums>>,
     /// First sample index this job takes.
     first: u32,
     /// Samples `first..done` are in `sums`.
@@ -227,6 +235,9 @@ impl<'a> RenderJob<'a> {
             cancel: options.cancel.clone(),
             progress,
             sums: PixelSums::new(region.width, region.height),
+            parts: options
+                .light_paths
+                .then(|| new_parts(region.width, region.height)),
             first: range.start,
             done: range.start,
             end: range.end,
@@ -293,7 +304,8 @@ impl<'a> RenderJob<'a> {
                 .par_iter()
                 .map(|t| {
                     let samples = samples.clone();
-                    render_tile(self.scene, integrator, t, samples, cancel, progress)
+                    let parts = self.parts.is_some();
+                    render_tile(self.scene, integrator, t, samples, parts, cancel, progress)
                 })
                 .collect()
         });
@@ -302,8 +314,13 @@ impl<'a> RenderJob<'a> {
         };
         for (tile, r) in self.tiles.iter().zip(results) {
             for i in 0..(tile.width * tile.height) as usize {
-                self.sums
-                    .add_pixel(pixel_index(region, tile, i), &r.sums, i);
+                let at = pixel_index(region, tile, i);
+                self.sums.add_pixel(at, &r.sums, i);
+                if let (Some(mine), Some(theirs)) = (self.parts.as_mut(), r.parts.as_ref()) {
+                    for (m, t) in mine.iter_mut().zip(theirs) {
+                        m.add_pixel(at, t, i);
+                    }
+                }
             }
             self.stats.rays += r.counters.rays;
             self.stats.photon_estimates += r.counters.photon_estimates;
@@ -339,6 +356,9 @@ impl<'a> RenderJob<'a> {
         self.region = region;
         self.tiles = tile_grid(region);
         self.sums = PixelSums::new(region.width, region.height);
+        if self.parts.is_some() {
+            self.parts = Some(new_parts(region.width, region.height));
+        }
         self.done = self.first;
         self.stats = RenderStats {
             threads: self.stats.threads,
@@ -379,9 +399,14 @@ impl<'a> RenderJob<'a> {
             last_shrink: p.shrink(self.done.saturating_sub(1)),
         });
         let sums = std::mem::replace(&mut self.sums, PixelSums::new(0, 0));
+        let parts = self
+            .parts
+            .as_mut()
+            .map(|p| std::mem::replace(p, new_parts(0, 0)));
         RenderOutput {
             film: sums.to_film(),
             sums,
+            parts,
             stats,
         }
     }
@@ -397,6 +422,14 @@ impl Drop for RenderJob<'_> {
     fn drop(&mut self) {
         self.progress.finish_and_clear();
     }
+}
+
+/// Empty sums for each kind of light path.
+fn new_parts(width: u32, height: u32) -> Vec<PixelSums> {
+    LightPath::ALL
+        .iter()
+        .map(|_| PixelSums::new(width, height))
+        .collect()
 }
 
 /// Index in the region-sized buffer of pixel `i` (row-major) of `tile`.
@@ -446,6 +479,7 @@ fn progress_bar(enabled: bool, tiles: u64) -> ProgressBar {
 /// counters.
 struct TileResult {
     sums: PixelSums,
+    parts: Option<Vec<PixelSums>>,
     counters: Counters,
     nan: u64,
 }
@@ -457,6 +491,7 @@ fn render_tile(
     integrator: &Integrator,
     tile: &Region,
     samples: Range<u32>,
+    keep_parts: bool,
     cancel: Option<&AtomicBool>,
     progress: &ProgressBar,
 ) -> Option<TileResult> {
@@ -468,6 +503,7 @@ fn render_tile(
     let mut counters = Counters::default();
     let mut nan = 0u64;
     let mut out = PixelSums::new(tile.width, tile.height);
+    let mut parts = keep_parts.then(|| new_parts(tile.width, tile.height));
     for i in 0..(tile.width * tile.height) as usize {
         if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
             return None;
@@ -478,9 +514,15 @@ fn render_tile(
         );
         for s in samples.clone() {
             let ray = camera_sample(scene, &mut sampler, x, y, s);
-            let l = integrator.li(ray, &mut sampler, &mut counters, None);
+            let r = integrator.li_parts(ray, &mut sampler, &mut counters, None);
+            let l = r.total();
             if l.is_finite() {
                 out.add(i, l);
+                if let Some(parts) = parts.as_mut() {
+                    for (p, v) in parts.iter_mut().zip(r.parts) {
+                        p.add(i, v);
+                    }
+                }
             } else {
                 nan += 1;
             }
@@ -489,6 +531,7 @@ fn render_tile(
     progress.inc(u64::from(samples.end - samples.start));
     Some(TileResult {
         sums: out,
+        parts,
         counters,
         nan,
     })

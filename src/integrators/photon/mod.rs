@@ -29,9 +29,9 @@ pub use progressive::{MapSet, PassTotals, ProgressivePhotons, RadiusSchedule};
 
 use glam::Vec3;
 
-use super::Counters;
 use super::shadow::{RayCone, connect_light};
 use super::trace_log::{RayKind, TraceLog};
+use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{LightSampler, RenderScene, ShadingPoint, SurfacePoint};
@@ -130,7 +130,7 @@ impl<'a> PhotonMapper<'a> {
         sampler: &mut Sampler,
         counters: &mut Counters,
         log: Option<&mut TraceLog>,
-    ) -> Vec3 {
+    ) -> Radiance {
         self.li_from(&self.maps, ray, sampler, counters, log)
     }
 
@@ -142,10 +142,10 @@ impl<'a> PhotonMapper<'a> {
         sampler: &mut Sampler,
         counters: &mut Counters,
         mut log: Option<&mut TraceLog>,
-    ) -> Vec3 {
+    ) -> Radiance {
         let scene = self.scene;
         let params = &scene.params;
-        let mut l = Vec3::ZERO;
+        let mut l = Radiance::default();
         let mut stack = [Branch::default(); STACK];
         stack[0] = Branch {
             ray,
@@ -169,7 +169,7 @@ impl<'a> PhotonMapper<'a> {
             let mut gathered = Vec3::ZERO;
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 gathered = beta * params.background;
-                l += gathered;
+                l.add(LightPath::Specular, gathered);
                 set_radiance(log.as_deref_mut(), node, gathered);
                 continue;
             };
@@ -180,7 +180,7 @@ impl<'a> PhotonMapper<'a> {
                 // Reached along a specular chain (or directly): the emitter is seen.
                 if let Some(i) = object.light {
                     gathered = beta * scene.lights[i as usize].le(sp.ng, wo);
-                    l += gathered;
+                    l.add(LightPath::Specular, gathered);
                 }
                 if let Some(lg) = log.as_deref_mut() {
                     lg.record_hit(node, scene, &hit, &sp, "light");
@@ -206,8 +206,8 @@ impl<'a> PhotonMapper<'a> {
                 let full = beta.max_element() >= FINAL_GATHER_MIN_WEIGHT;
                 let (c, note) =
                     self.local(maps, &sp, &sh, wo, full, sampler, counters, log.is_some());
-                gathered = beta * c;
-                l += gathered;
+                gathered = beta * c.total();
+                l.add_scaled(&c, beta);
                 if let Some(text) = note {
                     TraceLog::note(log.as_deref_mut(), node, &text);
                 }
@@ -308,7 +308,7 @@ impl<'a> PhotonMapper<'a> {
         sampler: &mut Sampler,
         counters: &mut Counters,
         describe: bool,
-    ) -> (Vec3, Option<String>) {
+    ) -> (Radiance, Option<String>) {
         let fr = frame(sh);
         let direct = self.direct(sp, &fr, sh, wo, sampler, counters);
         if !full && let Some(l) = cached_radiance(maps, sp, &fr, sh, wo) {
@@ -318,7 +318,10 @@ impl<'a> PhotonMapper<'a> {
                     direct.x, direct.y, direct.z, l.x, l.y, l.z
                 )
             });
-            return (direct + l, note);
+            let mut r = Radiance::default();
+            r.add(LightPath::Direct, direct);
+            r.add(LightPath::Indirect, l);
+            return (r, note);
         }
         let caustic = maps
             .caustic
@@ -368,7 +371,11 @@ impl<'a> PhotonMapper<'a> {
                 global_text
             )
         });
-        (direct + caustic_l + indirect, note)
+        let mut r = Radiance::default();
+        r.add(LightPath::Direct, direct);
+        r.add(LightPath::Caustic, caustic_l);
+        r.add(LightPath::Indirect, indirect);
+        (r, note)
     }
 
     /// Direct light at a vertex by one shadow ray to a light chosen in proportion to power.
