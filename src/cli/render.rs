@@ -12,8 +12,9 @@ use clap::Args;
 use caustic::Error;
 use caustic::pipeline::prepare;
 use caustic::render::output::{OutputFormat, write_image};
+use caustic::render::part_meta::settings_hash;
 use caustic::render::progressive::{CheckpointPlan, PassPlan, render_in_passes};
-use caustic::render::{Region, RenderError, RenderJob, RenderOptions};
+use caustic::render::{PartMeta, Region, RenderError, RenderJob, RenderOptions, Shard};
 
 use super::{SceneArgs, count, print_warnings};
 
@@ -75,6 +76,11 @@ pub struct RenderArgs {
     /// size or the samples change (photon integrator; a corrupt file is rebuilt).
     #[arg(long, value_name = "DIR")]
     photon_cache: Option<PathBuf>,
+    /// Render only shard I of N (numbered from 1): the sample indices ⌊(I−1)·S/N⌋ to
+    /// ⌊I·S/N⌋ − 1 of every pixel (S: samples per pixel), into the mergeable film (the output
+    /// must end in `.part`). `caustic merge` joins the shards into the image of one render.
+    #[arg(long, value_name = "I/N", conflicts_with = "compare")]
+    shard: Option<String>,
 }
 
 fn parse_max_rmse(text: &str) -> Result<f64, String> {
@@ -143,7 +149,7 @@ fn default_output(scene: &Path) -> PathBuf {
 }
 
 /// Whether `path` asks for the mergeable film (`.part`).
-fn is_part(path: &Path) -> bool {
+pub(super) fn is_part(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("part"))
@@ -207,8 +213,20 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         .unwrap_or_else(|| default_output(&args.scene.scene));
     // Refuse a bad output name before doing any work.
     if !is_part(&output) {
+        if args.shard.is_some() {
+            return Err(Error::Usage(format!(
+                "error: --shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
+                output.display()
+            )));
+        }
         OutputFormat::for_path(&output)?;
     }
+    let shard = args
+        .shard
+        .as_deref()
+        .map(Shard::parse)
+        .transpose()
+        .map_err(|e| Error::Usage(format!("error: {e}")))?;
     if let Some(cp) = &args.checkpoint {
         if OutputFormat::for_path(cp).is_err() {
             return Err(Error::Usage(format!(
@@ -249,6 +267,12 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     }
     let exposure = prepared.render_scene.params.exposure;
     let spp = prepared.render_scene.params.samples_per_pixel;
+    let samples = shard
+        .map(|s| s.samples(spp))
+        .transpose()
+        .map_err(|e| Error::Usage(format!("error: {e}")))?;
+    let first_sample = samples.as_ref().map_or(0, |r| r.start);
+    let hash = is_part(&output).then(|| settings_hash(&prepared.render_scene));
     let terminal = !args.quiet && std::io::stderr().is_terminal();
     let options = RenderOptions {
         threads: args.threads,
@@ -256,7 +280,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         progress: terminal && args.time.is_none(),
         cancel: Some(interrupt.start_rendering()),
         photon_cache: args.photon_cache.clone(),
-        ..RenderOptions::default()
+        samples,
     };
     let job = RenderJob::new(&prepared.render_scene, &options)?;
     if !args.quiet
@@ -294,13 +318,29 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if interrupt.raised() {
         return Err(interrupted());
     }
-    if is_part(&output) {
-        let meta = format!(
-            "scene={}\nspp={}\n",
-            args.scene.scene.display(),
-            out.stats.samples / u64::from(out.film.width * out.film.height).max(1)
-        );
-        out.sums.write(&output, &meta)?;
+    if let Some(hash) = hash {
+        let p = &prepared.render_scene.params;
+        let taken =
+            out.stats.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1);
+        let end = first_sample + taken as u32;
+        let meta = PartMeta {
+            hash,
+            samples: if end > first_sample {
+                std::iter::once(first_sample..end).collect()
+            } else {
+                Vec::new()
+            },
+            spp,
+            width: p.width,
+            height: p.height,
+            region,
+            integrator: format!("{:?}", p.integrator),
+            exposure,
+            scene: args.scene.scene.display().to_string(),
+            shard: shard.map(|s| s.to_string()),
+            seconds: out.stats.elapsed.as_secs_f64(),
+        };
+        out.sums.write(&output, &meta.to_text())?;
     } else {
         write_image(&out.film, &output, exposure)?;
     }
