@@ -2,6 +2,7 @@
 //! Ctrl-C handling and atomic output.
 
 use std::io::IsTerminal;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -81,6 +82,22 @@ pub struct RenderArgs {
     /// must end in `.part`). `caustic merge` joins the shards into the image of one render.
     #[arg(long, value_name = "I/N", conflicts_with = "compare")]
     shard: Option<String>,
+    /// Render only the sample indices START to END − 1 of every pixel (of the render's
+    /// samples per pixel): with a `.part` output, a shard of your own choosing; as an image,
+    /// what merging such parts gives.
+    #[arg(long, value_name = "START..END", conflicts_with_all = ["compare", "shard"], value_parser = parse_samples)]
+    samples: Option<Range<u32>>,
+}
+
+fn parse_samples(text: &str) -> Result<Range<u32>, String> {
+    text.split_once("..")
+        .and_then(|(a, b)| Some(a.trim().parse::<u32>().ok()?..b.trim().parse::<u32>().ok()?))
+        .filter(|r| !r.is_empty())
+        .ok_or_else(|| {
+            format!(
+                "expected START..END with whole numbers START < END, e.g. `0..16`, found `{text}`"
+            )
+        })
 }
 
 fn parse_max_rmse(text: &str) -> Result<f64, String> {
@@ -267,10 +284,19 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     }
     let exposure = prepared.render_scene.params.exposure;
     let spp = prepared.render_scene.params.samples_per_pixel;
-    let samples = shard
-        .map(|s| s.samples(spp))
-        .transpose()
-        .map_err(|e| Error::Usage(format!("error: {e}")))?;
+    let samples = match &args.samples {
+        Some(r) if r.end > spp => {
+            return Err(Error::Usage(format!(
+                "error: --samples {}..{}: the render has {spp} samples per pixel, so END must be at most {spp}",
+                r.start, r.end
+            )));
+        }
+        Some(r) => Some(r.clone()),
+        None => shard
+            .map(|s| s.samples(spp))
+            .transpose()
+            .map_err(|e| Error::Usage(format!("error: {e}")))?,
+    };
     let first_sample = samples.as_ref().map_or(0, |r| r.start);
     let hash = is_part(&output).then(|| settings_hash(&prepared.render_scene));
     let terminal = !args.quiet && std::io::stderr().is_terminal();
