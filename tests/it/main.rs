@@ -11,6 +11,7 @@ mod converge;
 mod determinism;
 mod doc_images;
 mod doc_snippets;
+mod farm;
 mod hard_cases;
 mod interrupt;
 mod kdtree;
