@@ -88,13 +88,17 @@ for _ in $(seq 50); do [ -S "$SOCK" ] && break; sleep 0.1; done
 
 # --- slurm.conf: one node on 127.0.0.1, no cgroups, no accounting ------------------------------
 NODE=caustic-ci-node
+# slurmctld runs only on the host named here: this machine's short name (the address avoids
+# any name resolution).
+HOST=$(uname -n | cut -d. -f1)
 NODELINE=$(slurmd -C | head -n 1 | sed -e "s/^NodeName=[^ ]*/NodeName=$NODE/" -e 's/ UpTime=.*//')
 CPUS=$(sed -n 's/.* CPUs=\([0-9]*\).*/\1/p' <<<"$NODELINE")
+[ -n "$CPUS" ] || fail "cannot read this node's CPUs from \`slurmd -C\`: '$NODELINE'"
 mkdir -p "$W/state" "$W/spool"
 export SLURM_CONF=$W/slurm.conf
 cat >"$SLURM_CONF" <<EOF
 ClusterName=causticci
-SlurmctldHost=$(hostname -s)(127.0.0.1)
+SlurmctldHost=$HOST(127.0.0.1)
 SlurmctldPort=16817
 SlurmdPort=16818
 SlurmUser=root

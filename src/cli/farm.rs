@@ -197,15 +197,15 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
             dir.join(manifest::FILE).display()
         )));
     }
-    for sub in [SHARDS, PHOTONS, LOGS] {
-        std::fs::create_dir_all(dir.join(sub)).map_err(|e| io(&dir.join(sub), &e))?;
-    }
     let dir = std::path::absolute(dir).map_err(|e| io(dir, &e))?;
     let dir_text = dir.display().to_string();
     if dir_text.contains(|c: char| c.is_whitespace() || c == '%') {
         return Err(usage(format!(
             "-o `{dir_text}`: the job folder's path must not contain spaces or `%` (Slurm's #SBATCH lines cannot quote them)"
         )));
+    }
+    for sub in [SHARDS, PHOTONS, LOGS] {
+        std::fs::create_dir_all(dir.join(sub)).map_err(|e| io(&dir.join(sub), &e))?;
     }
     let base = prepared.source.base_dir();
     let base = std::path::absolute(if base.as_os_str().is_empty() {
