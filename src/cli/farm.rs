@@ -51,7 +51,8 @@ struct PlanArgs {
     /// Number of shards (Slurm array tasks); at most the samples per pixel.
     #[arg(long, value_name = "N")]
     shards: u32,
-    /// Time limit of each shard (and of the photon-cache job), e.g. `2h`, `90m`.
+    /// Time limit of each shard (and of the photon-cache job), e.g. `2h`, `90m`. A shard
+    /// renders for at most this less a tenth and 30 s, then writes the samples it took.
     #[arg(long, value_name = "DURATION", default_value = "1h", value_parser = parse_duration)]
     time: Duration,
     /// The job folder to create (must not hold a job already).
@@ -104,6 +105,15 @@ fn usage(text: String) -> Error {
 
 fn io(path: &Path, e: &std::io::Error) -> Error {
     usage(format!("cannot write `{}`: {e}", path.display()))
+}
+
+/// The render-time budget of a shard under a Slurm time limit: the limit less a tenth and
+/// 30 s (for loading the scene and photon cache, writing the film, and one pass of overrun),
+/// so that a slow shard stops early and writes the samples it took instead of being killed
+/// with nothing; none under 2 minutes.
+fn shard_budget(limit: Duration) -> Option<Duration> {
+    (limit >= Duration::from_secs(120))
+        .then(|| Duration::from_secs((limit - limit / 10 - Duration::from_secs(30)).as_secs()))
 }
 
 /// The overrides as `path=value` strings, for the manifest.
@@ -250,6 +260,7 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
         integrator: format!("{:?}", p.integrator),
         caustic,
         time_limit: slurm_time(a.time),
+        shard_budget_seconds: shard_budget(a.time).map(|d| d.as_secs()),
         cpus_per_task: a.cpus,
         outputs: vec![format!("{stem}.exr"), format!("{stem}.png")],
     };
@@ -279,8 +290,9 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
 
 /// The state of one shard's film.
 enum ShardState {
-    /// Valid, with its render time in seconds.
-    Done(f64),
+    /// Valid: its render time in seconds and the end of its samples (the shard's end, or
+    /// less when its time budget stopped it early).
+    Done(f64, u32),
     /// Not written yet (running, queued, failed or cancelled).
     Missing,
     /// Present but unusable: why.
@@ -299,13 +311,13 @@ fn shard_state(m: &Manifest, hash: u64, dir: &Path, index: u32) -> ShardState {
             "settings hash {:016x}, not the job's {}",
             meta.hash, m.hash
         )),
-        Ok((_, meta)) if meta.samples.as_slice() != std::slice::from_ref(&(start..end)) => {
-            ShardState::Invalid(format!(
+        Ok((_, meta)) => match meta.samples.as_slice() {
+            [r] if r.start == start && r.end <= end => ShardState::Done(meta.seconds, r.end),
+            other => ShardState::Invalid(format!(
                 "holds samples {}, not the shard's {start}..{end}",
-                format_ranges(&meta.samples)
-            ))
-        }
-        Ok((_, meta)) => ShardState::Done(meta.seconds),
+                format_ranges(other)
+            )),
+        },
     }
 }
 
@@ -316,11 +328,19 @@ fn status(dir: &Path) -> Result<(), Error> {
     for index in 1..=m.shards {
         let [start, end] = m.ranges[index as usize - 1];
         let state = match shard_state(&m, hash, dir, index) {
-            ShardState::Done(s) => {
+            ShardState::Done(s, reached) => {
                 done += 1;
-                samples += end - start;
+                samples += reached - start;
                 seconds.push(s);
-                format!("done in {s:.1} s")
+                if reached == end {
+                    format!("done in {s:.1} s")
+                } else {
+                    format!(
+                        "stopped by its time budget after {s:.1} s with samples {start}..{reached} ({} of {})",
+                        reached - start,
+                        end - start
+                    )
+                }
             }
             ShardState::Missing => "not done (queued, running, failed or cancelled)".into(),
             ShardState::Invalid(why) => format!("INVALID: {why}"),
@@ -380,4 +400,22 @@ fn cache(dir: &Path, threads: Option<usize>) -> Result<(), Error> {
         ),
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shard_budgets_leave_a_tenth_and_half_a_minute() {
+        assert_eq!(shard_budget(Duration::from_secs(119)), None);
+        assert_eq!(
+            shard_budget(Duration::from_secs(120)),
+            Some(Duration::from_secs(78))
+        );
+        assert_eq!(
+            shard_budget(Duration::from_secs(7200)),
+            Some(Duration::from_secs(6450))
+        );
+    }
 }

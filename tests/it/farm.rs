@@ -251,6 +251,8 @@ fn a_planned_job_run_by_hand_equals_a_single_render() {
         "#SBATCH --cpus-per-task=2\n",
         "#SBATCH --partition=gpu\n",
         "#SBATCH --requeue\n",
+        // 5400 s less a tenth and 30 s: the shard stops in time to write what it did.
+        " --spp 4 --time 4830s ",
     ] {
         assert!(
             shard_script.contains(line),

@@ -48,6 +48,10 @@ pub struct Manifest {
     pub caustic: PathBuf,
     /// Slurm time limit of each shard (`#SBATCH --time`).
     pub time_limit: String,
+    /// Render-time budget of each shard in seconds (`render --time`; `None` under a 2-minute
+    /// limit): a shard that is slower than planned stops there and writes the samples it took.
+    #[serde(default)]
+    pub shard_budget_seconds: Option<u64>,
     /// CPUs per shard (`#SBATCH --cpus-per-task`, passed to `--threads`).
     pub cpus_per_task: u32,
     /// The merged images the merge job writes, relative to the job folder.

@@ -119,7 +119,7 @@ exec {caustic} farm cache "$DIR" --threads "${{SLURM_CPUS_PER_TASK:-1}}"
 #SBATCH --requeue
 # ^ after a node failure Slurm reruns the shard; it rewrites only its own .part, atomically
 #SBATCH --time={time}
-# ^ the limit given to `farm plan --time`; a shard killed at the limit writes nothing
+# ^ the limit given to `farm plan --time`; the shard's --time budget below ends it sooner
 #SBATCH --cpus-per-task={cpus}
 # ^ the shard renders with this many threads (--threads below)
 #SBATCH --nodes=1
@@ -127,8 +127,12 @@ exec {caustic} farm cache "$DIR" --threads "${{SLURM_CPUS_PER_TASK:-1}}"
 {common}set -euo pipefail
 i=$SLURM_ARRAY_TASK_ID
 exec {caustic} render {scene} --shard "$i/{n}" --threads "${{SLURM_CPUS_PER_TASK:-1}}" \
-    --photon-cache {photons} -o {shards}/shard-"$i".part
+    --photon-cache {photons} -o {shards}/shard-"$i".part{budget}
 "#,
+        budget = m.shard_budget_seconds.map_or_else(String::new, |b| format!(
+            " \\\n    --spp {spp} --time {b}s  # stop in time to write what was done",
+            spp = m.samples_per_pixel
+        )),
         scene = q(SCENE),
         photons = q(PHOTONS),
         shards = q(SHARDS),
