@@ -358,3 +358,49 @@ fn a_planned_job_run_by_hand_equals_a_single_render() {
         );
     }
 }
+
+/// A scene with assets (image textures, OBJ meshes) planned from another folder: the resolved
+/// scene names them by absolute paths, and `plan` has checked that it renders with the same
+/// settings hash as the original; a shard of it merges with a shard of the original.
+#[test]
+fn a_planned_scene_keeps_its_assets_and_its_hash() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let job = dir.path().join("job");
+    let bath = crate::common::root().join("scenes/bath.ron");
+    let small = ["--width", "16", "--height", "12", "--spp", "2"];
+    let mut args = vec!["farm", "plan", s(&bath), "--shards", "2", "-o", s(&job)];
+    args.extend_from_slice(&small);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_caustic"))
+        .args(&args)
+        .current_dir(dir.path())
+        .output()
+        .expect("caustic runs");
+    ok(&out);
+    let scene = std::fs::read_to_string(job.join("scene.ron")).expect("scene.ron");
+    let files: Vec<&str> = scene
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("file: \""))
+        .collect();
+    assert!(files.len() >= 3, "{scene}");
+    for f in files {
+        assert!(Path::new(f.trim_end_matches("\",")).is_absolute(), "{f}");
+    }
+    // Shard 1 of the planned scene and shard 2 of the original are parts of one render.
+    let (p1, p2) = (dir.path().join("1.part"), dir.path().join("2.part"));
+    let planned = job.join("scene.ron");
+    let mut a = vec!["render", s(&planned), "--shard", "1/2", "-q", "-o", s(&p1)];
+    a.extend_from_slice(&["--caustic-photons", "2000", "--photons", "2000"]);
+    let mut b = vec!["render", s(&bath), "--shard", "2/2", "-q", "-o", s(&p2)];
+    b.extend_from_slice(&small);
+    b.extend_from_slice(&["--caustic-photons", "2000", "--photons", "2000"]);
+    ok(&caustic(&a));
+    ok(&caustic(&b));
+    let merged = ok(&caustic(&[
+        "merge",
+        s(&p1),
+        s(&p2),
+        "-o",
+        s(&dir.path().join("m.exr")),
+    ]));
+    assert!(merged.contains("2 of 2 samples per pixel"), "{merged}");
+}
