@@ -2,8 +2,10 @@
 //! a manifest, the batch scripts); `sbatch DIR/render.sbatch` runs it (photon cache, shard
 //! array, merge); `status` says which shards are done; `cache` is the first job's step.
 
+mod cache;
 mod manifest;
 mod scripts;
+mod status;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -13,8 +15,8 @@ use serde_json::Value;
 
 use caustic::Error;
 use caustic::pipeline::{SceneOverrides, prepare};
-use caustic::render::part_meta::{format_ranges, settings_hash};
-use caustic::render::{RenderJob, RenderOptions, Shard};
+use caustic::render::Shard;
+use caustic::render::part_meta::settings_hash;
 use caustic::scene::SceneFile;
 
 use self::manifest::{FORMAT, LOGS, Manifest, PHOTONS, SCENE, SHARDS};
@@ -94,8 +96,8 @@ struct CacheArgs {
 pub fn run(args: &FarmArgs) -> Result<(), Error> {
     match &args.command {
         FarmCommand::Plan(a) => plan(a),
-        FarmCommand::Status(a) => status(&a.dir),
-        FarmCommand::Cache(a) => cache(&a.dir, a.threads),
+        FarmCommand::Status(a) => status::run(&a.dir),
+        FarmCommand::Cache(a) => cache::run(&a.dir, a.threads),
     }
 }
 
@@ -285,120 +287,6 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
         m.hash,
         dir.display()
     );
-    Ok(())
-}
-
-/// The state of one shard's film.
-enum ShardState {
-    /// Valid: its render time in seconds and the end of its samples (the shard's end, or
-    /// less when its time budget stopped it early).
-    Done(f64, u32),
-    /// Not written yet (running, queued, failed or cancelled).
-    Missing,
-    /// Present but unusable: why.
-    Invalid(String),
-}
-
-fn shard_state(m: &Manifest, hash: u64, dir: &Path, index: u32) -> ShardState {
-    let path = Manifest::shard_path(dir, index);
-    if !path.exists() {
-        return ShardState::Missing;
-    }
-    let [start, end] = m.ranges[index as usize - 1];
-    match super::merge::read_part(&path) {
-        Err(e) => ShardState::Invalid(e.to_string()),
-        Ok((_, meta)) if meta.hash != hash => ShardState::Invalid(format!(
-            "settings hash {:016x}, not the job's {}",
-            meta.hash, m.hash
-        )),
-        Ok((_, meta)) => match meta.samples.as_slice() {
-            [r] if r.start == start && r.end <= end => ShardState::Done(meta.seconds, r.end),
-            other => ShardState::Invalid(format!(
-                "holds samples {}, not the shard's {start}..{end}",
-                format_ranges(other)
-            )),
-        },
-    }
-}
-
-fn status(dir: &Path) -> Result<(), Error> {
-    let m = Manifest::read(dir)?;
-    let hash = m.hash_value()?;
-    let (mut done, mut samples, mut seconds) = (0u32, 0u32, Vec::new());
-    for index in 1..=m.shards {
-        let [start, end] = m.ranges[index as usize - 1];
-        let state = match shard_state(&m, hash, dir, index) {
-            ShardState::Done(s, reached) => {
-                done += 1;
-                samples += reached - start;
-                seconds.push(s);
-                if reached == end {
-                    format!("done in {s:.1} s")
-                } else {
-                    format!(
-                        "stopped by its time budget after {s:.1} s with samples {start}..{reached} ({} of {})",
-                        reached - start,
-                        end - start
-                    )
-                }
-            }
-            ShardState::Missing => "not done (queued, running, failed or cancelled)".into(),
-            ShardState::Invalid(why) => format!("INVALID: {why}"),
-        };
-        println!(
-            "shard {index}/{}: samples {start}..{end}: {state}",
-            m.shards
-        );
-    }
-    println!(
-        "{done} of {} shards done: {samples} of {} samples per pixel",
-        m.shards, m.samples_per_pixel
-    );
-    let left = m.shards - done;
-    if left > 0 && !seconds.is_empty() {
-        let mean = seconds.iter().sum::<f64>() / seconds.len() as f64;
-        println!(
-            "ETA: the {left} other shards need about {:.0} s each ({:.0} s in all one after another; {:.0} s if they all run at once), from the done shards' mean",
-            mean,
-            mean * f64::from(left),
-            mean
-        );
-    } else if left > 0 {
-        println!("ETA: unknown until a shard is done");
-    }
-    for out in &m.outputs {
-        let path = dir.join(out);
-        if path.exists() {
-            println!("merged image: {}", path.display());
-        }
-    }
-    Ok(())
-}
-
-fn cache(dir: &Path, threads: Option<usize>) -> Result<(), Error> {
-    let m = Manifest::read(dir)?;
-    let prepared = prepare(&dir.join(SCENE), &SceneOverrides::default())?;
-    let hash = settings_hash(&prepared.render_scene);
-    if hash != m.hash_value()? {
-        return Err(usage(format!(
-            "`{}` now has settings hash {hash:016x}, not the planned {}: the scene or its assets changed since `caustic farm plan`; plan the job again",
-            dir.join(SCENE).display(),
-            m.hash
-        )));
-    }
-    let options = RenderOptions {
-        threads,
-        photon_cache: Some(dir.join(PHOTONS)),
-        ..RenderOptions::default()
-    };
-    let job = RenderJob::new(&prepared.render_scene, &options)?;
-    match job.integrator().photon_maps() {
-        Some(maps) => println!("{}", maps.summary),
-        None => println!(
-            "photon cache: nothing to build (the {} integrator has no fixed photon maps)",
-            m.integrator
-        ),
-    }
     Ok(())
 }
 
