@@ -5,7 +5,9 @@ mod compare;
 mod converge;
 mod debug_pixel;
 mod error_image;
+mod farm;
 mod golden;
+mod merge;
 mod photons;
 mod pixel_font;
 mod plot;
@@ -53,6 +55,13 @@ enum Command {
     /// Draw the photon maps over a dim render of the scene (caustic photons orange, global
     /// blue, brighter where more power landed).
     Photons(photons::PhotonsArgs),
+    /// Merge `.part` films (farm shards, renders of disjoint sample ranges) into one image,
+    /// byte-identical to a single render of the same samples; refuses parts of different
+    /// scenes/settings, duplicates, and (without `--partial`) missing samples.
+    Merge(merge::MergeArgs),
+    /// Render on a Slurm cluster: `farm plan` writes a job folder, `sbatch DIR/render.sbatch`
+    /// runs it, `farm status DIR` reports progress (docs/farm.md).
+    Farm(farm::FarmArgs),
 }
 
 /// Runs one command.
@@ -68,6 +77,8 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Compare(args) => compare::run(&args),
         Command::Converge(args) => converge::run(&args),
         Command::Photons(args) => photons::run(&args),
+        Command::Merge(args) => merge::run(&args),
+        Command::Farm(args) => farm::run(&args),
     }
 }
 

@@ -2,6 +2,7 @@
 //! Ctrl-C handling and atomic output.
 
 use std::io::IsTerminal;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -12,8 +13,11 @@ use clap::Args;
 use caustic::Error;
 use caustic::pipeline::prepare;
 use caustic::render::output::{OutputFormat, write_image};
+use caustic::render::part_meta::settings_hash;
 use caustic::render::progressive::{CheckpointPlan, PassPlan, render_in_passes};
-use caustic::render::{Region, RenderError, RenderJob, RenderOptions};
+use caustic::render::{
+    Layer, PartMeta, Region, RenderError, RenderJob, RenderOptions, Shard, write_layers,
+};
 
 use super::{SceneArgs, count, print_warnings};
 
@@ -75,6 +79,43 @@ pub struct RenderArgs {
     /// size or the samples change (photon integrator; a corrupt file is rebuilt).
     #[arg(long, value_name = "DIR")]
     photon_cache: Option<PathBuf>,
+    /// Render only shard I of N (numbered from 1): the sample indices ⌊(I−1)·S/N⌋ to
+    /// ⌊I·S/N⌋ − 1 of every pixel (S: samples per pixel), into the mergeable film (the output
+    /// must end in `.part`). `caustic merge` joins the shards into the image of one render.
+    #[arg(long, value_name = "I/N", conflicts_with = "compare")]
+    shard: Option<String>,
+    /// Render only the sample indices START to END − 1 of every pixel (of the render's
+    /// samples per pixel): with a `.part` output, a shard of your own choosing; as an image,
+    /// what merging such parts gives.
+    #[arg(long, value_name = "START..END", conflicts_with_all = ["compare", "shard"], value_parser = parse_samples)]
+    samples: Option<Range<u32>>,
+    /// Also write these layers into the `.exr` output beside the image, comma-separated:
+    /// specular (emitters and background seen directly or through mirrors and glass), direct
+    /// (light after one diffuse or glossy bounce), caustic (light through mirrors or glass onto
+    /// a diffuse surface), indirect (two or more bounces), variance (of each pixel's mean),
+    /// samples (per pixel); `all` for every one. The four light kinds add up to the image.
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_layers)]
+    layers: Vec<Vec<Layer>>,
+}
+
+fn parse_layers(text: &str) -> Result<Vec<Layer>, String> {
+    if text.trim().eq_ignore_ascii_case("all") {
+        return Ok(Layer::ALL.to_vec());
+    }
+    Layer::parse(text)
+        .map(|l| vec![l])
+        .map_err(|e| e.to_string())
+}
+
+fn parse_samples(text: &str) -> Result<Range<u32>, String> {
+    text.split_once("..")
+        .and_then(|(a, b)| Some(a.trim().parse::<u32>().ok()?..b.trim().parse::<u32>().ok()?))
+        .filter(|r| !r.is_empty())
+        .ok_or_else(|| {
+            format!(
+                "expected START..END with whole numbers START < END, e.g. `0..16`, found `{text}`"
+            )
+        })
 }
 
 fn parse_max_rmse(text: &str) -> Result<f64, String> {
@@ -143,7 +184,7 @@ fn default_output(scene: &Path) -> PathBuf {
 }
 
 /// Whether `path` asks for the mergeable film (`.part`).
-fn is_part(path: &Path) -> bool {
+pub(super) fn is_part(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("part"))
@@ -207,8 +248,27 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         .unwrap_or_else(|| default_output(&args.scene.scene));
     // Refuse a bad output name before doing any work.
     if !is_part(&output) {
+        if args.shard.is_some() {
+            return Err(Error::Usage(format!(
+                "error: --shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
+                output.display()
+            )));
+        }
         OutputFormat::for_path(&output)?;
     }
+    if !args.layers.is_empty() && !matches!(OutputFormat::for_path(&output), Ok(OutputFormat::Exr))
+    {
+        return Err(Error::Usage(format!(
+            "error: --layers are written into an EXR file: the output `{}` must end in `.exr`",
+            output.display()
+        )));
+    }
+    let shard = args
+        .shard
+        .as_deref()
+        .map(Shard::parse)
+        .transpose()
+        .map_err(|e| Error::Usage(format!("error: {e}")))?;
     if let Some(cp) = &args.checkpoint {
         if OutputFormat::for_path(cp).is_err() {
             return Err(Error::Usage(format!(
@@ -249,14 +309,32 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     }
     let exposure = prepared.render_scene.params.exposure;
     let spp = prepared.render_scene.params.samples_per_pixel;
+    let samples = match &args.samples {
+        Some(r) if r.end > spp => {
+            return Err(Error::Usage(format!(
+                "error: --samples {}..{}: the render has {spp} samples per pixel, so END must be at most {spp}",
+                r.start, r.end
+            )));
+        }
+        Some(r) => Some(r.clone()),
+        None => shard
+            .map(|s| s.samples(spp))
+            .transpose()
+            .map_err(|e| Error::Usage(format!("error: {e}")))?,
+    };
+    let first_sample = samples.as_ref().map_or(0, |r| r.start);
+    let hash = is_part(&output).then(|| settings_hash(&prepared.render_scene));
     let terminal = !args.quiet && std::io::stderr().is_terminal();
+    let mut layers: Vec<Layer> = args.layers.iter().flatten().copied().collect();
+    layers.dedup();
     let options = RenderOptions {
         threads: args.threads,
         region,
         progress: terminal && args.time.is_none(),
         cancel: Some(interrupt.start_rendering()),
         photon_cache: args.photon_cache.clone(),
-        ..RenderOptions::default()
+        samples,
+        light_paths: layers.iter().any(|l| matches!(l, Layer::Part(_))),
     };
     let job = RenderJob::new(&prepared.render_scene, &options)?;
     if !args.quiet
@@ -294,13 +372,31 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if interrupt.raised() {
         return Err(interrupted());
     }
-    if is_part(&output) {
-        let meta = format!(
-            "scene={}\nspp={}\n",
-            args.scene.scene.display(),
-            out.stats.samples / u64::from(out.film.width * out.film.height).max(1)
-        );
-        out.sums.write(&output, &meta)?;
+    if let Some(hash) = hash {
+        let p = &prepared.render_scene.params;
+        let taken =
+            out.stats.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1);
+        let end = first_sample + taken as u32;
+        let meta = PartMeta {
+            hash,
+            samples: if end > first_sample {
+                std::iter::once(first_sample..end).collect()
+            } else {
+                Vec::new()
+            },
+            spp,
+            width: p.width,
+            height: p.height,
+            region,
+            integrator: format!("{:?}", p.integrator),
+            exposure,
+            scene: args.scene.scene.display().to_string(),
+            shard: shard.map(|s| s.to_string()),
+            seconds: out.stats.elapsed.as_secs_f64(),
+        };
+        out.sums.write(&output, &meta.to_text())?;
+    } else if !layers.is_empty() {
+        write_layers(&out.sums, out.parts.as_deref(), &layers, &output)?;
     } else {
         write_image(&out.film, &output, exposure)?;
     }

@@ -88,12 +88,15 @@ pub fn encode_layers(
     let (w, h) = (sums.width as usize, sums.height as usize);
     let n = w * h;
     let rgb = |name: &str, value: &dyn Fn(usize) -> glam::Vec3| -> [AnyChannel<FlatSamples>; 3] {
-        let mut c = [vec![0f32; n], vec![0f32; n], vec![0f32; n]];
-        for i in 0..n {
-            let v = value(i);
-            c[0][i] = v.x;
-            c[1][i] = v.y;
-            c[2][i] = v.z;
+        let mut c = [
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        ];
+        for v in (0..n).map(value) {
+            c[0].push(v.x);
+            c[1].push(v.y);
+            c[2].push(v.z);
         }
         let prefix = if name.is_empty() {
             String::new()

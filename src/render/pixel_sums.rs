@@ -282,7 +282,7 @@ impl Reader<'_> {
 }
 
 /// FNV-1a, 64 bits: detects truncation and corruption of film files (not an adversary).
-fn fnv1a(bytes: &[u8]) -> u64 {
+pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in bytes {
         h ^= u64::from(*b);

@@ -1,0 +1,309 @@
+//! `caustic farm`: render on a Slurm cluster. `plan` writes a job folder (the resolved scene,
+//! a manifest, the batch scripts); `sbatch DIR/render.sbatch` runs it (photon cache, shard
+//! array, merge); `status` says which shards are done; `cache` is the first job's step.
+
+mod cache;
+mod manifest;
+mod scripts;
+mod status;
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use clap::{Args, Subcommand};
+use serde_json::Value;
+
+use caustic::Error;
+use caustic::pipeline::{SceneOverrides, prepare};
+use caustic::render::Shard;
+use caustic::render::part_meta::settings_hash;
+use caustic::scene::SceneFile;
+
+use self::manifest::{FORMAT, LOGS, Manifest, PHOTONS, SCENE, SHARDS};
+use self::scripts::{Resources, scripts, slurm_time};
+use super::render::parse_duration;
+use super::{SceneArgs, print_warnings};
+
+/// Arguments of `caustic farm`.
+#[derive(Args)]
+pub struct FarmArgs {
+    #[command(subcommand)]
+    command: FarmCommand,
+}
+
+#[derive(Subcommand)]
+enum FarmCommand {
+    /// Write a job folder for Slurm: DIR/scene.ron (the scene with the overrides applied and
+    /// asset paths made absolute), DIR/manifest.json, and DIR/render.sbatch (submit it with
+    /// `sbatch`), shard.sbatch and merge.sbatch.
+    Plan(Box<PlanArgs>),
+    /// Which shards of a job folder are done (valid films), the samples per pixel so far, and
+    /// an estimate of the time left.
+    Status(DirArgs),
+    /// Build the job's photon cache (DIR/photons) once for all shards; nothing to do for
+    /// integrators without fixed photon maps. Run by the job's first step.
+    Cache(CacheArgs),
+}
+
+/// Arguments of `caustic farm plan`.
+#[derive(Args)]
+struct PlanArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Number of shards (Slurm array tasks); at most the samples per pixel.
+    #[arg(long, value_name = "N")]
+    shards: u32,
+    /// Time limit of each shard (and of the photon-cache job), e.g. `2h`, `90m`. A shard
+    /// renders for at most this less a tenth and 30 s, then writes the samples it took.
+    #[arg(long, value_name = "DURATION", default_value = "1h", value_parser = parse_duration)]
+    time: Duration,
+    /// The job folder to create (must not hold a job already).
+    #[arg(short, long, value_name = "DIR")]
+    output: PathBuf,
+    /// CPUs (render threads) per shard.
+    #[arg(long, default_value = "1", value_name = "N")]
+    cpus: u32,
+    /// Slurm partition for every job.
+    #[arg(long)]
+    partition: Option<String>,
+    /// Slurm account for every job.
+    #[arg(long)]
+    account: Option<String>,
+    /// Memory per job, as Slurm writes it (e.g. `4G`).
+    #[arg(long)]
+    mem: Option<String>,
+    /// The caustic binary the jobs run (default: this one); must be reachable from the nodes.
+    #[arg(long, value_name = "PATH")]
+    caustic: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct DirArgs {
+    /// The job folder written by `caustic farm plan`.
+    dir: PathBuf,
+}
+
+#[derive(Args)]
+struct CacheArgs {
+    /// The job folder written by `caustic farm plan`.
+    dir: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+/// Runs a `farm` subcommand.
+pub fn run(args: &FarmArgs) -> Result<(), Error> {
+    match &args.command {
+        FarmCommand::Plan(a) => plan(a),
+        FarmCommand::Status(a) => status::run(&a.dir),
+        FarmCommand::Cache(a) => cache::run(&a.dir, a.threads),
+    }
+}
+
+fn usage(text: String) -> Error {
+    Error::Usage(format!("error: {text}"))
+}
+
+fn io(path: &Path, e: &std::io::Error) -> Error {
+    usage(format!("cannot write `{}`: {e}", path.display()))
+}
+
+/// The render-time budget of a shard under a Slurm time limit: the limit less a tenth and
+/// 30 s (for loading the scene and photon cache, writing the film, and one pass of overrun),
+/// so that a slow shard stops early and writes the samples it took instead of being killed
+/// with nothing; none under 2 minutes.
+fn shard_budget(limit: Duration) -> Option<Duration> {
+    (limit >= Duration::from_secs(120))
+        .then(|| Duration::from_secs((limit - limit / 10 - Duration::from_secs(30)).as_secs()))
+}
+
+/// The overrides as `path=value` strings, for the manifest.
+fn override_record(o: &SceneOverrides) -> Vec<String> {
+    let mut out = o.sets.clone();
+    let flags = [
+        ("render.width", o.width.map(u64::from)),
+        ("render.height", o.height.map(u64::from)),
+        (
+            "render.samples_per_pixel",
+            o.samples_per_pixel.map(u64::from),
+        ),
+        ("render.max_depth", o.max_depth.map(u64::from)),
+        ("render.seed", o.seed),
+        ("photons.caustic", o.caustic_photons.map(u64::from)),
+    ];
+    for (path, v) in flags {
+        if let Some(v) = v {
+            out.push(format!("{path}={v}"));
+        }
+    }
+    out
+}
+
+/// Makes every relative `file` field (meshes, image textures) absolute against `base`.
+fn absolute_assets(v: &mut Value, base: &Path) {
+    match v {
+        Value::Object(map) => {
+            for (key, x) in map.iter_mut() {
+                match x {
+                    Value::String(s) if key == "file" && Path::new(s.as_str()).is_relative() => {
+                        *s = base.join(s.as_str()).display().to_string();
+                    }
+                    _ => absolute_assets(x, base),
+                }
+            }
+        }
+        Value::Array(items) => items.iter_mut().for_each(|x| absolute_assets(x, base)),
+        _ => {}
+    }
+}
+
+/// The scene as RON with asset paths absolute, so it renders the same from the job folder.
+fn resolved_scene(scene: &SceneFile, base: &Path, from: &Path) -> Result<String, Error> {
+    let fail = |e: String| {
+        usage(format!(
+            "cannot write the resolved scene of `{}`: {e}",
+            from.display()
+        ))
+    };
+    let mut tree = serde_json::to_value(scene).map_err(|e| fail(e.to_string()))?;
+    absolute_assets(&mut tree, base);
+    let scene: SceneFile = serde_json::from_value(tree).map_err(|e| fail(e.to_string()))?;
+    let body = ron::ser::to_string_pretty(&scene, ron::ser::PrettyConfig::default())
+        .map_err(|e| fail(e.to_string()))?;
+    Ok(format!(
+        "// Written by `caustic farm plan` from `{}` with its overrides applied and asset paths\n// made absolute; the farm's shards render this file.\n{body}\n",
+        from.display()
+    ))
+}
+
+fn plan(a: &PlanArgs) -> Result<(), Error> {
+    let overrides = a.scene.overrides();
+    let source_path = &a.scene.scene;
+    let prepared = prepare(source_path, &overrides)?;
+    print_warnings(&prepared.warnings);
+    let hash = settings_hash(&prepared.render_scene);
+    let p = &prepared.render_scene.params;
+    let spp = p.samples_per_pixel;
+    if a.shards == 0 {
+        return Err(usage("--shards must be at least 1".into()));
+    }
+    if a.cpus == 0 {
+        return Err(usage("--cpus must be at least 1".into()));
+    }
+    let mut ranges = Vec::new();
+    for index in 1..=a.shards {
+        let r = Shard {
+            index,
+            count: a.shards,
+        }
+        .samples(spp)
+        .map_err(|e| usage(e.to_string()))?;
+        ranges.push([r.start, r.end]);
+    }
+    let dir = &a.output;
+    if dir.join(manifest::FILE).exists() {
+        return Err(usage(format!(
+            "`{}` already holds a farm job ({} exists); choose another folder or delete it",
+            dir.display(),
+            dir.join(manifest::FILE).display()
+        )));
+    }
+    let dir = std::path::absolute(dir).map_err(|e| io(dir, &e))?;
+    let dir_text = dir.display().to_string();
+    if dir_text.contains(|c: char| c.is_whitespace() || c == '%') {
+        return Err(usage(format!(
+            "-o `{dir_text}`: the job folder's path must not contain spaces or `%` (Slurm's #SBATCH lines cannot quote them)"
+        )));
+    }
+    for sub in [SHARDS, PHOTONS, LOGS] {
+        std::fs::create_dir_all(dir.join(sub)).map_err(|e| io(&dir.join(sub), &e))?;
+    }
+    let base = prepared.source.base_dir();
+    let base = std::path::absolute(if base.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        &base
+    })
+    .map_err(|e| io(&base, &e))?;
+    let scene_text = resolved_scene(&prepared.scene, &base, source_path)?;
+    let scene_path = dir.join(SCENE);
+    caustic::render::output::write_atomic(&scene_path, scene_text.as_bytes())?;
+    // The shards render the resolved scene: it must be the very scene that was planned.
+    let again = prepare(&scene_path, &SceneOverrides::default())?;
+    if settings_hash(&again.render_scene) != hash {
+        return Err(usage(format!(
+            "the resolved scene `{}` does not render like `{}` with its overrides (a field that does not survive RON); please report this",
+            scene_path.display(),
+            source_path.display()
+        )));
+    }
+    let caustic = match &a.caustic {
+        Some(c) => std::path::absolute(c).map_err(|e| io(c, &e))?,
+        None => std::env::current_exe().map_err(|e| {
+            usage(format!(
+                "cannot find the caustic binary's path: {e}; pass --caustic PATH"
+            ))
+        })?,
+    };
+    let stem = source_path
+        .file_stem()
+        .map_or_else(|| "image".into(), |s| s.to_string_lossy().into_owned());
+    let m = Manifest {
+        format: FORMAT.into(),
+        hash: format!("{hash:016x}"),
+        source_scene: std::path::absolute(source_path).map_err(|e| io(source_path, &e))?,
+        overrides: override_record(&overrides),
+        shards: a.shards,
+        samples_per_pixel: spp,
+        ranges,
+        width: p.width,
+        height: p.height,
+        integrator: format!("{:?}", p.integrator),
+        caustic,
+        time_limit: slurm_time(a.time),
+        shard_budget_seconds: shard_budget(a.time).map(|d| d.as_secs()),
+        cpus_per_task: a.cpus,
+        outputs: vec![format!("{stem}.exr"), format!("{stem}.png")],
+    };
+    let res = Resources {
+        partition: a.partition.clone(),
+        account: a.account.clone(),
+        mem: a.mem.clone(),
+    };
+    for (name, text) in scripts(&m, &dir, &res) {
+        let path = dir.join(name);
+        caustic::render::output::write_atomic(&path, text.as_bytes())?;
+    }
+    let json = serde_json::to_string_pretty(&m).map_err(|e| usage(e.to_string()))?;
+    caustic::render::output::write_atomic(&dir.join(manifest::FILE), json.as_bytes())?;
+    println!(
+        "{}: {} shards of {}×{} at {spp} spp ({}), hash {}; submit with: sbatch {}/render.sbatch",
+        dir.display(),
+        a.shards,
+        p.width,
+        p.height,
+        m.integrator,
+        m.hash,
+        dir.display()
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shard_budgets_leave_a_tenth_and_half_a_minute() {
+        assert_eq!(shard_budget(Duration::from_secs(119)), None);
+        assert_eq!(
+            shard_budget(Duration::from_secs(120)),
+            Some(Duration::from_secs(78))
+        );
+        assert_eq!(
+            shard_budget(Duration::from_secs(7200)),
+            Some(Duration::from_secs(6450))
+        );
+    }
+}
