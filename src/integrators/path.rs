@@ -18,11 +18,6 @@ use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 /// Bounces after which Russian roulette may end a path.
 const ROULETTE_DEPTH: u32 = 3;
 
-/// With a caustic map: the vertices after fewer than this many diffuse bounces read it (and
-/// the one that reads the global map); deeper ones (dim, after several diffuse bounces) leave
-/// their caustics to emitters hit by chance.
-pub const CAUSTIC_MAP_DEPTH: u32 = 2;
-
 /// Photon maps a camera path reads ([`PathTracer::li_with_maps`]); none by default.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct PathMaps<'m> {
@@ -81,10 +76,10 @@ impl<'a> PathTracer<'a> {
     }
 
     /// [`PathTracer::li`] reading photon maps (the progressive integrators):
-    /// - `maps.caustic` (light → specular⁺ → diffuse photons) at the first
-    ///   [`CAUSTIC_MAP_DEPTH`] vertices with a non-delta part (where the path may still
-    ///   scatter); an emitter reached by delta bounces after such a vertex is then not
-    ///   counted, since the map holds exactly those paths;
+    /// - `maps.caustic` (light → specular⁺ → diffuse photons) at every vertex with a non-delta
+    ///   part where the path may still scatter; an emitter reached by delta bounces after such
+    ///   a vertex is then not counted, since the map holds exactly those paths (left to
+    ///   chance hits, such paths through water or glass are the fireflies of path tracing);
     /// - `maps.global` at the vertices after `maps.global_at` diffuse bounces: there direct
     ///   light (next-event estimation, without MIS), caustics and the global map (light that
     ///   made at least one diffuse bounce) account for all the light of the scene's emitters
@@ -213,10 +208,7 @@ impl<'a> PathTracer<'a> {
                 );
                 l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
             }
-            let read_caustic = local
-                && may_scatter
-                && maps.caustic.is_some()
-                && (diffuse_bounces < CAUSTIC_MAP_DEPTH || read_global);
+            let read_caustic = local && may_scatter && maps.caustic.is_some();
             if read_caustic || read_global {
                 let caustic = maps.caustic.filter(|_| read_caustic);
                 let global = maps.global.filter(|_| read_global);
