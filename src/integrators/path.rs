@@ -28,6 +28,9 @@ pub struct PathMaps<'m> {
     /// Diffuse bounces a path makes before the vertex that reads `global` (0: the first
     /// diffuse hit, as progressive photon mapping; 1: after one bounce, as final gathering).
     pub global_at: u32,
+    /// `global` holds caustic photons too (landings after any first bounce): the vertex that
+    /// reads it does not read `caustic`.
+    pub global_has_caustics: bool,
 }
 
 /// The path tracer over a compiled scene.
@@ -82,7 +85,8 @@ impl<'a> PathTracer<'a> {
     ///   chance hits, such paths through water or glass are the fireflies of path tracing);
     /// - `maps.global` at the vertices after `maps.global_at` diffuse bounces: there direct
     ///   light (next-event estimation, without MIS), caustics and the global map (light that
-    ///   made at least one diffuse bounce) account for all the light of the scene's emitters
+    ///   made at least one diffuse bounce; or any bounce, caustics included, with
+    ///   `global_has_caustics`) account for all the light of the scene's emitters
     ///   leaving through the non-delta part, so a path that scatters on from there counts only
     ///   the background it escapes to (the maps hold no light from it).
     ///
@@ -208,7 +212,10 @@ impl<'a> PathTracer<'a> {
                 );
                 l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
             }
-            let read_caustic = local && may_scatter && maps.caustic.is_some();
+            let read_caustic = local
+                && may_scatter
+                && maps.caustic.is_some()
+                && !(read_global && maps.global_has_caustics);
             if read_caustic || read_global {
                 let caustic = maps.caustic.filter(|_| read_caustic);
                 let global = maps.global.filter(|_| read_global);

@@ -5,7 +5,9 @@
 //! everything else comes from the path tracer with next-event estimation and MIS
 //! ([`PathTracer::li_with_maps`]). With global photons (`photons.global` > 0) the path stops
 //! gathering the emitters' light after one diffuse bounce and reads the global map there
-//! instead (final gathering with one ray per sample: far less noise in indirect light).
+//! instead (final gathering with one ray per sample: far less noise in indirect light); that
+//! map stores photons after any first bounce, caustics included, so one estimate there reads
+//! all the light that has bounced.
 //! Sample index `i` of every pixel is pass `i`, with fresh photons read within a radius that
 //! shrinks by Knaus & Zwicker's schedule ([`ProgressivePhotons`]), so the image converges to
 //! the path tracer's expectation.
@@ -34,6 +36,7 @@ impl<'a> PathPpm<'a> {
                 MapSet {
                     caustic: true,
                     global: scene.params.photons.global > 0,
+                    global_any_bounce: true,
                 },
             ),
             path: PathTracer::new(scene),
@@ -64,6 +67,7 @@ impl<'a> PathPpm<'a> {
             caustic: m.caustic.as_ref(),
             global: m.global.as_ref(),
             global_at: 1,
+            global_has_caustics: true,
         };
         self.path.li_with_maps(maps, ray, sampler, counters, log)
     }

@@ -32,6 +32,7 @@ impl<'a> Ppm<'a> {
                 MapSet {
                     caustic: true,
                     global: true,
+                    global_any_bounce: false,
                 },
             ),
             path: PathTracer::new(scene),
@@ -62,6 +63,7 @@ impl<'a> Ppm<'a> {
             caustic: m.caustic.as_ref(),
             global: m.global.as_ref(),
             global_at: 0,
+            global_has_caustics: false,
         };
         self.path.li_with_maps(maps, ray, sampler, counters, log)
     }

@@ -40,6 +40,7 @@ fn direct_photons(scene: &RenderScene, n: u64) -> (Vec<Photon>, TraceCounts) {
     let settings = TraceSettings {
         kind: MapKind::Global,
         min_bounces: 0,
+        any_bounce: false,
         max_bounces: 0,
         pass: None,
     };

@@ -295,7 +295,25 @@ pub struct PhotonMaps {
 /// Traces and builds the maps the scene's `photons` settings ask for.
 #[must_use]
 pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
-    build_maps_with(scene, None, true, true)
+    let all = MapSet {
+        caustic: true,
+        global: true,
+        global_any_bounce: false,
+    };
+    build_maps_with(scene, None, all)
+}
+
+/// Which maps to build.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MapSet {
+    /// Light → specular⁺ → diffuse photons.
+    pub caustic: bool,
+    /// Diffuse landings after `min_bounces` diffuse bounces.
+    pub global: bool,
+    /// The global map stores every landing after a first bounce of any kind (mirror and glass
+    /// ones too): it then also holds the caustics, and is read alone where all the light that
+    /// arrives after a bounce is wanted (`path-ppm`'s second diffuse vertex).
+    pub global_any_bounce: bool,
 }
 
 /// Traces and builds the caustic and/or global maps of the scene's `photons` settings from the
@@ -303,12 +321,7 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
 /// then is irradiance precomputed for final gathering). Maps estimate from k nearest photons
 /// within an automatic or given largest radius; progressive integrators then fix the radius.
 #[must_use]
-pub fn build_maps_with(
-    scene: &RenderScene,
-    pass: Option<u32>,
-    want_caustic: bool,
-    want_global: bool,
-) -> PhotonMaps {
+pub fn build_maps_with(scene: &RenderScene, pass: Option<u32>, set: MapSet) -> PhotonMaps {
     let p = &scene.params.photons;
     let mut summary = PhotonSummary::default();
     let weights: Vec<f64> = scene
@@ -353,7 +366,7 @@ pub fn build_maps_with(
     let t0 = Instant::now();
     let mut build_time = Duration::ZERO;
     let mut memory = 0;
-    let caustic = if !want_caustic {
+    let caustic = if !set.caustic {
         summary.caustic_skipped = Some("not used by this integrator".into());
         None
     } else if targets.is_empty() {
@@ -367,6 +380,7 @@ pub fn build_maps_with(
         let settings = TraceSettings {
             kind: MapKind::Caustic,
             min_bounces: 0,
+            any_bounce: false,
             max_bounces: p.max_bounces,
             pass,
         };
@@ -388,7 +402,7 @@ pub fn build_maps_with(
             &mut memory,
         )
     };
-    let global = if !want_global {
+    let global = if !set.global {
         summary.global_skipped = Some("not used by this integrator".into());
         None
     } else if global_counts.iter().all(|&c| c == 0) {
@@ -400,6 +414,7 @@ pub fn build_maps_with(
             kind: MapKind::Global,
             // Progressive integrators read the global map for all light after a diffuse bounce.
             min_bounces: if pass.is_some() { 1 } else { p.min_bounces },
+            any_bounce: set.global_any_bounce,
             max_bounces: p.max_bounces,
             pass,
         };

@@ -24,8 +24,8 @@ pub mod progressive;
 pub mod trace;
 
 pub use estimate::{Estimate, IrradianceCache, Kernel, PhotonMap};
-pub use maps::{PhotonMaps, PhotonSummary, build_maps};
-pub use progressive::{MapSet, PassTotals, ProgressivePhotons, RadiusSchedule};
+pub use maps::{MapSet, PhotonMaps, PhotonSummary, build_maps};
+pub use progressive::{PassTotals, ProgressivePhotons, RadiusSchedule};
 
 use glam::Vec3;
 

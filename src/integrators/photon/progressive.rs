@@ -17,7 +17,7 @@
 
 use std::time::{Duration, Instant};
 
-use super::maps::{PhotonMaps, build_maps_with};
+use super::maps::{MapSet, PhotonMaps, build_maps_with};
 use crate::render_scene::RenderScene;
 
 /// Knaus & Zwicker's radius schedule.
@@ -39,15 +39,6 @@ impl RadiusSchedule {
         }
         r2.sqrt() as f32
     }
-}
-
-/// Which maps a progressive integrator reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct MapSet {
-    /// Light → specular⁺ → diffuse photons.
-    pub caustic: bool,
-    /// Diffuse landings after `min_bounces` diffuse bounces.
-    pub global: bool,
 }
 
 /// Totals over the passes a progressive render has traced (for its summary).
@@ -98,7 +89,7 @@ impl<'a> ProgressivePhotons<'a> {
             return;
         }
         let t = Instant::now();
-        self.maps = build_maps_with(self.scene, Some(pass), self.set.caustic, self.set.global);
+        self.maps = build_maps_with(self.scene, Some(pass), self.set);
         self.pass = Some(pass);
         let shrink = self.shrink(pass);
         for m in [self.maps.caustic.as_mut(), self.maps.global.as_mut()]

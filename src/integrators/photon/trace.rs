@@ -66,8 +66,11 @@ impl TraceCounts {
 pub struct TraceSettings {
     /// Which map the path feeds.
     pub kind: MapKind,
-    /// Global map: diffuse bounces before a photon is stored.
+    /// Global map: diffuse bounces before a photon is stored (any bounces, mirror and glass
+    /// ones too, with `any_bounce`).
     pub min_bounces: u32,
+    /// Global map: count every bounce towards `min_bounces`, so the map also holds caustics.
+    pub any_bounce: bool,
     /// Most bounces before a path is dropped.
     pub max_bounces: u32,
     /// The progressive pass whose independent photon streams to draw (`None`: the photon
@@ -111,6 +114,7 @@ pub fn trace_photon(
         if bsdf.has_local() {
             let store = match settings.kind {
                 MapKind::Caustic => bounces > 0,
+                MapKind::Global if settings.any_bounce => bounces >= settings.min_bounces,
                 MapKind::Global => diffuse_bounces >= settings.min_bounces,
             };
             if store {
