@@ -15,10 +15,17 @@ const SAH_DEPTH: usize = 32;
 /// Cost of visiting a node relative to intersecting one block of primitives.
 const TRAVERSAL_COST: f32 = 2.0;
 
-/// SAH cost of intersecting `n` primitives: they are tested [`LEAF_BLOCK`] at a time.
+/// Cost of testing one primitive on its own (a sphere or an ellipsoid, in f64), relative to one
+/// block of [`LEAF_BLOCK`] packed triangles. At 2, a sphere inside a room of large triangles gets
+/// a leaf of its own, which on `benches/scenes/cbox_caustic.ron` takes the path tracer from 5.1 s
+/// to 4.5 s (1 thread, 32 spp; at 1, each ball shares a room-sized leaf and every ray tests it).
+const SOLO_COST: f32 = 2.0;
+
+/// SAH cost of intersecting `n` primitives tested [`LEAF_BLOCK`] at a time (triangles, in SIMD
+/// packs) and `solo` primitives tested one by one (spheres, ellipsoids), priced at [`SOLO_COST`].
 #[inline]
-fn blocks(n: u32) -> f32 {
-    n.div_ceil(LEAF_BLOCK as u32) as f32
+fn blocks(n: u32, solo: u32) -> f32 {
+    n.div_ceil(LEAF_BLOCK as u32) as f32 + solo as f32 * SOLO_COST
 }
 
 struct Task {
@@ -28,8 +35,12 @@ struct Task {
     depth: usize,
 }
 
-pub(super) fn build(bounds: &[Aabb]) -> (Vec<BvhNode>, Vec<u32>) {
+/// Builds the binary tree over `bounds`; `solo[i]` marks primitive `i` as tested on its own
+/// rather than in a SIMD pack (an empty `solo` marks none). Returns the nodes and the primitive
+/// order of the leaves.
+pub(super) fn build(bounds: &[Aabb], solo: &[bool]) -> (Vec<BvhNode>, Vec<u32>) {
     let n = bounds.len();
+    let is_solo = |i: u32| solo.get(i as usize).copied().unwrap_or(false);
     if n == 0 {
         return (Vec::new(), Vec::new());
     }
@@ -61,7 +72,14 @@ pub(super) fn build(bounds: &[Aabb]) -> (Vec<BvhNode>, Vec<u32>) {
         let split = if count <= 1 {
             None
         } else if depth < SAH_DEPTH {
-            sah_split(slice, bounds, &centroids, node_bounds, centroid_bounds)
+            sah_split(
+                slice,
+                bounds,
+                &is_solo,
+                &centroids,
+                node_bounds,
+                centroid_bounds,
+            )
         } else {
             Some(median_split(slice, &centroids, centroid_bounds))
         };
@@ -133,6 +151,7 @@ pub(super) fn padded(b: Aabb) -> ([f32; 3], [f32; 3]) {
 fn sah_split(
     slice: &mut [u32],
     bounds: &[Aabb],
+    is_solo: &impl Fn(u32) -> bool,
     centroids: &[Vec3],
     node_bounds: Aabb,
     centroid_bounds: Aabb,
@@ -147,30 +166,37 @@ fn sah_split(
         let scale = BINS as f32 / extent[axis];
         let lo = centroid_bounds.min[axis];
         let mut bin_bounds = [Aabb::EMPTY; BINS];
-        let mut bin_count = [0u32; BINS];
+        // Per bin: primitives tested in packs, and those tested alone.
+        let mut bin_count = [(0u32, 0u32); BINS];
         for &i in slice.iter() {
             let b = bin_index(centroids[i as usize][axis], lo, scale);
             bin_bounds[b] = bin_bounds[b].union(bounds[i as usize]);
-            bin_count[b] += 1;
+            if is_solo(i) {
+                bin_count[b].1 += 1;
+            } else {
+                bin_count[b].0 += 1;
+            }
         }
         // Sweep from the right to get suffix areas and counts.
         let mut right_area = [0.0f32; BINS];
-        let mut right_count = [0u32; BINS];
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0u32);
+        let mut right_count = [(0u32, 0u32); BINS];
+        let (mut acc, mut cnt) = (Aabb::EMPTY, (0u32, 0u32));
         for b in (1..BINS).rev() {
             acc = acc.union(bin_bounds[b]);
-            cnt += bin_count[b];
+            cnt = (cnt.0 + bin_count[b].0, cnt.1 + bin_count[b].1);
             right_area[b] = acc.half_area();
             right_count[b] = cnt;
         }
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0u32);
+        let (mut acc, mut cnt) = (Aabb::EMPTY, (0u32, 0u32));
         for b in 1..BINS {
             acc = acc.union(bin_bounds[b - 1]);
-            cnt += bin_count[b - 1];
-            if cnt == 0 || right_count[b] == 0 {
+            cnt = (cnt.0 + bin_count[b - 1].0, cnt.1 + bin_count[b - 1].1);
+            let right = right_count[b];
+            if cnt.0 + cnt.1 == 0 || right.0 + right.1 == 0 {
                 continue;
             }
-            let cost = acc.half_area() * blocks(cnt) + right_area[b] * blocks(right_count[b]);
+            let cost =
+                acc.half_area() * blocks(cnt.0, cnt.1) + right_area[b] * blocks(right.0, right.1);
             if best.is_none_or(|(c, _, _)| cost < c) {
                 best = Some((cost, axis, b));
             }
@@ -184,7 +210,8 @@ fn sah_split(
         } else {
             0.0
         };
-    let leaf_cost = blocks(slice.len() as u32);
+    let solo = slice.iter().filter(|&&i| is_solo(i)).count() as u32;
+    let leaf_cost = blocks(slice.len() as u32 - solo, solo);
     if slice.len() <= MAX_LEAF && split_cost >= leaf_cost {
         return None;
     }

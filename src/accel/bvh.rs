@@ -140,7 +140,16 @@ impl Bvh {
     /// Builds a BVH with the binned surface-area heuristic over the given primitive bounds.
     #[must_use]
     pub fn build(bounds: &[Aabb]) -> Bvh {
-        let (binary, order) = super::build::build(bounds);
+        Bvh::build_with_solo(bounds, &[])
+    }
+
+    /// [`Bvh::build`] for primitives of two kinds: `solo[i]` marks primitive `i` as one that
+    /// leaves test on its own (a sphere), which the SAH prices like two whole blocks of
+    /// [`LEAF_BLOCK`] packed triangles, so such primitives get leaves of their own unless they are
+    /// large. A `solo` shorter than `bounds` marks the rest as packed.
+    #[must_use]
+    pub fn build_with_solo(bounds: &[Aabb], solo: &[bool]) -> Bvh {
+        let (binary, order) = super::build::build(bounds, solo);
         let bounds = binary.first().map_or(Aabb::EMPTY, BvhNode::bounds);
         let (nodes, order, stack_need) = collapse(&binary, &order);
         Bvh {
@@ -365,5 +374,60 @@ mod tests {
             kids.len() - 1 + deepest
         }
         assert_eq!(bvh.stack_need(), need(&bvh, 0));
+    }
+
+    /// The leaf holding primitive `p`: its bounds and its primitives.
+    fn leaf_of(bvh: &Bvh, p: u32) -> (Aabb, Vec<u32>) {
+        for n in &bvh.nodes {
+            for c in (0..WIDTH).filter(|&c| n.has_child(c) && n.count[c] > 0) {
+                let (i, k) = (n.index[c] as usize, n.count[c] as usize);
+                let prims = bvh.order[i..i + k].to_vec();
+                if prims.contains(&p) {
+                    return (n.child_bounds(c), prims);
+                }
+            }
+        }
+        panic!("primitive {p} in no leaf");
+    }
+
+    #[test]
+    fn solo_primitives_get_their_own_leaves_in_a_room_of_walls() {
+        // The caustic Cornell box (benches/scenes/cbox_caustic.ron): five 2-unit walls of two
+        // triangles each (no front wall), a glass and a mirror ball and a small spherical light.
+        // Packed, some ball shares a room-sized leaf that nearly every ray tests; priced as solo,
+        // each ball has a leaf of its own, bounded by its own box.
+        let wall = |axis: usize, side: f32| {
+            let mut min = Vec3::splat(-1.0);
+            let mut max = Vec3::splat(1.0);
+            min[axis] = side;
+            max[axis] = side;
+            Aabb { min, max }
+        };
+        let mut input = Vec::new();
+        for (axis, side) in [(0, -1.0), (0, 1.0), (1, -1.0), (1, 1.0), (2, -1.0)] {
+            input.extend([wall(axis, side); 2]);
+        }
+        let ball = |c: Vec3, r: f32| Aabb {
+            min: c - Vec3::splat(r),
+            max: c + Vec3::splat(r),
+        };
+        input.push(ball(Vec3::new(-0.42, -0.62, -0.25), 0.38));
+        input.push(ball(Vec3::new(0.45, -0.65, 0.25), 0.35));
+        input.push(ball(Vec3::new(0.0, 0.75, 0.0), 0.08));
+        let balls = [10u32, 11, 12];
+        let packed = Bvh::build(&input);
+        assert!(
+            balls.iter().any(|&b| leaf_of(&packed, b).1.len() > 1),
+            "packed build already isolates the balls: the test shows nothing"
+        );
+        let mut solo = vec![false; 10];
+        solo.extend([true; 3]);
+        let bvh = Bvh::build_with_solo(&input, &solo);
+        for b in balls {
+            let (bounds, prims) = leaf_of(&bvh, b);
+            assert_eq!(prims, vec![b]);
+            assert!(contains(bounds, input[b as usize]));
+            assert!(bounds.half_area() < 1.01 * input[b as usize].half_area());
+        }
     }
 }

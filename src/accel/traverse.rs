@@ -16,14 +16,23 @@ const STACK_SMALL: usize = 64;
 /// at most `WIDTH - 1` entries each.
 const STACK_MAX: usize = (WIDTH - 1) * 64 + 1;
 
-/// Widening of the far slab distance that covers the slab computation's rounding (pbrt's 1 + 2γ₃).
-const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
+/// `1/d` for the far planes: widened by 1 + 2γ₄, so that even after this product's own rounding
+/// (half an ulp) it is at least 1 + 2γ₃ times `1/d` in magnitude, pbrt's widening of the far slab
+/// distance that covers the slab computation's rounding. Applied to `1/d` once per ray rather
+/// than to every node's far distances, the multiplication is off the chain from a node's load to
+/// the choice of its children.
+#[inline]
+fn scale_up(inv: f32) -> f32 {
+    inv * (1.0 + 2.0 * gamma(4))
+}
 
 /// Per-ray constants of the slab test.
 #[derive(Debug, Clone, Copy)]
 pub struct RayBoxTest {
     o: [f32x8; 3],
     inv: [f32x8; 3],
+    /// `inv` times [`FAR_SCALE`] (rounded up), for the far planes.
+    inv_far: [f32x8; 3],
     /// Per axis, which of a node's planes (0 = min, 1 = max) the ray crosses first.
     near: [usize; 3],
 }
@@ -79,6 +88,11 @@ impl RayBoxTest {
                 f32x8::splat(inv.y),
                 f32x8::splat(inv.z),
             ],
+            inv_far: [
+                f32x8::splat(scale_up(inv.x)),
+                f32x8::splat(scale_up(inv.y)),
+                f32x8::splat(scale_up(inv.z)),
+            ],
             near: [near(inv.x), near(inv.y), near(inv.z)],
         }
     }
@@ -109,15 +123,16 @@ impl RayBoxTest {
             let n = near[axis] & 1;
             let b = &node.bounds[axis];
             let near = (b[n] - self.o[axis]) * self.inv[axis];
-            let far = (b[n ^ 1] - self.o[axis]) * self.inv[axis];
+            let far = (b[n ^ 1] - self.o[axis]) * self.inv_far[axis];
             (near, far)
         };
         let (nx, fx) = slab(0);
         let (ny, fy) = slab(1);
         let (nz, fz) = slab(2);
-        let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
-        let far =
-            (fx.fast_min(fy).fast_min(fz) * f32x8::splat(FAR_SCALE)).fast_min(f32x8::splat(t_max));
+        // Two levels of max/min instead of a chain of three: each pair's NaN (second operand) is
+        // dropped by the outer operation, whose second operand is never NaN.
+        let near = nx.fast_max(ny).fast_max(nz.fast_max(f32x8::ZERO));
+        let far = fx.fast_min(fy).fast_min(fz.fast_min(f32x8::splat(t_max)));
         (near.simd_le(far).to_bitmask(), near.to_array())
     }
 }
@@ -664,5 +679,23 @@ mod tests {
         assert!(any_slots(&one, &r, 5.0, |_, _| true));
         let miss = RayBoxTest::new(Vec3::new(5.0, 5.0, -1.0), Vec3::Z);
         assert!(!any_slots(&one, &miss, 5.0, |_, _| true));
+    }
+
+    #[test]
+    fn far_reciprocal_is_widened_by_at_least_pbrt_factor() {
+        // |scale_up(inv)| >= |inv| (1 + 2γ₃), checked exactly in f64, over many magnitudes.
+        let factor = 1.0 + 2.0 * f64::from(gamma(3));
+        let mut rng = crate::sampling::Rng::new(1, 2);
+        for _ in 0..100_000 {
+            let e = (rng.next_u32() % 200) as i32 - 100;
+            let inv = (1.0 + rng.next_f32()) * 2f32.powi(e);
+            for v in [inv, -inv] {
+                let w = f64::from(scale_up(v));
+                assert!(w.abs() >= f64::from(v).abs() * factor, "{v}");
+                assert_eq!(w.signum(), f64::from(v).signum());
+            }
+        }
+        assert_eq!(scale_up(f32::INFINITY), f32::INFINITY);
+        assert_eq!(scale_up(f32::NEG_INFINITY), f32::NEG_INFINITY);
     }
 }

@@ -183,7 +183,12 @@ impl GeometryBuilder {
             refs.push(PrimRef::new(PrimKind::Ellipsoid, i));
             bounds.push(ellipsoid_bounds(&e.world_from_object));
         }
-        let bvh = Bvh::build(&bounds);
+        // Spheres and ellipsoids are tested one at a time, triangles in packs.
+        let solo: Vec<bool> = refs
+            .iter()
+            .map(|r| r.kind() != PrimKind::Triangle)
+            .collect();
+        let bvh = Bvh::build_with_solo(&bounds, &solo);
         let mut g = Geometry {
             slots: Vec::with_capacity(refs.len()),
             triangles: Vec::with_capacity(self.triangles.len()),
