@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
+    restore_sigpipe();
     let args = cli::Cli::parse();
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
@@ -28,3 +29,22 @@ fn error_text(e: &caustic::Error) -> String {
         _ => format!("error: {text}"),
     }
 }
+
+/// Lets a closed standard output end the program quietly, as it does every Unix tool
+/// (`caustic compare a.exr b.exr | head -1`): Rust ignores SIGPIPE, which would turn the failed
+/// write into a panic.
+#[cfg(unix)]
+fn restore_sigpipe() {
+    // POSIX `signal(SIGPIPE, SIG_DFL)`; SIGPIPE is 13 and SIG_DFL is 0 on Linux and macOS.
+    unsafe extern "C" {
+        fn signal(signum: i32, handler: usize) -> usize;
+    }
+    // SAFETY: called first thing in `main`, before any thread starts; resetting a signal's
+    // disposition to the default touches no Rust state.
+    unsafe {
+        signal(13, 0);
+    }
+}
+
+#[cfg(not(unix))]
+fn restore_sigpipe() {}

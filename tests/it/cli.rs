@@ -402,3 +402,21 @@ fn debug_pixel_prints_the_ray_tree() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("outside"));
 }
+
+#[test]
+fn a_closed_output_pipe_ends_the_program_quietly() {
+    // `caustic schema | head -0`: the reader is gone before the program writes; it must stop
+    // without a panic message (it used to panic in `println!` on the broken pipe).
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_caustic"))
+        .arg("schema")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("caustic starts");
+    drop(child.stdout.take()); // Close the pipe's only reader.
+    let out = child.wait_with_output().expect("caustic ends");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_ne!(out.status.code(), Some(101), "a panic's exit code");
+}
