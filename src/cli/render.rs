@@ -66,10 +66,10 @@ pub struct RenderArgs {
     /// when the RMSE against the reference is above this.
     #[arg(long, value_name = "RMSE", requires = "compare", value_parser = parse_max_rmse)]
     max_rmse: Option<f64>,
-    /// Seconds between checkpoints (0: after every pass).
+    /// Time between checkpoints: seconds, or with a unit (`90s`, `5m`); 0: after every pass.
     #[arg(
         long,
-        value_name = "SECONDS",
+        value_name = "DURATION",
         default_value = "30",
         requires = "checkpoint",
         value_parser = parse_seconds
@@ -127,11 +127,14 @@ fn parse_max_rmse(text: &str) -> Result<f64, String> {
 }
 
 fn parse_seconds(text: &str) -> Result<Duration, String> {
-    text.trim()
-        .parse::<f64>()
-        .ok()
-        .and_then(|s| Duration::try_from_secs_f64(s).ok())
-        .ok_or_else(|| format!("expected a non-negative number of seconds, found `{text}`"))
+    if text.trim().parse::<f64>().is_ok_and(|s| s == 0.0) {
+        return Ok(Duration::ZERO);
+    }
+    parse_duration(text).map_err(|_| {
+        format!(
+            "expected seconds or a duration such as `30`, `90s` or `5m` (0: after every pass), found `{text}`"
+        )
+    })
 }
 
 /// A duration such as `30s`, `2m`, `1.5h`, `250ms` or a bare number of seconds; positive.

@@ -389,3 +389,27 @@ mod cli {
         );
     }
 }
+
+#[test]
+fn checkpoint_intervals_take_units() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (cp, out) = (dir.path().join("cp.png"), dir.path().join("x.png"));
+    let o = crate::common::caustic(&[
+        "render",
+        "scenes/cornell.ron",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "2",
+        "--checkpoint",
+        cp.to_str().expect("utf-8"),
+        "--checkpoint-every",
+        "5m",
+        "-o",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.exists());
+}
