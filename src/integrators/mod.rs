@@ -3,17 +3,15 @@
 //! and then asked for the radiance of camera samples by every worker.
 
 pub mod path;
-pub mod path_ppm;
 pub mod photon;
-pub mod ppm;
+pub mod progressive;
 pub mod shadow;
 pub mod trace_log;
 pub mod whitted;
 
 pub use path::PathTracer;
-pub use path_ppm::PathPpm;
 pub use photon::PhotonMapper;
-pub use ppm::Ppm;
+pub use progressive::ProgressivePath;
 pub use trace_log::TraceLog;
 pub use whitted::Whitted;
 
@@ -133,10 +131,10 @@ pub enum Integrator<'a> {
     Path(PathTracer<'a>),
     /// Photon mapping ([`PhotonMapper`]); its maps are built by `prepare`.
     Photon(Box<PhotonMapper<'a>>),
-    /// Progressive photon mapping ([`Ppm`]); fresh maps every pass.
-    Ppm(Box<Ppm<'a>>),
-    /// Path tracing with progressive photon-mapped caustics ([`PathPpm`]).
-    PathPpm(Box<PathPpm<'a>>),
+    /// Progressive photon mapping ([`ProgressivePath::ppm`]); fresh maps every pass.
+    Ppm(Box<ProgressivePath<'a>>),
+    /// Path tracing with progressive photon maps ([`ProgressivePath::path_ppm`]).
+    PathPpm(Box<ProgressivePath<'a>>),
 }
 
 impl<'a> Integrator<'a> {
@@ -156,8 +154,10 @@ impl<'a> Integrator<'a> {
             IntegratorKind::Photon => {
                 Integrator::Photon(Box::new(PhotonMapper::new(scene, photon_cache)))
             }
-            IntegratorKind::Ppm => Integrator::Ppm(Box::new(Ppm::new(scene))),
-            IntegratorKind::PathPpm => Integrator::PathPpm(Box::new(PathPpm::new(scene))),
+            IntegratorKind::Ppm => Integrator::Ppm(Box::new(ProgressivePath::ppm(scene))),
+            IntegratorKind::PathPpm => {
+                Integrator::PathPpm(Box::new(ProgressivePath::path_ppm(scene)))
+            }
         }
     }
 
@@ -167,8 +167,7 @@ impl<'a> Integrator<'a> {
     pub fn photon_maps(&self) -> Option<&photon::PhotonMaps> {
         match self {
             Integrator::Photon(p) => Some(p.maps()),
-            Integrator::Ppm(p) => Some(p.photons().maps()),
-            Integrator::PathPpm(p) => Some(p.photons().maps()),
+            Integrator::Ppm(p) | Integrator::PathPpm(p) => Some(p.photons().maps()),
             _ => None,
         }
     }
@@ -177,8 +176,7 @@ impl<'a> Integrator<'a> {
     #[must_use]
     pub fn progressive(&self) -> Option<&photon::ProgressivePhotons<'a>> {
         match self {
-            Integrator::Ppm(p) => Some(p.photons()),
-            Integrator::PathPpm(p) => Some(p.photons()),
+            Integrator::Ppm(p) | Integrator::PathPpm(p) => Some(p.photons()),
             _ => None,
         }
     }
@@ -194,8 +192,7 @@ impl<'a> Integrator<'a> {
     /// maps, built in parallel on the calling thread pool); a no-op for the others.
     pub fn begin_pass(&mut self, sample: u32) {
         match self {
-            Integrator::Ppm(p) => p.begin_pass(sample),
-            Integrator::PathPpm(p) => p.begin_pass(sample),
+            Integrator::Ppm(p) | Integrator::PathPpm(p) => p.begin_pass(sample),
             _ => {}
         }
     }
@@ -227,8 +224,7 @@ impl<'a> Integrator<'a> {
             Integrator::Whitted(w) => w.li(ray, sampler, counters, log),
             Integrator::Path(p) => p.li(ray, sampler, counters, log),
             Integrator::Photon(p) => p.li(ray, sampler, counters, log),
-            Integrator::Ppm(p) => p.li(ray, sampler, counters, log),
-            Integrator::PathPpm(p) => p.li(ray, sampler, counters, log),
+            Integrator::Ppm(p) | Integrator::PathPpm(p) => p.li(ray, sampler, counters, log),
         }
     }
 }

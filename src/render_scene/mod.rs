@@ -90,9 +90,9 @@ pub enum IntegratorKind {
     Path,
     /// Photon mapping (`integrators::PhotonMapper`).
     Photon,
-    /// Progressive photon mapping (`integrators::Ppm`).
+    /// Progressive photon mapping (`integrators::ProgressivePath::ppm`).
     Ppm,
-    /// Path tracing with progressive photon-mapped caustics (`integrators::PathPpm`).
+    /// Path tracing with progressive photon maps (`integrators::ProgressivePath::path_ppm`).
     PathPpm,
 }
 
