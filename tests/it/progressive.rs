@@ -207,6 +207,13 @@ fn a_point_lights_caustic_through_a_ball_lens_carries_the_power_it_passes() {
 /// A glass ball under a small sphere light over a floor: a caustic both the path tracer (by
 /// chance hits of the light through the ball) and the photon integrators render.
 fn glass_caustic(integrator: &str, spp: u32) -> String {
+    let photons = if integrator == "Photon" {
+        // Traced once: many photons, no global map (the floor's indirect light is tiny).
+        "(global: 0, caustic: 2000000, caustic_gather: 100, final_gather: 0, caustic_filter: Box)"
+    } else {
+        // Per pass.
+        "(global: 20000, caustic: 100000, caustic_gather: 40, gather: 40, caustic_filter: Box)"
+    };
     format!(
         r#"Scene(
     render: (width: 16, height: 16, samples_per_pixel: {spp}, max_depth: 12, seed: 5, integrator: {integrator}),
@@ -215,7 +222,7 @@ fn glass_caustic(integrator: &str, spp: u32) -> String {
         "floor": (color: (0.8, 0.8, 0.8)),
         "glass": (color: (1, 1, 1), diffuse: 0, transmit: 1, ior: 1.5),
     }},
-    photons: (global: 20000, caustic: 100000, caustic_gather: 40, gather: 40, caustic_filter: Box),
+    photons: {photons},
     lights: [ Sphere(center: (0, 2.5, 0), radius: 0.1, power: (40, 40, 40)) ],
     nodes: [
         Quad(material: "floor", size: (8, 8), transform: [RotateX(-90)]),
@@ -237,7 +244,12 @@ fn block(f: &Film, bx: u32, by: u32) -> f32 {
 }
 
 #[test]
-fn progressive_integrators_converge_to_the_path_tracers_glass_caustic() {
+fn photon_integrators_agree_with_the_path_tracers_glass_caustic() {
+    // A glass ball under a small sphere light focuses a caustic on the floor, which the path
+    // tracer renders too (slowly: through BSDF sampling of the refracted paths). Effort: path
+    // 4096 spp; photon 4 spp over 2M caustic photons; ppm and path-ppm 48 passes of 100k.
+    // Tolerance: image mean within 3 % (5 % for photon, whose estimate keeps its blur), the
+    // brightest 4×4 block (the caustic) within 10 % (15 %).
     let path = render(
         &scene_from_text(&glass_caustic("Path", 4096)),
         &RenderOptions::default(),
@@ -252,9 +264,13 @@ fn progressive_integrators_converge_to_the_path_tracers_glass_caustic() {
             }
         }
     }
-    for integrator in ["Ppm", "PathPpm"] {
+    for (integrator, spp, mean_tol, block_tol) in [
+        ("Photon", 4, 0.05, 0.15),
+        ("Ppm", 48, 0.03, 0.1),
+        ("PathPpm", 48, 0.03, 0.1),
+    ] {
         let out = render(
-            &scene_from_text(&glass_caustic(integrator, 48)),
+            &scene_from_text(&glass_caustic(integrator, spp)),
             &RenderOptions::default(),
         )
         .expect("renders");
@@ -262,11 +278,11 @@ fn progressive_integrators_converge_to_the_path_tracers_glass_caustic() {
         let c = block(&out.film, at.0, at.1);
         eprintln!("{integrator}: image mean {p} vs path {q}; caustic block {c} vs {best}");
         assert!(
-            (p.x / q.x - 1.0).abs() < 0.03,
+            (p.x / q.x - 1.0).abs() < mean_tol,
             "{integrator}: {p} vs path {q}"
         );
         assert!(
-            (c / best - 1.0).abs() < 0.1,
+            (c / best - 1.0).abs() < block_tol,
             "{integrator}: caustic block {c} vs path {best}"
         );
     }
