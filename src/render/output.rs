@@ -5,7 +5,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use image::{ImageFormat, Rgb32FImage, RgbImage};
+use image::{ImageFormat, RgbImage};
 
 use super::Film;
 
@@ -35,8 +35,8 @@ pub enum OutputError {
         /// The OS error.
         source: std::io::Error,
     },
-    /// The EXR layers could not be written.
-    #[error("error: cannot write the layers of `{}`: {reason}", path.display())]
+    /// The EXR file (with or without layers) could not be encoded.
+    #[error("error: cannot encode the EXR `{}`: {reason}", path.display())]
     Layers {
         /// The requested path.
         path: PathBuf,
@@ -116,11 +116,12 @@ pub fn encode(film: &Film, path: &Path, exposure: f32) -> Result<Vec<u8>, Output
     let result = match format {
         OutputFormat::Png => to_srgb8(film, exposure).write_to(&mut bytes, ImageFormat::Png),
         OutputFormat::Exr => {
-            let data: Vec<f32> = film.pixels.iter().flat_map(|p| p.to_array()).collect();
-            match Rgb32FImage::from_raw(film.width, film.height, data) {
-                Some(img) => img.write_to(&mut bytes, ImageFormat::OpenExr),
-                None => Ok(()),
-            }
+            return super::layers::encode_rgb_exr(
+                film.width as usize,
+                film.height as usize,
+                &|i| film.pixels[i],
+                path,
+            );
         }
     };
     result.map_err(|source| OutputError::Encode {
