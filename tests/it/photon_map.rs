@@ -129,7 +129,7 @@ fn stored_flux_in_a_closed_box_is_the_emitted_power_times_the_reflected_share() 
 
 /// A glass ball (R = 1, η = 1.5) under a point light 50 units up, seen through a square hole of
 /// half-side 0.15 in an opaque plate at y = 1.5, over a floor at y = −FLOOR.
-fn lens_scene(floor: f64) -> String {
+pub(crate) fn lens_scene(floor: f64) -> String {
     format!(
         r#"Scene(
     render: (width: 8, height: 8, seed: 4, integrator: Photon),
@@ -153,6 +153,31 @@ fn lens_scene(floor: f64) -> String {
     )
 }
 
+/// The power (W) the lens scene's 100 W point light sends through the plate's hole and both
+/// refractions of the ball: Φ/(4π) ∫ (1 − F(θ))² dΩ over the hole, θ the incidence on the ball
+/// (sin θ = D sin α / R for a ray at angle α from the axis); the exit is at the same angle
+/// inside, so the same Fresnel factor applies twice.
+pub(crate) fn lens_power() -> f64 {
+    let (eta, d, half, plate) = (1.5f64, 50.0f64, 0.15f64, 1.5f64);
+    let steps = 400;
+    let mut share = 0.0;
+    for i in 0..steps {
+        for j in 0..steps {
+            let x = (i as f64 + 0.5) / steps as f64 * 2.0 * half - half;
+            let z = (j as f64 + 0.5) / steps as f64 * 2.0 * half - half;
+            let h = d - plate;
+            let r2 = x * x + z * z + h * h;
+            let cos_a = h / r2.sqrt();
+            let d_omega = cos_a / r2 * (2.0 * half / steps as f64).powi(2);
+            let sin_a = (1.0 - cos_a * cos_a).sqrt();
+            let sin_t = d * sin_a; // R = 1
+            let t = 1.0 - fresnel((1.0 - sin_t * sin_t).sqrt(), eta);
+            share += t * t * d_omega / (4.0 * PI);
+        }
+    }
+    100.0 * share
+}
+
 /// Unpolarised Fresnel reflectance from air into a medium of index `eta` at incidence cos `ci`.
 fn fresnel(ci: f64, eta: f64) -> f64 {
     let st = (1.0 - ci * ci).sqrt() / eta;
@@ -166,7 +191,8 @@ fn fresnel(ci: f64, eta: f64) -> f64 {
 fn a_ball_lens_focuses_point_light_photons_at_the_paraxial_focus_with_the_power_it_passes() {
     // A ball lens has its principal planes at its centre and focal length f = ηR / (2(η − 1))
     // = 1.5; a source at s_o = 50 images at s_i = 1/(1/f − 1/s_o) below the centre.
-    let (eta, f, so) = (1.5f64, 1.5f64, 50.0f64);
+    let (eta, r, so) = (1.5f64, 1.0f64, 50.0f64);
+    let f = eta * r / (2.0 * (eta - 1.0));
     let si = 1.0 / (1.0 / f - 1.0 / so);
     let spread = |floor: f64| {
         let maps = build_maps(&scene_from_text(&lens_scene(floor)));
@@ -202,27 +228,7 @@ fn a_ball_lens_focuses_point_light_photons_at_the_paraxial_focus_with_the_power_
     // Geometric defocus alone gives ≈ 0.15·0.15 ≈ 0.023 at ±15 %; the focus is far tighter.
     assert!(at_focus < 0.01, "rms spot radius at the focus {at_focus}");
 
-    // Power through the hole and both refractions: Φ/(4π) ∫ (1 − F(θ))² dΩ over the hole,
-    // θ the incidence on the ball (sin θ = D sin α / R for a ray at angle α from the axis);
-    // the exit is at the same angle inside, so the same Fresnel factor applies twice.
-    let (d, half, plate) = (50.0f64, 0.15f64, 1.5f64);
-    let steps = 400;
-    let mut share = 0.0;
-    for i in 0..steps {
-        for j in 0..steps {
-            let x = (i as f64 + 0.5) / steps as f64 * 2.0 * half - half;
-            let z = (j as f64 + 0.5) / steps as f64 * 2.0 * half - half;
-            let h = d - plate;
-            let r2 = x * x + z * z + h * h;
-            let cos_a = h / r2.sqrt();
-            let d_omega = cos_a / r2 * (2.0 * half / steps as f64).powi(2);
-            let sin_a = (1.0 - cos_a * cos_a).sqrt();
-            let sin_t = d * sin_a; // R = 1
-            let t = 1.0 - fresnel((1.0 - sin_t * sin_t).sqrt(), eta);
-            share += t * t * d_omega / (4.0 * PI);
-        }
-    }
-    let expected = 100.0 * share;
+    let expected = lens_power();
     assert!(
         (flux / expected - 1.0).abs() < 0.03,
         "caustic flux {flux} W vs {expected} W through the hole and the ball"

@@ -115,26 +115,17 @@ fn a_point_lights_caustic_through_a_ball_lens_carries_the_power_it_passes() {
     // computation of `photon_map.rs`'s ball-lens test; a few per cent more scatter widely
     // after internal reflections). `max_depth: 1` keeps the floor's own estimate only: light
     // from the floor beyond the plate, sent back through the ball, is not part of that flux.
-    let text = r#"Scene(
-    render: (width: 8, height: 8, samples_per_pixel: 16, max_depth: 1, integrator: Ppm, seed: 4),
-    camera: Pinhole(eye: (0, 0, 6), look_at: (0, 0, 0), fov_y: 40),
-    materials: {
-        "glass": (color: (1, 1, 1), transmit: 1, ior: 1.5),
-        "plate": (color: (0.5, 0.5, 0.5)),
-        "floor": (color: (0.8, 0.8, 0.8)),
-    },
-    photons: (global: 0, caustic: 100000, caustic_gather: 40, caustic_filter: Box),
-    lights: [ Point(position: (0, 50, 0), power: (100, 100, 100)) ],
-    nodes: [
-        Sphere(material: "glass", center: (0, 0, 0), radius: 1),
-        Quad(material: "plate", size: (6, 2.85), transform: [RotateX(-90), Translate(0, 1.5, 1.575)]),
-        Quad(material: "plate", size: (6, 2.85), transform: [RotateX(-90), Translate(0, 1.5, -1.575)]),
-        Quad(material: "plate", size: (2.85, 0.3), transform: [RotateX(-90), Translate(1.575, 1.5, 0)]),
-        Quad(material: "plate", size: (2.85, 0.3), transform: [RotateX(-90), Translate(-1.575, 1.5, 0)]),
-        Quad(material: "floor", size: (20, 20), transform: [RotateX(-90), Translate(0, -1.2, 0)]),
-    ],
-)"#;
-    let scene = scene_from_text(text);
+    let text = crate::photon_map::lens_scene(1.2)
+        .replace(
+            "render: (width: 8, height: 8, seed: 4, integrator: Photon)",
+            "render: (width: 8, height: 8, samples_per_pixel: 16, max_depth: 1, integrator: Ppm, seed: 4)",
+        )
+        .replace(
+            "photons: (global: 0, caustic: 1000000)",
+            "photons: (global: 0, caustic: 100000, caustic_gather: 40, caustic_filter: Box)",
+        );
+    assert!(text.contains("integrator: Ppm") && text.contains("caustic: 100000"));
+    let scene = scene_from_text(&text);
     let mut it = Integrator::prepare(&scene);
     let mut sampler = Sampler::new(scene.params.sampler, 1, 16);
     let (n, half) = (48, 0.3f32);
@@ -167,30 +158,7 @@ fn a_point_lights_caustic_through_a_ball_lens_carries_the_power_it_passes() {
             }
         }
     }
-    let (d, hole, plate, eta) = (50.0f64, 0.15f64, 1.5f64, 1.5f64);
-    let fresnel = |ci: f64| {
-        let st = (1.0 - ci * ci).sqrt() / eta;
-        let ct = (1.0 - st * st).sqrt();
-        let rs = (ci - eta * ct) / (ci + eta * ct);
-        let rp = (ct - eta * ci) / (ct + eta * ci);
-        0.5 * (rs * rs + rp * rp)
-    };
-    let steps = 200;
-    let mut share = 0.0;
-    for i in 0..steps {
-        for j in 0..steps {
-            let x = (i as f64 + 0.5) / steps as f64 * 2.0 * hole - hole;
-            let z = (j as f64 + 0.5) / steps as f64 * 2.0 * hole - hole;
-            let h = d - plate;
-            let r2 = x * x + z * z + h * h;
-            let cos_a = h / r2.sqrt();
-            let d_omega = cos_a / r2 * (2.0 * hole / steps as f64).powi(2);
-            let sin_t = d * (1.0 - cos_a * cos_a).sqrt();
-            let t = 1.0 - fresnel((1.0 - sin_t * sin_t).sqrt());
-            share += t * t * d_omega / (4.0 * PI);
-        }
-    }
-    let expected = 100.0 * share;
+    let expected = crate::photon_map::lens_power();
     let flux = flux / 32.0;
     let (e4, e32) = (after_4 / expected - 1.0, flux / expected - 1.0);
     eprintln!(
