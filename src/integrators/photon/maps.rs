@@ -300,7 +300,29 @@ pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
         global: true,
         global_any_bounce: false,
     };
-    build_maps_with(scene, None, all)
+    build_maps_with(scene, &MapScene::new(scene), None, all)
+}
+
+/// What every build of a scene's maps needs and no pass changes: where caustic photons are
+/// aimed and the diffuse area the automatic radius spreads photons over. Made once per render
+/// (progressive integrators build maps every pass).
+#[derive(Debug, Clone)]
+pub struct MapScene {
+    /// Objects that reflect or transmit.
+    pub targets: CausticTargets,
+    /// Diffuse surface area, m² ([`diffuse_area`]).
+    pub area: f64,
+}
+
+impl MapScene {
+    /// Finds the targets and sums the diffuse area of `scene`.
+    #[must_use]
+    pub fn new(scene: &RenderScene) -> Self {
+        Self {
+            targets: CausticTargets::new(scene),
+            area: diffuse_area(scene),
+        }
+    }
 }
 
 /// Which maps to build.
@@ -321,7 +343,12 @@ pub struct MapSet {
 /// then is irradiance precomputed for final gathering). Maps estimate from k nearest photons
 /// within an automatic or given largest radius; progressive integrators then fix the radius.
 #[must_use]
-pub fn build_maps_with(scene: &RenderScene, pass: Option<u32>, set: MapSet) -> PhotonMaps {
+pub fn build_maps_with(
+    scene: &RenderScene,
+    prepared: &MapScene,
+    pass: Option<u32>,
+    set: MapSet,
+) -> PhotonMaps {
     let p = &scene.params.photons;
     let mut summary = PhotonSummary::default();
     let weights: Vec<f64> = scene
@@ -332,7 +359,7 @@ pub fn build_maps_with(scene: &RenderScene, pass: Option<u32>, set: MapSet) -> P
             f64::from((w.x + w.y + w.z) / 3.0)
         })
         .collect();
-    let targets = CausticTargets::new(scene);
+    let targets = &prepared.targets;
     summary.targets = targets.len();
     let mut sampler = Sampler::new(scene.params.sampler, scene.params.seed, 1);
 
@@ -360,7 +387,7 @@ pub fn build_maps_with(scene: &RenderScene, pass: Option<u32>, set: MapSet) -> P
             })
             .collect()
     };
-    let area = diffuse_area(scene);
+    let area = prepared.area;
     summary.auto_radius = p.max_radius.is_none();
 
     let t0 = Instant::now();
@@ -384,7 +411,7 @@ pub fn build_maps_with(scene: &RenderScene, pass: Option<u32>, set: MapSet) -> P
             max_bounces: p.max_bounces,
             pass,
         };
-        let (photons, counts) = trace_map(scene, &e, &targets, settings);
+        let (photons, counts) = trace_map(scene, &e, targets, settings);
         summary.caustic = counts;
         finish_map(
             photons,
@@ -418,7 +445,7 @@ pub fn build_maps_with(scene: &RenderScene, pass: Option<u32>, set: MapSet) -> P
             max_bounces: p.max_bounces,
             pass,
         };
-        let (photons, counts) = trace_map(scene, &e, &targets, settings);
+        let (photons, counts) = trace_map(scene, &e, targets, settings);
         summary.global = counts;
         finish_map(
             photons,

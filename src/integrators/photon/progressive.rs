@@ -17,7 +17,7 @@
 
 use std::time::{Duration, Instant};
 
-use super::maps::{MapSet, PhotonMaps, build_maps_with};
+use super::maps::{MapScene, MapSet, PhotonMaps, build_maps_with};
 use crate::render_scene::RenderScene;
 
 /// Knaus & Zwicker's radius schedule.
@@ -58,6 +58,8 @@ pub struct PassTotals {
 #[derive(Debug)]
 pub struct ProgressivePhotons<'a> {
     scene: &'a RenderScene,
+    /// The photon targets and diffuse area, found once for every pass.
+    prepared: MapScene,
     set: MapSet,
     schedule: RadiusSchedule,
     /// The pass whose maps `maps` holds (`None` before the first).
@@ -72,6 +74,7 @@ impl<'a> ProgressivePhotons<'a> {
     pub fn new(scene: &'a RenderScene, set: MapSet) -> Self {
         Self {
             scene,
+            prepared: MapScene::new(scene),
             set,
             schedule: RadiusSchedule {
                 alpha: f64::from(scene.params.photons.alpha),
@@ -89,7 +92,7 @@ impl<'a> ProgressivePhotons<'a> {
             return;
         }
         let t = Instant::now();
-        self.maps = build_maps_with(self.scene, Some(pass), self.set);
+        self.maps = build_maps_with(self.scene, &self.prepared, Some(pass), self.set);
         self.pass = Some(pass);
         let shrink = self.shrink(pass);
         for m in [self.maps.caustic.as_mut(), self.maps.global.as_mut()]
