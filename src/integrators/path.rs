@@ -193,10 +193,11 @@ impl<'a> PathTracer<'a> {
             let local = bsdf.has_local() && !background_only;
             let read_global =
                 local && may_scatter && maps.global.is_some() && diffuse_bounces == maps.global_at;
-            // Next-event estimation through the non-delta part.
-            let u_light = sampler.next_1d();
-            let u_point = sampler.next_2d();
-            if local && let Some((index, pmf)) = self.lights.sample(u_light) {
+            // Next-event estimation through the non-delta part. Every bounce reserves the same
+            // dimensions, whether or not it uses them, and computes only those it uses.
+            let u_light = sampler.defer_1d();
+            let u_point = sampler.defer_2d();
+            if local && let Some((index, pmf)) = self.lights.choose(|| sampler.get_1d(u_light)) {
                 let c = self.direct(
                     &sp,
                     wo,
@@ -204,7 +205,7 @@ impl<'a> PathTracer<'a> {
                     &bsdf,
                     index,
                     pmf,
-                    u_point,
+                    sampler.get_2d(u_point),
                     may_scatter && !read_global,
                     counters,
                     log.as_deref_mut(),
@@ -238,9 +239,14 @@ impl<'a> PathTracer<'a> {
                 }
             }
             // Continue the path by sampling the BSDF.
-            let u_lobe = sampler.next_1d();
+            let u_lobe = sampler.defer_1d();
             let u_dir = sampler.next_2d();
-            let u_rr = sampler.next_1d();
+            let u_rr = sampler.defer_1d();
+            let u_lobe = if bsdf.lobe_choice_matters() {
+                sampler.get_1d(u_lobe)
+            } else {
+                0.5
+            };
             let Some(s) = bsdf.sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance) else {
                 break;
             };
@@ -261,7 +267,7 @@ impl<'a> PathTracer<'a> {
             depth += 1;
             if depth > ROULETTE_DEPTH {
                 let q = (beta / eta_scale).max_element().min(1.0);
-                if u_rr >= q {
+                if sampler.get_1d(u_rr) >= q {
                     TraceLog::note(log.as_deref_mut(), node, "ended by Russian roulette");
                     break;
                 }

@@ -41,6 +41,18 @@ impl LightSampler {
         self.table.sample(u)
     }
 
+    /// [`LightSampler::sample`] with the number drawn by `u` only when there is a choice to
+    /// make: with a single light the result does not depend on it, so a sampler's deferred draw
+    /// ([`crate::sampling::Sampler::defer_1d`]) is never computed.
+    #[inline]
+    pub fn choose(&self, u: impl FnOnce() -> f32) -> Option<(usize, f32)> {
+        if self.table.len() == 1 {
+            self.table.sample(0.0)
+        } else {
+            self.table.sample(u())
+        }
+    }
+
     /// Probability that `sample` chooses light `i` (0 for dark lights and out-of-range indices);
     /// used for MIS when a BSDF-sampled ray hits light `i`.
     #[inline]
@@ -54,6 +66,25 @@ impl LightSampler {
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    #[test]
+    fn choose_skips_the_number_only_when_it_cannot_matter() {
+        let one = LightSampler::new(&[Light::sphere(Vec3::ONE, 0.5, Vec3::splat(2.0))]);
+        for k in 0..1000 {
+            let u = k as f32 / 1000.0;
+            assert_eq!(one.sample(u), one.choose(|| panic!("not needed")));
+        }
+        let two = LightSampler::new(&[
+            Light::point(Vec3::ZERO, Vec3::ONE),
+            Light::sphere(Vec3::ONE, 0.5, Vec3::splat(2.0)),
+        ]);
+        for k in 0..1000 {
+            let u = k as f32 / 1000.0;
+            assert_eq!(two.sample(u), two.choose(|| u));
+        }
+        let dark = LightSampler::new(&[Light::point(Vec3::ZERO, Vec3::ZERO)]);
+        assert_eq!(dark.choose(|| 0.3), None);
+    }
 
     #[test]
     fn probabilities_follow_mean_channel_power() {

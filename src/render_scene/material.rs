@@ -58,17 +58,18 @@ impl RenderScene {
         let mut bsdf = material.bsdf;
         let mut ns = sp.ns;
         if material.color_texture.is_some() || material.bump.is_some() {
+            let sps = self.geometry.surface_params(sp);
             let footprint = match self.params.texture_filter {
                 _ if !material.filtered => Footprint::POINT,
-                TextureFilter::Anisotropic => uv_footprint(width, -wo, sp.ng, sp.dpdu, sp.dpdv),
-                TextureFilter::Trilinear => {
-                    Footprint::isotropic(uv_footprint(width, -wo, sp.ng, sp.dpdu, sp.dpdv).width())
-                }
+                TextureFilter::Anisotropic => uv_footprint(width, -wo, sp.ng, sps.dpdu, sps.dpdv),
+                TextureFilter::Trilinear => Footprint::isotropic(
+                    uv_footprint(width, -wo, sp.ng, sps.dpdu, sps.dpdv).width(),
+                ),
                 TextureFilter::Bilinear => Footprint::POINT,
             };
             let lookup = Lookup {
                 p: sp.p,
-                uv: sp.uv,
+                uv: sps.uv,
                 footprint,
                 width: if self.params.texture_filter == TextureFilter::Bilinear {
                     0.0
@@ -77,7 +78,7 @@ impl RenderScene {
                 },
             };
             if let Some(t) = material.bump {
-                ns = self.textures[t as usize].bump(ns, sp.dpdu, sp.dpdv, &lookup);
+                ns = self.textures[t as usize].bump(ns, sps.dpdu, sps.dpdv, &lookup);
             }
             if let Some(t) = material.color_texture {
                 bsdf.color = self.textures[t as usize].color(&lookup);

@@ -13,7 +13,7 @@ pub use geometry::{Geometry, Hit, PrimRef};
 pub use light::{EmissionSample, Light, LightSample};
 pub use light_sampler::LightSampler;
 pub use material::{ShadingPoint, SurfaceMaterial};
-pub use surface::SurfacePoint;
+pub use surface::{SurfaceParams, SurfacePoint};
 pub use texture::Texture;
 
 use glam::Vec3;

@@ -9,7 +9,8 @@ use crate::geometry::float::gamma;
 use crate::geometry::sphere::{reproject_to_sphere, unit_quadric_t};
 use crate::geometry::triangle::hit_point_error;
 
-/// Everything shading needs about a hit point.
+/// Everything shading needs about a hit point, except its surface parameterisation
+/// ([`SurfaceParams`], which only textures read and [`Geometry::surface_params`] computes).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfacePoint {
     /// Position.
@@ -25,6 +26,26 @@ pub struct SurfacePoint {
     /// Ray Tracing Gems II ch. 4), so coarse smooth meshes do not shadow themselves in facets.
     /// Equal to `p` for everything else.
     pub p_outside: Vec3,
+    /// Owning object.
+    pub object: u32,
+    /// Where on its primitive the point lies, for [`Geometry::surface_params`]: the primitive,
+    /// and the barycentric weights of the second and third vertex (triangles) or the point on
+    /// the unit sphere (spheres: the normal; ellipsoids: the object-space point).
+    local: Local,
+}
+
+/// A hit's position on its primitive (see [`SurfacePoint`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Local {
+    prim: super::geometry::PrimRef,
+    b1: f32,
+    b2: f32,
+    unit: Vec3,
+}
+
+/// A surface's parameterisation at a point: what texture lookups and bump mapping need.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceParams {
     /// Texture coordinates.
     pub uv: Vec2,
     /// ∂p/∂u: how the position changes with `u` (a tangent; never zero — a surface without a
@@ -32,8 +53,6 @@ pub struct SurfacePoint {
     pub dpdu: Vec3,
     /// ∂p/∂v.
     pub dpdv: Vec3,
-    /// Owning object.
-    pub object: u32,
 }
 
 impl Geometry {
@@ -66,8 +85,6 @@ impl Geometry {
                     }
                     None => ng,
                 };
-                let uv = a.uvs[0] * b0 + a.uvs[1] * hit.b1 + a.uvs[2] * hit.b2;
-                let (dpdu, dpdv) = triangle_derivatives([p0, p1, p2], a.uvs, ng);
                 let p_outside = a.normals.map_or(p, |n| {
                     terminator_point(p, [p0, p1, p2], n, [b0, hit.b1, hit.b2])
                 });
@@ -77,10 +94,13 @@ impl Geometry {
                     p_error: hit_point_error(&th, p0, p1, p2),
                     ng,
                     ns,
-                    uv,
-                    dpdu,
-                    dpdv,
                     object: a.object,
+                    local: Local {
+                        prim: hit.prim,
+                        b1: hit.b1,
+                        b2: hit.b2,
+                        unit: Vec3::ZERO,
+                    },
                 }
             }
             PrimKind::Sphere => {
@@ -90,18 +110,19 @@ impl Geometry {
                 let pd = reproject_to_sphere(c, f64::from(s.radius), raw);
                 let n = ((pd - c) / f64::from(s.radius)).as_vec3().normalize();
                 let p = pd.as_vec3();
-                let uv = sphere_uv(n);
-                let (dpdu, dpdv) = sphere_derivatives(n, s.radius);
                 SurfacePoint {
                     p,
                     p_outside: p,
                     p_error: p.abs() * gamma(2),
                     ng: n,
                     ns: n,
-                    uv,
-                    dpdu,
-                    dpdv,
                     object: s.object,
+                    local: Local {
+                        prim: hit.prim,
+                        b1: 0.0,
+                        b2: 0.0,
+                        unit: n,
+                    },
                 }
             }
             PrimKind::Ellipsoid => {
@@ -114,21 +135,53 @@ impl Geometry {
                 let pd = e.world_from_object.transform_point3(po);
                 let n = (e.normal_to_world * po).as_vec3().normalize();
                 let p = pd.as_vec3();
-                let uv = sphere_uv(po.as_vec3());
-                let (du, dv) = sphere_derivatives(po.as_vec3(), 1.0);
-                let l = e.world_from_object.matrix3;
-                let dpdu = (l * du.as_dvec3()).as_vec3();
-                let dpdv = (l * dv.as_dvec3()).as_vec3();
                 SurfacePoint {
                     p,
                     p_outside: p,
                     p_error: p.abs() * gamma(3),
                     ng: n,
                     ns: n,
-                    uv,
+                    object: e.object,
+                    local: Local {
+                        prim: hit.prim,
+                        b1: 0.0,
+                        b2: 0.0,
+                        unit: po.as_vec3(),
+                    },
+                }
+            }
+        }
+    }
+
+    /// The parameterisation (uv and its derivatives) at a point [`Geometry::surface`] returned:
+    /// interpolated vertex uvs for triangles, longitude/latitude for spheres and ellipsoids
+    /// (pbrt's). Computed only for materials with textures.
+    #[must_use]
+    pub fn surface_params(&self, sp: &SurfacePoint) -> SurfaceParams {
+        let Local { prim, b1, b2, unit } = sp.local;
+        match prim.kind() {
+            PrimKind::Triangle => {
+                let a = &self.tri_attrs[prim.index()];
+                let b0 = 1.0 - b1 - b2;
+                let uv = a.uvs[0] * b0 + a.uvs[1] * b1 + a.uvs[2] * b2;
+                let (dpdu, dpdv) = triangle_derivatives(self.triangles[prim.index()], a.uvs, sp.ng);
+                SurfaceParams { uv, dpdu, dpdv }
+            }
+            PrimKind::Sphere => {
+                let (dpdu, dpdv) = sphere_derivatives(unit, self.spheres[prim.index()].radius);
+                SurfaceParams {
+                    uv: sphere_uv(unit),
                     dpdu,
                     dpdv,
-                    object: e.object,
+                }
+            }
+            PrimKind::Ellipsoid => {
+                let (du, dv) = sphere_derivatives(unit, 1.0);
+                let l = self.ellipsoids[prim.index()].world_from_object.matrix3;
+                SurfaceParams {
+                    uv: sphere_uv(unit),
+                    dpdu: (l * du.as_dvec3()).as_vec3(),
+                    dpdv: (l * dv.as_dvec3()).as_vec3(),
                 }
             }
         }

@@ -4,7 +4,7 @@
 //! for any thread count.
 
 use super::rng::{Rng, mix64};
-use super::sobol::{shuffled_scrambled_2d, to_unit_f32};
+use super::sobol::{shuffled_scrambled_1d, shuffled_scrambled_2d, to_unit_f32};
 
 /// Which sequence a [`Sampler`] draws from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -138,7 +138,7 @@ impl Sampler {
             SamplerKind::Sobol => {
                 let d = self.dimension;
                 self.dimension += 1;
-                self.sobol(d).0
+                self.sobol_1d(d)
             }
         }
     }
@@ -156,6 +156,69 @@ impl Sampler {
         }
     }
 
+    /// Reserves the next dimension for a number that may not be needed: its value, the one
+    /// [`Sampler::next_1d`] would have returned, is computed by [`Sampler::get_1d`] only if the
+    /// integrator uses it (the Sobol sampler's points cost a few hashes each). The independent
+    /// sampler draws it now, since its stream is sequential; either way the numbers of later
+    /// draws, and so the image, are the same whether or not it is used.
+    #[inline]
+    pub fn defer_1d(&mut self) -> Deferred1d {
+        match self.kind {
+            SamplerKind::Independent => Deferred1d {
+                dimension: 0,
+                value: self.rng.next_f32(),
+            },
+            SamplerKind::Sobol => {
+                let d = self.dimension;
+                self.dimension += 1;
+                Deferred1d {
+                    dimension: d,
+                    value: 0.0,
+                }
+            }
+        }
+    }
+
+    /// [`Sampler::defer_1d`] for a pair: the value [`Sampler::next_2d`] would have returned,
+    /// computed by [`Sampler::get_2d`].
+    #[inline]
+    pub fn defer_2d(&mut self) -> Deferred2d {
+        match self.kind {
+            SamplerKind::Independent => Deferred2d {
+                dimension: 0,
+                value: self.rng.next_2d(),
+            },
+            SamplerKind::Sobol => {
+                let d = self.dimension;
+                self.dimension += 2;
+                Deferred2d {
+                    dimension: d,
+                    value: (0.0, 0.0),
+                }
+            }
+        }
+    }
+
+    /// The number reserved by [`Sampler::defer_1d`] (valid until the next `start_*` call).
+    #[inline]
+    #[must_use]
+    pub fn get_1d(&self, d: Deferred1d) -> f32 {
+        match self.kind {
+            SamplerKind::Independent => d.value,
+            SamplerKind::Sobol => self.sobol_1d(d.dimension),
+        }
+    }
+
+    /// The pair reserved by [`Sampler::defer_2d`] (valid until the next `start_*` call).
+    #[inline]
+    #[must_use]
+    pub fn get_2d(&self, d: Deferred2d) -> (f32, f32) {
+        match self.kind {
+            SamplerKind::Independent => d.value,
+            SamplerKind::Sobol => self.sobol(d.dimension),
+        }
+    }
+
     /// The 2-D position inside the pixel for the camera ray (the sample's first two dimensions,
     /// whenever it is called).
     #[inline]
@@ -170,11 +233,42 @@ impl Sampler {
     /// shuffle and scrambles, keyed by (seed, pixel or stream, dimension) ("padding").
     #[inline]
     fn sobol(&self, dimension: u32) -> (f32, f32) {
-        let h = mix64(self.key ^ mix64(u64::from(dimension) ^ 0x9E37_79B9_7F4A_7C15));
+        let h = self.dimension_hash(dimension);
         let h2 = mix64(h);
         let (x, y) = shuffled_scrambled_2d(self.index, [h as u32, (h >> 32) as u32, h2 as u32]);
         (to_unit_f32(x), to_unit_f32(y))
     }
+
+    /// The first coordinate of [`Sampler::sobol`] alone (the same number, without computing
+    /// and scrambling the second).
+    #[inline]
+    fn sobol_1d(&self, dimension: u32) -> f32 {
+        let h = self.dimension_hash(dimension);
+        to_unit_f32(shuffled_scrambled_1d(
+            self.index,
+            [h as u32, (h >> 32) as u32],
+        ))
+    }
+
+    /// The hash keying dimension `dimension` of this sample's scrambles.
+    #[inline]
+    fn dimension_hash(&self, dimension: u32) -> u64 {
+        mix64(self.key ^ mix64(u64::from(dimension) ^ 0x9E37_79B9_7F4A_7C15))
+    }
+}
+
+/// A number reserved by [`Sampler::defer_1d`], read with [`Sampler::get_1d`].
+#[derive(Debug, Clone, Copy)]
+pub struct Deferred1d {
+    dimension: u32,
+    value: f32,
+}
+
+/// A pair reserved by [`Sampler::defer_2d`], read with [`Sampler::get_2d`].
+#[derive(Debug, Clone, Copy)]
+pub struct Deferred2d {
+    dimension: u32,
+    value: (f32, f32),
 }
 
 #[cfg(test)]

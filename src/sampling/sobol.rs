@@ -131,6 +131,17 @@ pub fn shuffled_scrambled_2d(index: u32, seeds: [u32; 3]) -> (u32, u32) {
     )
 }
 
+/// The first coordinate of [`shuffled_scrambled_2d`] with the same first two seeds, without
+/// computing the second.
+#[inline]
+#[must_use]
+pub fn shuffled_scrambled_1d(index: u32, seeds: [u32; 2]) -> u32 {
+    nested_uniform_scramble(
+        sobol_dim0(nested_uniform_scramble(index, seeds[0])),
+        seeds[1],
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -195,6 +195,19 @@ impl Bsdf {
         }
     }
 
+    /// Whether [`Bsdf::sample`]'s lobe number `u_lobe` can change its result: false for a
+    /// single lobe (pure Lambert, pure Phong, a pure mirror, or black), so integrators need not
+    /// draw it (`Sampler::defer_1d`). Any dielectric part, or two parts of non-zero weight,
+    /// make it matter.
+    #[inline]
+    #[must_use]
+    pub fn lobe_choice_matters(&self) -> bool {
+        let diffuse = self.diffuse > 0.0;
+        self.transmit > 0.0
+            || (diffuse && self.reflect > 0.0)
+            || (diffuse && self.specular != Vec3::ZERO && self.color != Vec3::ZERO)
+    }
+
     /// Probabilities of sampling the diffuse part, the mirror and the dielectric (summing to 1,
     /// or all 0 for a black BSDF), and within the diffuse part the Lambert lobe's share.
     #[inline]

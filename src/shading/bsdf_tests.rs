@@ -456,3 +456,58 @@ fn chi2_rejects_a_pdf_that_does_not_match_the_sampler() {
     );
     assert!(r.p_value < 1e-6, "{r:?}");
 }
+
+#[test]
+fn lobe_number_matters_exactly_where_lobe_choice_matters_says() {
+    let c = Vec3::new(0.7, 0.5, 0.3);
+    let materials = [
+        ("lambert", diffuse(0.8)),
+        ("black", diffuse(0.0)),
+        (
+            "phong only",
+            Bsdf::new(
+                Vec3::ZERO,
+                Vec3::splat(0.4),
+                30.0,
+                [Some(1.0), None, None],
+                1.5,
+            ),
+        ),
+        (
+            "mirror",
+            Bsdf::new(c, Vec3::ZERO, 1.0, [None, Some(1.0), None], 1.5),
+        ),
+        (
+            "glass",
+            Bsdf::new(Vec3::ONE, Vec3::ZERO, 1.0, [None, None, Some(1.0)], 1.5),
+        ),
+        (
+            "lambert + phong",
+            Bsdf::new(c, Vec3::splat(0.25), 20.0, [Some(1.0), None, None], 1.5),
+        ),
+        (
+            "lambert + mirror",
+            Bsdf::new(c, Vec3::ZERO, 1.0, [Some(0.5), Some(0.5), None], 1.5),
+        ),
+        ("mixed", mixed()),
+    ];
+    let mut rng = Rng::new(41, 2);
+    for (name, m) in materials {
+        let mut differs = false;
+        for entering in [true, false] {
+            let fr = frame_z(entering);
+            for wo in [dir(10.0, 30.0), dir(80.0, 200.0)] {
+                let wo = if entering { wo } else { -wo };
+                for _ in 0..200 {
+                    let u = rng.next_2d();
+                    let first = m.sample(wo, 0.0, u, &fr, TransportMode::Radiance);
+                    for k in 1..16 {
+                        let other = m.sample(wo, k as f32 / 16.0, u, &fr, TransportMode::Radiance);
+                        differs |= other != first;
+                    }
+                }
+            }
+        }
+        assert_eq!(differs, m.lobe_choice_matters(), "{name}");
+    }
+}

@@ -210,7 +210,9 @@ fn box_projected_uvs_are_oriented_like_cube_faces_on_all_six_sides() {
     let uv_at = |p: Vec3, out: Vec3| {
         let ray = Ray::new(p + out * 5.0, -out);
         let hit = s.geometry.intersect(&ray).expect("hits");
-        s.geometry.surface(&ray, &hit).uv
+        s.geometry
+            .surface_params(&s.geometry.surface(&ray, &hit))
+            .uv
     };
     for (out, right, up) in CUBE_FACES {
         let c = out + right * 0.1 + up * 0.1;

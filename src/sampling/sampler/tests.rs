@@ -259,3 +259,49 @@ fn names_round_trip() {
     assert_eq!(SamplerKind::from_name("Sobol"), Some(SamplerKind::Sobol));
     assert_eq!(SamplerKind::from_name("halton"), None);
 }
+
+#[test]
+fn deferred_draws_equal_eager_ones_and_unused_ones_change_nothing() {
+    for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
+        let mut eager = Sampler::new(kind, 9, 64);
+        let mut lazy = Sampler::new(kind, 9, 64);
+        for i in 0..64 {
+            for (x, y) in [(0, 0), (17, 3)] {
+                eager.start_pixel_sample(x, y, i);
+                lazy.start_pixel_sample(x, y, i);
+                let want = [
+                    eager.next_1d(),
+                    eager.next_2d().0,
+                    eager.next_1d(),
+                    eager.next_2d().1,
+                ];
+                let a = lazy.defer_1d();
+                let b = lazy.defer_2d();
+                // `c` is reserved and never read: the draw after it must not move.
+                let _c = lazy.defer_1d();
+                let d = lazy.defer_2d();
+                let got = [lazy.get_1d(a), lazy.get_2d(b).0, want[2], lazy.get_2d(d).1];
+                assert_eq!(
+                    got.map(f32::to_bits),
+                    want.map(f32::to_bits),
+                    "{kind:?} {i}"
+                );
+                // Reading a value twice gives it twice.
+                assert_eq!(lazy.get_1d(a).to_bits(), want[0].to_bits());
+            }
+        }
+    }
+}
+
+#[test]
+fn one_dimensional_sobol_draws_are_the_first_coordinate_of_the_pair() {
+    use crate::sampling::sobol::{shuffled_scrambled_1d, shuffled_scrambled_2d};
+    let mut r = crate::sampling::Rng::new(3, 4);
+    for _ in 0..10_000 {
+        let (i, s) = (r.next_u32(), [r.next_u32(), r.next_u32(), r.next_u32()]);
+        assert_eq!(
+            shuffled_scrambled_1d(i, [s[0], s[1]]),
+            shuffled_scrambled_2d(i, s).0
+        );
+    }
+}

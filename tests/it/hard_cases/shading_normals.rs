@@ -69,13 +69,14 @@ fn for_each_bumped_hit(s: &RenderScene, mut visit: impl FnMut(&BumpedHit)) {
             let material =
                 &s.materials[s.objects[sp.object as usize].material.expect("material") as usize];
             let Some(t) = material.bump else { continue };
+            let sps = s.geometry.surface_params(&sp);
             let l = Lookup {
                 p: sp.p,
-                uv: sp.uv,
+                uv: sps.uv,
                 footprint: caustic::texture::Footprint::POINT,
                 width: 0.0,
             };
-            let raw = s.textures[t as usize].bump(sp.ns, sp.dpdu, sp.dpdv, &l);
+            let raw = s.textures[t as usize].bump(sp.ns, sps.dpdu, sps.dpdv, &l);
             visit(&BumpedHit {
                 wo: -ray.dir,
                 sp,
