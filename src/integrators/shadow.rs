@@ -69,7 +69,15 @@ pub fn connect_light(
         return None;
     }
     counters.rays += 1;
-    let occluded = scene.geometry.occluded(&shadow_ray(sp, fr.ng, ls.point));
+    // The light's own surface is skipped: the sampled point is where the segment first meets
+    // it (the near side of a sphere light), so it cannot block the segment, and the test would
+    // cost a full quadric intersection on every shadow ray.
+    let own = Some(light as u32);
+    let occluded = scene
+        .geometry
+        .occluded_by(&shadow_ray(sp, fr.ng, ls.point), |prim| {
+            scene.objects[scene.geometry.object_of(prim) as usize].light != own
+        });
     Some(LightConnection { ls, f, occluded })
 }
 

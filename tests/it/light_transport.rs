@@ -322,3 +322,61 @@ fn floor_under_water_matches_the_analytic_radiance_from_above_and_from_below_the
         "from above: {l} ± {se} vs {above} (floor {floor})"
     );
 }
+
+#[test]
+fn a_sphere_light_shadows_another_light_but_never_itself() {
+    // Seen from the origin, the near light (radius 0.5 at height 2: a 14.5° half-angle) covers
+    // the far one (radius 0.3 at height 5: 3.4°) entirely. Shadow rays skip the surface of the
+    // light they aim at, never the others: every sample of the far light is blocked, none of
+    // the near light's.
+    let scene = scene_from_text(
+        r#"Scene(
+    render: (width: 4, height: 4),
+    camera: Pinhole(eye: (0, 1, 5), look_at: (0, 0, 0), fov_y: 30),
+    materials: { "m": (color: (0.5, 0.5, 0.5), diffuse: 1) },
+    lights: [
+        Sphere(center: (0, 2, 0), radius: 0.5, power: (10, 10, 10)),
+        Sphere(center: (0, 5, 0), radius: 0.3, power: (10, 10, 10)),
+    ],
+    nodes: [ Quad(material: "m", size: (10, 10), transform: [RotateX(-90)]) ],
+)"#,
+    );
+    let ray = Ray::new(
+        Vec3::new(0.0, 1.0, 5.0),
+        Vec3::new(0.0, -1.0, -5.0).normalize(),
+    );
+    let hit = scene.geometry.intersect(&ray).expect("the floor");
+    let sp = scene.geometry.surface(&ray, &hit);
+    let m = scene.objects[sp.object as usize]
+        .material
+        .expect("material");
+    let wo = -ray.dir;
+    let sh = scene.shading_point(&scene.materials[m as usize], &sp, wo, 0.0);
+    let fr = caustic::shading::ShadingFrame {
+        ns: sh.ns,
+        ng: sh.ng,
+        entering: sh.entering,
+    };
+    let mut rng = caustic::sampling::Rng::new(3, 0);
+    let mut counters = Counters::default();
+    let mut blocked = [0u32; 2];
+    let n = 2000;
+    for _ in 0..n {
+        let u = rng.next_2d();
+        for (light, b) in blocked.iter_mut().enumerate() {
+            let c = caustic::integrators::shadow::connect_light(
+                &scene,
+                light,
+                &sp,
+                wo,
+                &fr,
+                &sh.bsdf,
+                u,
+                &mut counters,
+            )
+            .expect("both lights are above the floor");
+            *b += u32::from(c.occluded);
+        }
+    }
+    assert_eq!(blocked, [0, n]);
+}
