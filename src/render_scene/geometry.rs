@@ -140,6 +140,10 @@ pub struct Geometry {
     pub tri_packs: Vec<TriPack4>,
     /// True if some slot holds a sphere or an ellipsoid: leaves are then checked for them.
     pub has_quadrics: bool,
+    /// Per pack of [`LEAF_BLOCK`] slots (as `tri_packs`): whether one of them is a sphere or an
+    /// ellipsoid, so a leaf (which starts on a pack) is checked for them in one or two loads
+    /// instead of a pass over its slots.
+    pub quadric_packs: Vec<bool>,
     /// Triangle positions, in leaf order.
     pub triangles: Vec<[Vec3; 3]>,
     /// Triangle attributes, parallel to `triangles`.
@@ -197,6 +201,7 @@ impl GeometryBuilder {
             ellipsoids: Vec::with_capacity(self.ellipsoids.len()),
             tri_packs: vec![TriPack4::EMPTY; bvh.order.len() / LEAF_BLOCK],
             has_quadrics: !self.spheres.is_empty() || !self.ellipsoids.is_empty(),
+            quadric_packs: vec![false; bvh.order.len() / LEAF_BLOCK],
             bvh: Bvh::default(),
         };
         for (slot, &o) in bvh.order.iter().enumerate() {
@@ -223,6 +228,7 @@ impl GeometryBuilder {
                     PrimRef::new(PrimKind::Ellipsoid, g.ellipsoids.len() - 1)
                 }
             };
+            g.quadric_packs[slot / LEAF_BLOCK] |= new.kind() != PrimKind::Triangle;
             g.slots.push(new);
         }
         g.bvh = bvh;
@@ -287,11 +293,7 @@ impl Geometry {
     ) -> Option<f32> {
         let (first, end) = (first as usize, (first + count) as usize);
         let mut found = None;
-        if self.has_quadrics
-            && self.slots[first..end]
-                .iter()
-                .any(|p| p.kind() != PrimKind::Triangle)
-        {
+        if self.leaf_has_quadrics(first, end) {
             for slot in first..end {
                 let prim = self.slots[slot];
                 if let Some((t, b1, b2)) = self.intersect_prim::<KZ>(prim, tri_ray, ray, t_max) {
@@ -395,11 +397,7 @@ impl Geometry {
         counts: impl Fn(PrimRef) -> bool,
     ) -> bool {
         let (first, end) = (first as usize, (first + count) as usize);
-        if self.has_quadrics
-            && self.slots[first..end]
-                .iter()
-                .any(|p| p.kind() != PrimKind::Triangle)
-        {
+        if self.leaf_has_quadrics(first, end) {
             return self.slots[first..end].iter().any(|&prim| {
                 counts(prim)
                     && self
@@ -438,6 +436,15 @@ impl Geometry {
             }
             false
         })
+    }
+
+    /// True if a sphere or ellipsoid is among slots `first .. end` (a leaf, starting on a pack).
+    #[inline(always)]
+    fn leaf_has_quadrics(&self, first: usize, end: usize) -> bool {
+        self.has_quadrics
+            && self.quadric_packs[first / LEAF_BLOCK..end.div_ceil(LEAF_BLOCK)]
+                .iter()
+                .any(|&q| q)
     }
 
     #[inline(always)]

@@ -4,7 +4,7 @@
 //! for any thread count.
 
 use super::rng::{Rng, mix64};
-use super::sobol::{shuffled_scrambled_1d, shuffled_scrambled_2d, to_unit_f32};
+use super::sobol::{shuffled_scrambled_1d_reversed, shuffled_scrambled_2d_reversed, to_unit_f32};
 
 /// Which sequence a [`Sampler`] draws from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -62,6 +62,8 @@ pub struct Sampler {
     key: u64,
     /// Index of the sample within its pixel or stream (the Sobol point index).
     index: u32,
+    /// `index` bit-reversed, which every Sobol draw of the sample starts from.
+    reversed_index: u32,
     /// Next dimension to draw.
     dimension: u32,
     /// Independent kind: the sample's stream.
@@ -81,6 +83,7 @@ impl Sampler {
             samples_per_pixel,
             key: 0,
             index: 0,
+            reversed_index: 0,
             dimension: 0,
             rng: Rng::new(seed, 0),
             pixel: (0.5, 0.5),
@@ -105,6 +108,7 @@ impl Sampler {
         let pixel = (u64::from(y) << 32) | u64::from(x);
         self.key = mix64(pixel ^ mix64(self.seed));
         self.index = index;
+        self.reversed_index = index.reverse_bits();
         self.dimension = FIRST_INTEGRATOR_DIMENSION;
         if self.kind == SamplerKind::Independent {
             self.rng = Rng::for_pixel_sample(self.seed, x, y, index);
@@ -123,6 +127,7 @@ impl Sampler {
                 ^ (index >> 32).wrapping_mul(0x3C6E_F372_FE94_F82B),
         );
         self.index = index as u32;
+        self.reversed_index = self.index.reverse_bits();
         self.dimension = 0;
         if self.kind == SamplerKind::Independent {
             self.rng = Rng::new(self.seed ^ self.key, index);
@@ -235,7 +240,8 @@ impl Sampler {
     fn sobol(&self, dimension: u32) -> (f32, f32) {
         let h = self.dimension_hash(dimension);
         let h2 = mix64(h);
-        let (x, y) = shuffled_scrambled_2d(self.index, [h as u32, (h >> 32) as u32, h2 as u32]);
+        let seeds = [h as u32, (h >> 32) as u32, h2 as u32];
+        let (x, y) = shuffled_scrambled_2d_reversed(self.reversed_index, seeds);
         (to_unit_f32(x), to_unit_f32(y))
     }
 
@@ -244,10 +250,8 @@ impl Sampler {
     #[inline]
     fn sobol_1d(&self, dimension: u32) -> f32 {
         let h = self.dimension_hash(dimension);
-        to_unit_f32(shuffled_scrambled_1d(
-            self.index,
-            [h as u32, (h >> 32) as u32],
-        ))
+        let seeds = [h as u32, (h >> 32) as u32];
+        to_unit_f32(shuffled_scrambled_1d_reversed(self.reversed_index, seeds))
     }
 
     /// The hash keying dimension `dimension` of this sample's scrambles.

@@ -60,6 +60,34 @@ const fn dim1_byte_tables() -> [[u32; 256]; 4] {
     t
 }
 
+/// The map `t ↦ reverse(sobol_dim1(reverse(t)))` folded per byte of `t` like
+/// [`SOBOL_DIM1_BYTES`]: it is linear over GF(2), with column `k` equal to the bit reversal of
+/// generator column `31 − k`. [`shuffled_scrambled_2d_reversed`] uses it to skip two bit
+/// reversals.
+const SOBOL_DIM1_REVERSED_BYTES: [[u32; 256]; 4] = dim1_reversed_byte_tables();
+
+const fn dim1_reversed_byte_tables() -> [[u32; 256]; 4] {
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut v = 0;
+        while v < 256 {
+            let mut x = 0;
+            let mut j = 0;
+            while j < 8 {
+                if v & (1 << j) != 0 {
+                    x ^= SOBOL_DIM1[31 - (b * 8 + j)].reverse_bits();
+                }
+                j += 1;
+            }
+            t[b][v] = x;
+            v += 1;
+        }
+        b += 1;
+    }
+    t
+}
+
 /// Sobol dimension 1 of point `index`: the XOR of the generator columns of its set bits.
 #[inline]
 #[must_use]
@@ -131,15 +159,33 @@ pub fn shuffled_scrambled_2d(index: u32, seeds: [u32; 3]) -> (u32, u32) {
     )
 }
 
-/// The first coordinate of [`shuffled_scrambled_2d`] with the same first two seeds, without
-/// computing the second.
+/// [`shuffled_scrambled_2d`] of the index whose bit reversal is `reversed_index` (the same
+/// two numbers), with the bit reversals that cancel left out: x86 has no instruction for them,
+/// and the direct form makes seven. With `t` the Laine–Karras permutation of the reversed
+/// index, the shuffled index is `reverse(t)`, so its dimension 0 is `t` itself and its
+/// dimension 1, reversed, is a linear map of `t` ([`SOBOL_DIM1_REVERSED_BYTES`]), which is
+/// what the Owen scramble of dimension 1 takes. Three reversals remain.
 #[inline]
 #[must_use]
-pub fn shuffled_scrambled_1d(index: u32, seeds: [u32; 2]) -> u32 {
-    nested_uniform_scramble(
-        sobol_dim0(nested_uniform_scramble(index, seeds[0])),
-        seeds[1],
+pub fn shuffled_scrambled_2d_reversed(reversed_index: u32, seeds: [u32; 3]) -> (u32, u32) {
+    let t = laine_karras_permutation(reversed_index, seeds[0]);
+    let [b0, b1, b2, b3] = t.to_le_bytes();
+    let y_reversed = SOBOL_DIM1_REVERSED_BYTES[0][b0 as usize]
+        ^ SOBOL_DIM1_REVERSED_BYTES[1][b1 as usize]
+        ^ SOBOL_DIM1_REVERSED_BYTES[2][b2 as usize]
+        ^ SOBOL_DIM1_REVERSED_BYTES[3][b3 as usize];
+    (
+        laine_karras_permutation(t.reverse_bits(), seeds[1]).reverse_bits(),
+        laine_karras_permutation(y_reversed, seeds[2]).reverse_bits(),
     )
+}
+
+/// The first coordinate of [`shuffled_scrambled_2d_reversed`] alone.
+#[inline]
+#[must_use]
+pub fn shuffled_scrambled_1d_reversed(reversed_index: u32, seeds: [u32; 2]) -> u32 {
+    let t = laine_karras_permutation(reversed_index, seeds[0]);
+    laine_karras_permutation(t.reverse_bits(), seeds[1]).reverse_bits()
 }
 
 #[cfg(test)]
@@ -168,6 +214,26 @@ mod tests {
         assert_eq!(f(1), (0.5, 0.5));
         assert_eq!(f(2), (0.25, 0.75));
         assert_eq!(f(3), (0.75, 0.25));
+    }
+
+    #[test]
+    fn the_reversed_forms_equal_the_direct_construction() {
+        let mut r = crate::sampling::Rng::new(11, 12);
+        for k in 0..200_000u32 {
+            let i = if k < 4096 { k } else { r.next_u32() };
+            let s = [r.next_u32(), r.next_u32(), r.next_u32()];
+            let direct = shuffled_scrambled_2d(i, s);
+            assert_eq!(
+                shuffled_scrambled_2d_reversed(i.reverse_bits(), s),
+                direct,
+                "{i}"
+            );
+            assert_eq!(
+                shuffled_scrambled_1d_reversed(i.reverse_bits(), [s[0], s[1]]),
+                direct.0,
+                "{i}"
+            );
+        }
     }
 
     #[test]

@@ -237,6 +237,7 @@ fn hash_geometry(h: &mut Fnv, g: &Geometry) {
         slots: _,
         tri_packs: _,
         has_quadrics: _,
+        quadric_packs: _,
         triangles,
         tri_attrs,
         spheres,

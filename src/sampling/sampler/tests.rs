@@ -292,16 +292,3 @@ fn deferred_draws_equal_eager_ones_and_unused_ones_change_nothing() {
         }
     }
 }
-
-#[test]
-fn one_dimensional_sobol_draws_are_the_first_coordinate_of_the_pair() {
-    use crate::sampling::sobol::{shuffled_scrambled_1d, shuffled_scrambled_2d};
-    let mut r = crate::sampling::Rng::new(3, 4);
-    for _ in 0..10_000 {
-        let (i, s) = (r.next_u32(), [r.next_u32(), r.next_u32(), r.next_u32()]);
-        assert_eq!(
-            shuffled_scrambled_1d(i, [s[0], s[1]]),
-            shuffled_scrambled_2d(i, s).0
-        );
-    }
-}
