@@ -58,6 +58,8 @@ pub struct Sampler {
     kind: SamplerKind,
     seed: u64,
     samples_per_pixel: u32,
+    /// `mix64(seed)`, which every pixel's key starts from.
+    seed_hash: u64,
     /// Hash of (seed, pixel or stream): keys every scramble of this sample's dimensions.
     key: u64,
     /// Index of the sample within its pixel or stream (the Sobol point index).
@@ -81,6 +83,7 @@ impl Sampler {
             kind,
             seed,
             samples_per_pixel,
+            seed_hash: mix64(seed),
             key: 0,
             index: 0,
             reversed_index: 0,
@@ -106,7 +109,7 @@ impl Sampler {
     /// pixel, and integrator draws start at dimension 2.
     pub fn start_pixel_sample(&mut self, x: u32, y: u32, index: u32) {
         let pixel = (u64::from(y) << 32) | u64::from(x);
-        self.key = mix64(pixel ^ mix64(self.seed));
+        self.key = mix64(pixel ^ self.seed_hash);
         self.index = index;
         self.reversed_index = index.reverse_bits();
         self.dimension = FIRST_INTEGRATOR_DIMENSION;
@@ -257,8 +260,13 @@ impl Sampler {
     /// The hash keying dimension `dimension` of this sample's scrambles.
     #[inline]
     fn dimension_hash(&self, dimension: u32) -> u64 {
-        mix64(self.key ^ mix64(u64::from(dimension) ^ 0x9E37_79B9_7F4A_7C15))
+        mix64(self.key ^ dimension_key(dimension))
     }
+}
+
+/// The per-dimension half of [`Sampler::dimension_hash`], which depends on nothing else.
+const fn dimension_key(dimension: u32) -> u64 {
+    mix64(dimension as u64 ^ 0x9E37_79B9_7F4A_7C15)
 }
 
 /// A number reserved by [`Sampler::defer_1d`], read with [`Sampler::get_1d`].
