@@ -36,37 +36,28 @@ pub fn sobol_dim0(index: u32) -> u32 {
 /// [`SOBOL_DIM1`] folded per index byte: entry `[b][v]` is the XOR of the columns of the set
 /// bits of byte value `v` in byte `b` of the index (4 KiB), so a point costs four lookups
 /// instead of a loop over up to 32 bits (the shuffled indices use all 32).
-const SOBOL_DIM1_BYTES: [[u32; 256]; 4] = dim1_byte_tables();
-
-const fn dim1_byte_tables() -> [[u32; 256]; 4] {
-    let mut t = [[0u32; 256]; 4];
-    let mut b = 0;
-    while b < 4 {
-        let mut v = 0;
-        while v < 256 {
-            let mut x = 0;
-            let mut j = 0;
-            while j < 8 {
-                if v & (1 << j) != 0 {
-                    x ^= SOBOL_DIM1[b * 8 + j];
-                }
-                j += 1;
-            }
-            t[b][v] = x;
-            v += 1;
-        }
-        b += 1;
-    }
-    t
-}
+const SOBOL_DIM1_BYTES: [[u32; 256]; 4] = byte_tables(SOBOL_DIM1);
 
 /// The map `t ↦ reverse(sobol_dim1(reverse(t)))` folded per byte of `t` like
 /// [`SOBOL_DIM1_BYTES`]: it is linear over GF(2), with column `k` equal to the bit reversal of
 /// generator column `31 − k`. [`shuffled_scrambled_2d_reversed`] uses it to skip two bit
 /// reversals.
-const SOBOL_DIM1_REVERSED_BYTES: [[u32; 256]; 4] = dim1_reversed_byte_tables();
+const SOBOL_DIM1_REVERSED_BYTES: [[u32; 256]; 4] = byte_tables(reversed_columns(SOBOL_DIM1));
 
-const fn dim1_reversed_byte_tables() -> [[u32; 256]; 4] {
+/// The columns of `t ↦ reverse(M · reverse(t))` for the matrix `M` with `columns`.
+const fn reversed_columns(columns: [u32; 32]) -> [u32; 32] {
+    let mut r = [0u32; 32];
+    let mut k = 0;
+    while k < 32 {
+        r[k] = columns[31 - k].reverse_bits();
+        k += 1;
+    }
+    r
+}
+
+/// A GF(2) matrix given by its 32 `columns` folded per byte of its input: entry `[b][v]` is
+/// the XOR of the columns of the set bits of value `v` in byte `b`.
+const fn byte_tables(columns: [u32; 32]) -> [[u32; 256]; 4] {
     let mut t = [[0u32; 256]; 4];
     let mut b = 0;
     while b < 4 {
@@ -76,7 +67,7 @@ const fn dim1_reversed_byte_tables() -> [[u32; 256]; 4] {
             let mut j = 0;
             while j < 8 {
                 if v & (1 << j) != 0 {
-                    x ^= SOBOL_DIM1[31 - (b * 8 + j)].reverse_bits();
+                    x ^= columns[b * 8 + j];
                 }
                 j += 1;
             }
