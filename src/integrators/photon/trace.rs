@@ -128,9 +128,14 @@ pub fn trace_photon(
             ng: sh.ng,
             entering: sh.entering,
         };
-        let u_lobe = sampler.next_1d();
+        let u_lobe = sampler.defer_1d();
         let u = sampler.next_2d();
         let u_rr = sampler.next_1d();
+        let u_lobe = if bsdf.lobe_choice_matters() {
+            sampler.get_1d(u_lobe)
+        } else {
+            0.5
+        };
         let Some(s) = bsdf.sample(wo, u_lobe, u, &fr, TransportMode::Importance) else {
             return;
         };
