@@ -136,14 +136,33 @@ fn interior(b: Aabb, first_child: usize) -> BvhNode {
 /// Node bounds grown by one ulp on every side, so every primitive point lies strictly inside its
 /// node's slabs: an axis-parallel ray sliding exactly along a primitive's bounding plane is then
 /// inside the slab instead of on its boundary, where `0·(1/d)` would be ambiguous.
+///
+/// A plane that would be subnormal (one ulp beyond a bound of exactly 0, e.g. a mesh vertex on a
+/// coordinate plane) is moved further out to `∓f32::MIN_POSITIVE`, the smallest normal value.
+/// Otherwise a ray whose origin lies on that coordinate plane (a camera at `x = 0`) computes
+/// `(plane − 0) · (1/d)` from a subnormal operand into a subnormal result for every such node it
+/// visits, and x86 CPUs take a microcode assist (on the order of a hundred cycles) for each
+/// multiplication with subnormal inputs or outputs: on the blob workload (camera at the origin of
+/// x and y, vertices on the x = 0 and y = 0 great circles) this made primary rays 1.4× slower.
 pub(super) fn padded(b: Aabb) -> ([f32; 3], [f32; 3]) {
     if b.is_empty() {
         return (b.min.to_array(), b.max.to_array());
     }
     (
-        b.min.to_array().map(next_down),
-        b.max.to_array().map(next_up),
+        b.min
+            .to_array()
+            .map(|v| normal_or(next_down(v), -f32::MIN_POSITIVE)),
+        b.max
+            .to_array()
+            .map(|v| normal_or(next_up(v), f32::MIN_POSITIVE)),
     )
+}
+
+/// `v`, or `outward` if `v` is subnormal (`outward` must lie beyond `v`: it replaces a lower plane
+/// with a lower one, an upper with a higher one).
+#[inline]
+fn normal_or(v: f32, outward: f32) -> f32 {
+    if v.is_subnormal() { outward } else { v }
 }
 
 /// Best SAH split of `slice` over all three axes; returns the size of the left part, or `None`
@@ -259,4 +278,57 @@ fn partition(slice: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
         }
     }
     first
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn padded_planes_enclose_strictly_and_are_never_subnormal() {
+        let tiny = f32::from_bits(1); // the smallest subnormal
+        let values = [
+            0.0,
+            -0.0,
+            tiny,
+            -tiny,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::MIN_POSITIVE * 0.5,
+            f32::from_bits(f32::MIN_POSITIVE.to_bits() + 1),
+            1.0,
+            -3.5,
+            1e30,
+        ];
+        for &v in &values {
+            for &w in &values {
+                let (lo, hi) = (v.min(w), v.max(w));
+                let b = Aabb {
+                    min: Vec3::new(lo, v, 1.0),
+                    max: Vec3::new(hi, v, 2.0),
+                };
+                let (min, max) = padded(b);
+                for axis in 0..3 {
+                    assert!(min[axis] < b.min[axis], "{v} {w}: {min:?} vs {:?}", b.min);
+                    assert!(max[axis] > b.max[axis], "{v} {w}: {max:?} vs {:?}", b.max);
+                    assert!(!min[axis].is_subnormal() && !max[axis].is_subnormal());
+                }
+            }
+        }
+        // A bound of exactly 0 (a vertex on a coordinate plane): the smallest normal planes, so
+        // that (plane − 0) · (1/d) stays normal for |d| ≤ 1.
+        let b = Aabb {
+            min: Vec3::ZERO,
+            max: Vec3::ZERO,
+        };
+        let (min, max) = padded(b);
+        assert_eq!(min, [-f32::MIN_POSITIVE; 3]);
+        assert_eq!(max, [f32::MIN_POSITIVE; 3]);
+        // Ordinary bounds keep their one-ulp padding.
+        let b = Aabb {
+            min: Vec3::splat(1.0),
+            max: Vec3::splat(2.0),
+        };
+        assert_eq!(padded(b), ([next_down(1.0); 3], [next_up(2.0); 3]));
+    }
 }

@@ -376,6 +376,43 @@ mod tests {
         assert_eq!(bvh.stack_need(), need(&bvh, 0));
     }
 
+    #[test]
+    fn no_slab_plane_is_subnormal_when_bounds_touch_coordinate_planes() {
+        // Boxes with corners exactly on x = 0, y = 0 or z = 0 (mesh vertices on a coordinate
+        // plane): padding by one ulp would give planes of ±1.4e-45, and a ray from a point on
+        // that plane would multiply a subnormal in every such node (see `build::padded`).
+        let mut input = boxes(2000);
+        for (i, b) in input.iter_mut().enumerate() {
+            let axis = i % 3;
+            let extent = b.max[axis] - b.min[axis];
+            if i % 2 == 0 {
+                (b.min[axis], b.max[axis]) = (0.0, extent);
+            } else {
+                (b.min[axis], b.max[axis]) = (-extent, 0.0);
+            }
+        }
+        let bvh = Bvh::build(&input);
+        let mut seen = Vec::new();
+        let mut planes = 0;
+        for n in &bvh.nodes {
+            for c in (0..WIDTH).filter(|&c| n.has_child(c)) {
+                let b = n.child_bounds(c);
+                for v in b.min.to_array().into_iter().chain(b.max.to_array()) {
+                    assert!(!v.is_subnormal(), "subnormal plane {v:e}");
+                    planes += usize::from(v.abs() == f32::MIN_POSITIVE);
+                }
+            }
+        }
+        // The boxes on the coordinate planes did get the smallest normal planes, and the tree
+        // still encloses every primitive.
+        assert!(planes > 0);
+        let root = &bvh.nodes[0];
+        for c in (0..WIDTH).filter(|&c| root.has_child(c)) {
+            check_child(&bvh, &input, root, c, &mut seen);
+        }
+        assert_eq!(seen.len(), input.len());
+    }
+
     /// The leaf holding primitive `p`: its bounds and its primitives.
     fn leaf_of(bvh: &Bvh, p: u32) -> (Aabb, Vec<u32>) {
         for n in &bvh.nodes {
