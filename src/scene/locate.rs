@@ -343,6 +343,38 @@ pub fn ron_unclosed_bracket(text: &str) -> Option<(usize, char)> {
     open.pop()
 }
 
+/// The byte offset of the first `"key":` entry directly inside the innermost `{` map still open
+/// at the end of RON `text` (comments and strings skipped), so that a key given twice in that
+/// map can point back at its first definition. `None` when the innermost open bracket is not a
+/// map or the key is not in it.
+#[must_use]
+pub fn ron_first_key_in_open_map(text: &str, key: &str) -> Option<usize> {
+    let tokens = lex(text);
+    let mut open: Vec<(usize, u8)> = Vec::new();
+    let mut keys: Vec<(usize, usize)> = Vec::new();
+    for (i, t) in tokens.iter().enumerate() {
+        match &t.tok {
+            Tok::Open(c) => open.push((t.start, *c)),
+            Tok::Close(_) => {
+                open.pop();
+            }
+            Tok::Str(s)
+                if s == key && matches!(tokens.get(i + 1).map(|n| &n.tok), Some(Tok::Colon)) =>
+            {
+                if let Some(&(map, b'{')) = open.last() {
+                    keys.push((map, t.start));
+                }
+            }
+            _ => {}
+        }
+    }
+    let &(map, bracket) = open.last()?;
+    if bracket != b'{' {
+        return None;
+    }
+    keys.iter().find(|(m, _)| *m == map).map(|&(_, k)| k)
+}
+
 #[derive(Debug, Clone, PartialEq)]
 enum Tok {
     Open(u8),
@@ -710,6 +742,30 @@ impl RonParser<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn first_key_in_the_open_map_skips_values_comments_and_other_maps() {
+        let text = r#"Scene(
+    textures: { "white": Checker(a: "white") },
+    materials: {
+        // "white": a comment, not a key
+        "red": (color: (1, 0, 0), note: "white"),
+        "white": (color: (1, 1, 1)),
+        "blue": (color: (0, 0, 1)),
+        "white""#;
+        let first = ron_first_key_in_open_map(text, "white").expect("found");
+        let line = text[..first].matches('\n').count() + 1;
+        assert_eq!(
+            line, 6,
+            "the key inside `materials`, not the texture or the comment"
+        );
+        assert_eq!(ron_first_key_in_open_map(text, "green"), None);
+        // The innermost open bracket is a tuple, not a map.
+        assert_eq!(
+            ron_first_key_in_open_map("Scene(materials: { \"a\": (", "a"),
+            None
+        );
+    }
 
     const RON: &str = r#"// demo
 Scene(

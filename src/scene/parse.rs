@@ -135,6 +135,9 @@ fn ron_error(src: &SourceFile, code: &ron::Error, path: &str, at: (usize, usize)
             d("the file ends in the middle of a value".into())
         }
         E::Message(msg) if is_bare_expectation(msg) => return bare_expectation(src, path, msg),
+        E::Message(msg) if msg.ends_with("` is defined twice") => {
+            return defined_twice(src, path, msg, skip_space(src, at));
+        }
         E::DuplicateStructField { field, .. } => d(format!("field `{field}` is given twice")),
         E::ExceededRecursionLimit => d(format!(
             "values are nested more than {RON_RECURSION_LIMIT} levels deep; groups may nest at most {} levels",
@@ -171,6 +174,32 @@ fn ron_error(src: &SourceFile, code: &ron::Error, path: &str, at: (usize, usize)
         },
         Some(skip_space(src, at)),
     )
+}
+
+/// A name given twice in one map (`schema::unique_keys`): named by its full path, placed at the
+/// second definition, with the line of the first as help.
+fn defined_twice(src: &SourceFile, path: &str, msg: &str, at: (usize, usize)) -> Diagnostic {
+    let key = msg.split('`').nth(1).unwrap_or_default();
+    let full = if path.is_empty() {
+        key.to_string()
+    } else {
+        format!("{path}.{key}")
+    };
+    let first = super::locate::ron_first_key_in_open_map(&src.text[..offset_of(src, at)], key)
+        .map(|offset| src.text[..offset].matches('\n').count() + 1);
+    let text = if path.is_empty() {
+        format!("`{key}` is defined twice")
+    } else {
+        format!("`{key}` is defined twice in `{path}`")
+    };
+    let mut d = Diagnostic::error(full, text);
+    d.help = Some(match first {
+        Some(line) => format!(
+            "its first definition is on line {line}; each name may be defined once: rename or remove one of them"
+        ),
+        None => "each name may be defined once: rename or remove one of them".to_string(),
+    });
+    place(src, d, Some(at))
 }
 
 /// The byte offset of a 1-based (line, column in chars) position.
