@@ -242,11 +242,7 @@ impl<'a> PathTracer<'a> {
             let u_lobe = sampler.defer_1d();
             let u_dir = sampler.next_2d();
             let u_rr = sampler.defer_1d();
-            let u_lobe = if bsdf.lobe_choice_matters() {
-                sampler.get_1d(u_lobe)
-            } else {
-                0.5
-            };
+            let u_lobe = bsdf.lobe_number(|| sampler.get_1d(u_lobe));
             let Some(s) = bsdf.sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance) else {
                 break;
             };

@@ -208,6 +208,18 @@ impl Bsdf {
             || (diffuse && self.specular != Vec3::ZERO && self.color != Vec3::ZERO)
     }
 
+    /// The lobe number for [`Bsdf::sample`]: `draw()` where the choice matters
+    /// ([`Bsdf::lobe_choice_matters`]), otherwise a constant that gives the same sample, so a
+    /// deferred sampler draw (`Sampler::defer_1d`) is never computed for single-lobe BSDFs.
+    #[inline]
+    pub fn lobe_number(&self, draw: impl FnOnce() -> f32) -> f32 {
+        if self.lobe_choice_matters() {
+            draw()
+        } else {
+            0.5
+        }
+    }
+
     /// Probabilities of sampling the diffuse part, the mirror and the dielectric (summing to 1,
     /// or all 0 for a black BSDF), and within the diffuse part the Lambert lobe's share.
     #[inline]

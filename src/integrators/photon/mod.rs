@@ -259,9 +259,10 @@ impl<'a> PhotonMapper<'a> {
                 continue;
             }
             // Deeper: one delta lobe, sampled (the diffuse part was accounted for above).
-            let u_lobe = sampler.next_1d();
+            let u_lobe = sampler.defer_1d();
             let u_dir = sampler.next_2d();
             let u_rr = sampler.next_1d();
+            let u_lobe = sh.bsdf.lobe_number(|| sampler.get_1d(u_lobe));
             let Some(s) = sh
                 .bsdf
                 .sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance)
@@ -417,8 +418,9 @@ impl<'a> PhotonMapper<'a> {
         let scene = self.scene;
         let mut sum = Vec3::ZERO;
         for _ in 0..n {
-            let u_lobe = sampler.next_1d();
+            let u_lobe = sampler.defer_1d();
             let u_dir = sampler.next_2d();
+            let u_lobe = sh.bsdf.lobe_number(|| sampler.get_1d(u_lobe));
             let Some(s) = sh
                 .bsdf
                 .sample(wo, u_lobe, u_dir, fr, TransportMode::Radiance)
@@ -457,8 +459,9 @@ impl<'a> PhotonMapper<'a> {
                 if bounce == GATHER_SPECULAR_DEPTH || !gsh.bsdf.has_delta() {
                     break;
                 }
-                let u_lobe = sampler.next_1d();
+                let u_lobe = sampler.defer_1d();
                 let u_dir = sampler.next_2d();
+                let u_lobe = gsh.bsdf.lobe_number(|| sampler.get_1d(u_lobe));
                 let Some(g) = gsh
                     .bsdf
                     .sample(gwo, u_lobe, u_dir, &gfr, TransportMode::Radiance)

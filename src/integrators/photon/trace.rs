@@ -131,11 +131,7 @@ pub fn trace_photon(
         let u_lobe = sampler.defer_1d();
         let u = sampler.next_2d();
         let u_rr = sampler.next_1d();
-        let u_lobe = if bsdf.lobe_choice_matters() {
-            sampler.get_1d(u_lobe)
-        } else {
-            0.5
-        };
+        let u_lobe = bsdf.lobe_number(|| sampler.get_1d(u_lobe));
         let Some(s) = bsdf.sample(wo, u_lobe, u, &fr, TransportMode::Importance) else {
             return;
         };
