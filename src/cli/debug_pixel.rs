@@ -6,7 +6,7 @@ use clap::Args;
 
 use caustic::Error;
 use caustic::pipeline::prepare;
-use caustic::render::tiles::trace_pixel_with;
+use caustic::render::trace_pixel_with;
 
 use super::SceneArgs;
 

@@ -14,7 +14,7 @@ use caustic::Error;
 use caustic::pipeline::prepare;
 use caustic::render::output::{OutputFormat, write_image};
 use caustic::render::part_meta::settings_hash;
-use caustic::render::progressive::{CheckpointPlan, PassPlan, render_in_passes};
+use caustic::render::passes::{CheckpointPlan, PassPlan, render_in_passes};
 use caustic::render::{
     Layer, PartMeta, Region, RenderError, RenderJob, RenderOptions, Shard, write_layers,
 };

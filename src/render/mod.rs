@@ -1,21 +1,25 @@
-//! Rendering: integrators, the tile scheduler, the film and image output.
+//! Rendering: the render job and its tile loop, the film and its mergeable sums, image output.
 
 pub mod film;
+pub mod job;
 pub mod layers;
 pub mod metrics;
+pub mod options;
 pub mod output;
 pub mod part_meta;
+pub mod passes;
 pub mod pixel_sums;
-pub mod progressive;
 pub mod shard;
 pub mod tiles;
+pub mod trace_pixel;
 
 pub use film::Film;
+pub use job::{RenderJob, render};
 pub use layers::{Layer, UnknownLayer, encode_layers, write_layers};
+pub use options::{
+    ProgressiveStats, Region, RenderError, RenderOptions, RenderOutput, RenderStats,
+};
 pub use part_meta::PartMeta;
 pub use pixel_sums::PixelSums;
 pub use shard::Shard;
-pub use tiles::{
-    ProgressiveStats, Region, RenderError, RenderJob, RenderOptions, RenderOutput, RenderStats,
-    render, trace_pixel,
-};
+pub use trace_pixel::{trace_pixel, trace_pixel_with};

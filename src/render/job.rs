@@ -1,0 +1,320 @@
+//! The render job: a [`RenderJob`] owns the worker pool, the prepared integrator and the film's
+//! sums, and takes samples in passes over sample indices (the tile loop in
+//! [`super::tiles`] does each sweep), so a render can be checkpointed, cancelled, budgeted or
+//! split into farm shards without changing its bytes. [`render`] is the one-pass shortcut.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+
+use super::Film;
+use super::options::{
+    ProgressiveStats, Region, RenderError, RenderOptions, RenderOutput, RenderStats, check_region,
+};
+use super::pixel_sums::PixelSums;
+use super::tiles::{TileResult, new_parts, pixel_index, render_tile, tile_grid};
+use crate::integrators::Integrator;
+use crate::render_scene::RenderScene;
+
+/// Renders `scene` (or a region of it) in one pass of all its samples per pixel.
+///
+/// # Errors
+/// [`RenderError::Cancelled`] when `options.cancel` is raised before the last tile is done; the
+/// other variants when the region or thread count is unusable.
+pub fn render(scene: &RenderScene, options: &RenderOptions) -> Result<RenderOutput, RenderError> {
+    RenderJob::new(scene, options)?.finish()
+}
+
+/// A render done in passes over sample indices: pass after pass adds samples `[done, done + n)`
+/// to every pixel, in ascending sample order, so the finished film is bit-identical to the
+/// one-pass [`render`] whatever the pass sizes. Between passes the image so far can be read
+/// (for checkpoints), and a cancelled pass leaves the job as it was after the previous one.
+pub struct RenderJob<'a> {
+    scene: &'a RenderScene,
+    integrator: Integrator<'a>,
+    region: Region,
+    tiles: Vec<Region>,
+    pool: rayon::ThreadPool,
+    cancel: Option<Arc<AtomicBool>>,
+    progress: ProgressBar,
+    /// Per-pixel sample statistics over the samples done, row-major over the region.
+    sums: PixelSums,
+    /// The same per kind of light path, when kept.
+    parts: Option<Vec<PixelSums>>,
+    /// First sample index this job takes.
+    first: u32,
+    /// Samples `first..done` are in `sums`.
+    done: u32,
+    /// One past the last sample index this job takes.
+    end: u32,
+    stats: RenderStats,
+    start: Instant,
+}
+
+impl std::fmt::Debug for RenderJob<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RenderJob")
+            .field("region", &self.region)
+            .field("samples_done", &self.done)
+            .field("samples_per_pixel", &self.samples_per_pixel())
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'a> RenderJob<'a> {
+    /// Checks the options and sets up the worker pool; no samples are taken yet.
+    ///
+    /// # Errors
+    /// When the region is empty or outside the image, or the worker pool cannot start.
+    pub fn new(scene: &'a RenderScene, options: &RenderOptions) -> Result<Self, RenderError> {
+        let (w, h) = (scene.params.width, scene.params.height);
+        let region = options.region.unwrap_or(Region {
+            x: 0,
+            y: 0,
+            width: w,
+            height: h,
+        });
+        check_region(region, w, h)?;
+        let threads = options
+            .threads
+            .unwrap_or_else(rayon::current_num_threads)
+            .max(1);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| RenderError::Threads(threads, e.to_string()))?;
+        let tiles = tile_grid(region);
+        let range = options
+            .samples
+            .clone()
+            .unwrap_or(0..scene.params.samples_per_pixel);
+        // Shared state (photon maps; a progressive integrator's first pass) is built on the
+        // job's own workers.
+        let integrator = pool.install(|| {
+            let mut i = Integrator::prepare_with(scene, options.photon_cache.as_deref());
+            i.begin_pass(range.start);
+            i
+        });
+        if range.end > scene.params.samples_per_pixel || range.start > range.end {
+            return Err(RenderError::SampleRange(
+                range.start,
+                range.end,
+                scene.params.samples_per_pixel,
+            ));
+        }
+        let spp = u64::from(range.end - range.start);
+        let progress = progress_bar(options.progress, tiles.len() as u64 * spp);
+        Ok(Self {
+            scene,
+            integrator,
+            region,
+            tiles,
+            pool,
+            cancel: options.cancel.clone(),
+            progress,
+            sums: PixelSums::new(region.width, region.height),
+            parts: options
+                .light_paths
+                .then(|| new_parts(region.width, region.height)),
+            first: range.start,
+            done: range.start,
+            end: range.end,
+            stats: RenderStats {
+                threads,
+                ..Default::default()
+            },
+            start: Instant::now(),
+        })
+    }
+
+    /// The prepared integrator (e.g. to report how its photon maps were built).
+    #[must_use]
+    pub fn integrator(&self) -> &Integrator<'a> {
+        &self.integrator
+    }
+
+    /// One past the last sample index of the finished render (its samples per pixel when it
+    /// starts at 0).
+    #[must_use]
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.end
+    }
+
+    /// One past the last sample index taken so far (by complete passes).
+    #[must_use]
+    pub fn samples_done(&self) -> u32 {
+        self.done
+    }
+
+    /// Takes the next `n` samples of every pixel (fewer if fewer remain; none is a no-op). A
+    /// progressive integrator takes them one sample index (one pass) at a time, setting up
+    /// each pass's shared state first.
+    ///
+    /// # Errors
+    /// [`RenderError::Cancelled`] when the cancel flag is raised before the pass ends; the job
+    /// then still holds the image of the samples it completed before (whole sample indices).
+    pub fn render_pass(&mut self, n: u32) -> Result<(), RenderError> {
+        let end = self.done + n.min(self.samples_per_pixel() - self.done);
+        if self.is_cancelled() {
+            return Err(RenderError::Cancelled);
+        }
+        if !self.integrator.is_progressive() {
+            return self.sweep(end);
+        }
+        while self.done < end {
+            let integrator = &mut self.integrator;
+            let sample = self.done;
+            self.pool.install(|| integrator.begin_pass(sample));
+            self.sweep(sample + 1)?;
+        }
+        Ok(())
+    }
+
+    /// Takes samples `done..end` of every pixel in one sweep over the tiles.
+    fn sweep(&mut self, end: u32) -> Result<(), RenderError> {
+        if end == self.done {
+            return Ok(());
+        }
+        let (integrator, region, samples) = (&self.integrator, self.region, self.done..end);
+        let (progress, cancel) = (&self.progress, self.cancel.as_deref());
+        let results: Option<Vec<TileResult>> = self.pool.install(|| {
+            self.tiles
+                .par_iter()
+                .map(|t| {
+                    let samples = samples.clone();
+                    let parts = self.parts.is_some();
+                    render_tile(self.scene, integrator, t, samples, parts, cancel, progress)
+                })
+                .collect()
+        });
+        let Some(results) = results else {
+            return Err(RenderError::Cancelled);
+        };
+        for (tile, r) in self.tiles.iter().zip(results) {
+            for i in 0..(tile.width * tile.height) as usize {
+                let at = pixel_index(region, tile, i);
+                self.sums.add_pixel(at, &r.sums, i);
+                if let (Some(mine), Some(theirs)) = (self.parts.as_mut(), r.parts.as_ref()) {
+                    for (m, t) in mine.iter_mut().zip(theirs) {
+                        m.add_pixel(at, t, i);
+                    }
+                }
+            }
+            self.stats.rays += r.counters.rays;
+            self.stats.photon_estimates += r.counters.photon_estimates;
+            self.stats.photon_radius_cut += r.counters.photon_radius_cut;
+            self.stats.nan_samples += r.nan;
+        }
+        self.done = end;
+        Ok(())
+    }
+
+    /// The image so far: each pixel's mean over the samples done (black before the first
+    /// pass).
+    #[must_use]
+    pub fn snapshot(&self) -> Film {
+        self.sums.to_film()
+    }
+
+    /// The per-pixel statistics so far.
+    #[must_use]
+    pub fn sums(&self) -> &PixelSums {
+        &self.sums
+    }
+
+    /// Renders every sample of another `region` of the same image with this job's prepared
+    /// integrator (its photon maps are built once, by [`RenderJob::new`]) and returns that
+    /// region's output; the job can then render further regions. For tools that render many
+    /// crops of one image, such as the doc-image test's row strips.
+    ///
+    /// # Errors
+    /// When the region is empty or outside the image, or as [`RenderJob::render_pass`].
+    pub fn render_region(&mut self, region: Region) -> Result<RenderOutput, RenderError> {
+        check_region(region, self.scene.params.width, self.scene.params.height)?;
+        self.region = region;
+        self.tiles = tile_grid(region);
+        self.sums = PixelSums::new(region.width, region.height);
+        if self.parts.is_some() {
+            self.parts = Some(new_parts(region.width, region.height));
+        }
+        self.done = self.first;
+        self.stats = RenderStats {
+            threads: self.stats.threads,
+            ..Default::default()
+        };
+        self.start = Instant::now();
+        self.render_pass(self.end - self.done)?;
+        Ok(self.take_output())
+    }
+
+    /// Takes the remaining samples in one pass and returns the finished film.
+    ///
+    /// # Errors
+    /// As [`RenderJob::render_pass`].
+    pub fn finish(mut self) -> Result<RenderOutput, RenderError> {
+        self.render_pass(self.samples_per_pixel() - self.done)?;
+        Ok(self.into_output())
+    }
+
+    /// The image and statistics of the samples done so far (for a render stopped early by a
+    /// time budget: every pixel has the same number of samples). Ends the job; its sums move
+    /// into the output (no copy of the film's statistics).
+    #[must_use]
+    pub fn into_output(mut self) -> RenderOutput {
+        self.progress.finish_and_clear();
+        self.take_output()
+    }
+
+    /// The output of the samples done so far, moving the sums out (the job keeps empty ones).
+    fn take_output(&mut self) -> RenderOutput {
+        let mut stats = self.stats;
+        stats.samples = u64::from(self.region.width)
+            * u64::from(self.region.height)
+            * u64::from(self.done - self.first);
+        stats.elapsed = self.start.elapsed();
+        stats.progressive = self.integrator.progressive().map(|p| ProgressiveStats {
+            totals: p.totals(),
+            last_shrink: p.shrink(self.done.saturating_sub(1)),
+        });
+        let sums = std::mem::replace(&mut self.sums, PixelSums::new(0, 0));
+        let parts = self
+            .parts
+            .as_mut()
+            .map(|p| std::mem::replace(p, new_parts(0, 0)));
+        RenderOutput {
+            film: sums.to_film(),
+            sums,
+            parts,
+            stats,
+        }
+    }
+
+    fn is_cancelled(&self) -> bool {
+        self.cancel
+            .as_deref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+}
+
+impl Drop for RenderJob<'_> {
+    fn drop(&mut self) {
+        self.progress.finish_and_clear();
+    }
+}
+
+/// The tile progress bar on stderr (hidden unless `enabled`), counting tile-samples.
+fn progress_bar(enabled: bool, tiles: u64) -> ProgressBar {
+    if !enabled {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(tiles), ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template(
+        "{spinner} rendering [{bar:40}] {percent:>3}% {elapsed} eta {eta}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
