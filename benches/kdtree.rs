@@ -23,8 +23,8 @@ use std::hint::black_box;
 use std::num::NonZeroUsize;
 use std::time::Instant;
 
-use caustic::photon::{BuildOptions, KdTree, KnnHeap, Photon, SplitAxis};
 use caustic::sampling::Rng;
+use caustic::spatial::{BuildOptions, KdTree, KnnHeap, Photon, SplitAxis};
 use glam::Vec3;
 use kiddo::ImmutableKdTree;
 use kiddo::dist::SquaredEuclidean;
@@ -117,7 +117,7 @@ fn photons(points: &[[f32; 3]]) -> Vec<Photon> {
 }
 
 /// Sum of (count, Σ dist²) over all queries for our k-nearest.
-fn ours_knn<T: caustic::photon::HasPosition>(
+fn ours_knn<T: caustic::spatial::HasPosition>(
     t: &KdTree<T>,
     qs: &[[f32; 3]],
     k: usize,
@@ -132,7 +132,7 @@ fn ours_knn<T: caustic::photon::HasPosition>(
     (n, s)
 }
 
-fn ours_within<T: caustic::photon::HasPosition>(
+fn ours_within<T: caustic::spatial::HasPosition>(
     t: &KdTree<T>,
     qs: &[[f32; 3]],
     r2: f32,

@@ -26,13 +26,13 @@ pub mod compile;
 pub mod error;
 pub mod geometry;
 pub mod integrators;
-pub mod photon;
 pub mod pipeline;
 pub mod render;
 pub mod render_scene;
 pub mod sampling;
 pub mod scene;
 pub mod shading;
+pub mod spatial;
 pub mod texture;
 
 pub use error::Error;

@@ -3,10 +3,10 @@
 //! slot) on random, clustered, coincident, planar and lattice point sets, for every leaf size and
 //! split rule; plus the hard cases of issue 13 (empty maps, k larger than the map, NaN).
 
-use caustic::photon::{
+use caustic::sampling::Rng;
+use caustic::spatial::{
     BuildOptions, KdTree, KdTreeError, KnnHeap, Neighbor, Photon, SplitAxis, distance2,
 };
-use caustic::sampling::Rng;
 use glam::Vec3;
 use proptest::prelude::*;
 
@@ -247,7 +247,7 @@ fn coincident_photons_tie_to_the_lowest_slots_without_scanning_the_map() {
     let scan: f32 = tree
         .items()
         .iter()
-        .map(|p| distance2([0.25, 0.5, 0.8], caustic::photon::HasPosition::position(p)))
+        .map(|p| distance2([0.25, 0.5, 0.8], caustic::spatial::HasPosition::position(p)))
         .sum();
     let scan_time = t0.elapsed().as_secs_f64();
     assert!(scan > 0.0);

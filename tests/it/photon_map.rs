@@ -11,11 +11,11 @@ use caustic::integrators::photon::maps::trace_map;
 use caustic::integrators::photon::trace::{MapKind, TraceCounts, TraceSettings};
 use caustic::integrators::photon::{Kernel, PhotonMap, build_maps};
 use caustic::integrators::{Counters, Integrator};
-use caustic::photon::{KdTree, Photon};
 use caustic::render::{RenderOptions, render};
 use caustic::render_scene::RenderScene;
 use caustic::sampling::Sampler;
 use caustic::shading::{Bsdf, ShadingFrame};
+use caustic::spatial::{KdTree, Photon};
 
 use crate::common::scene_from_text;
 

@@ -8,9 +8,9 @@ use caustic::integrators::photon::cache::{
     MAGIC, build_or_load, cache_file, cache_key, decode, encode,
 };
 use caustic::integrators::photon::{PhotonMap, build_maps};
-use caustic::photon::{BuildOptions, KdTree};
 use caustic::render::{Film, RenderJob, RenderOptions};
 use caustic::render_scene::RenderScene;
+use caustic::spatial::{BuildOptions, KdTree};
 
 use crate::common::{caustic, scene_from_text};
 
@@ -390,7 +390,7 @@ fn the_viewer_shows_the_caustic_under_the_ball_and_nowhere_else() {
 #[test]
 #[ignore = "timing (1M photons)"]
 fn restoring_a_million_photons_is_faster_than_building() {
-    use caustic::photon::Photon;
+    use caustic::spatial::Photon;
     use std::time::Instant;
     let mut s = 12345u64;
     let mut next = || {

@@ -36,9 +36,9 @@ use super::maps::{
     PhotonMaps, PhotonSummary, auto_radius, build_maps, diffuse_area, precompute_irradiance,
 };
 use super::trace::{MapKind, TraceCounts};
-use crate::photon::{BuildOptions, KdTree, Photon};
 use crate::render_scene::geometry::{EllipsoidPrim, SpherePrim, TriAttrs};
 use crate::render_scene::{Geometry, ObjectInfo, PhotonParams, RenderParams, RenderScene, Texture};
+use crate::spatial::{BuildOptions, KdTree, Photon};
 
 /// File signature and format version of a cache file.
 pub const MAGIC: &[u8; 16] = b"caustic-photons1";

@@ -31,8 +31,8 @@ use std::cell::RefCell;
 
 use glam::Vec3;
 
-use crate::photon::{KdTree, KnnHeap, Photon};
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
+use crate::spatial::{KdTree, KnnHeap, Photon};
 
 /// The smallest estimate radius as a fraction of the map's largest radius.
 pub const MIN_RADIUS_FRACTION: f32 = 1e-3;

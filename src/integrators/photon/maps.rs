@@ -12,10 +12,10 @@ use super::aim::CausticTargets;
 use super::emit::{LightEmitter, split_by_power};
 use super::estimate::{IrradianceCache, Kernel, PhotonMap};
 use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
-use crate::photon::{KdTree, Photon};
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
 use crate::sampling::rng::mix64;
+use crate::spatial::{KdTree, Photon};
 
 /// Photons per parallel work item.
 const BATCH: u64 = 2048;

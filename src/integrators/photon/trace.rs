@@ -13,10 +13,10 @@ use glam::Vec3;
 
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::photon::Photon;
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
 use crate::shading::{ShadingFrame, TransportMode};
+use crate::spatial::Photon;
 
 /// Largest factor by which a photon's flux may grow along its path (the adjoint shading-normal
 /// factor can exceed 1 at grazing angles on bumped surfaces; Veach 1997 §5.3). Bounds the

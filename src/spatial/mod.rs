@@ -1,10 +1,11 @@
-//! Photon-map storage: the packed [`Photon`] record and the balanced 3-d [`KdTree`] that stores
-//! photons (or any positioned item) in flat arrays and answers k-nearest and fixed-radius
+//! Spatial search: the balanced 3-d [`KdTree`] that stores any positioned item
+//! ([`HasPosition`]) in flat arrays and answers k-nearest and fixed-radius
 //! queries without allocating (Jensen, "Realistic Image Synthesis Using Photon Mapping", 2001,
-//! ch. 6). Layout, memory per photon and speed are in `docs/photon_map.md`.
+//! ch. 6), its bounded k-nearest heap, and the packed [`Photon`] record the photon maps store in
+//! it. Layout, memory per photon and speed are in `docs/photon_map.md`.
 //!
 //! ```
-//! use caustic::photon::{KdTree, KnnHeap, Photon};
+//! use caustic::spatial::{KdTree, KnnHeap, Photon};
 //! use glam::Vec3;
 //!
 //! let photons: Vec<Photon> = (0..100)
@@ -16,7 +17,7 @@
 //! heap.sort();
 //! let xs: Vec<f32> = heap.iter().map(|n| map.items()[n.index as usize].position().x).collect();
 //! assert_eq!(xs, [10.0, 11.0, 9.0]);
-//! # Ok::<(), caustic::photon::KdTreeError>(())
+//! # Ok::<(), caustic::spatial::KdTreeError>(())
 //! ```
 
 pub mod kdtree;
