@@ -21,9 +21,11 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod accel;
+pub mod analysis;
 pub mod bench;
 pub mod compile;
 pub mod error;
+pub mod farm;
 pub mod geometry;
 pub mod integrators;
 pub mod pipeline;

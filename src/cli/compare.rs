@@ -7,8 +7,10 @@ use clap::Args;
 use serde_json::json;
 
 use caustic::Error;
+use caustic::analysis::metrics::{
+    ChannelError, ImageError, compare_region, pixel_errors, read_pair,
+};
 use caustic::render::Region;
-use caustic::render::metrics::{ChannelError, ImageError, compare_region, pixel_errors, read_pair};
 
 use super::error_image::{self, ErrorScale};
 use super::render::parse_region;

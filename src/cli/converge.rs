@@ -16,8 +16,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::json;
 
 use caustic::Error;
+use caustic::analysis::metrics::{ImageError, Reference};
 use caustic::pipeline::prepare;
-use caustic::render::metrics::{ImageError, Reference};
 use caustic::render::output::{write_atomic, write_image};
 use caustic::render::{RenderJob, RenderOptions};
 

@@ -14,9 +14,9 @@ use clap::{Args, Subcommand};
 use serde_json::Value;
 
 use caustic::Error;
+use caustic::farm::Shard;
+use caustic::farm::part_meta::settings_hash;
 use caustic::pipeline::{SceneOverrides, prepare};
-use caustic::render::Shard;
-use caustic::render::part_meta::settings_hash;
 use caustic::scene::SceneFile;
 
 use self::manifest::{FORMAT, LOGS, Manifest, PHOTONS, SCENE, SHARDS};

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use caustic::Error;
-use caustic::render::metrics::Reference;
+use caustic::analysis::metrics::Reference;
 use caustic::render::{Film, Region};
 
 /// Reads the reference of `--compare`, if given.

@@ -10,9 +10,10 @@ use std::time::Instant;
 use clap::Args;
 
 use caustic::Error;
+use caustic::farm::PartMeta;
+use caustic::farm::part_meta::format_ranges;
+use caustic::render::PixelSums;
 use caustic::render::output::{OutputFormat, check_writable, write_image};
-use caustic::render::part_meta::format_ranges;
-use caustic::render::{PartMeta, PixelSums};
 
 use super::render::is_part;
 

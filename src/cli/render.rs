@@ -11,13 +11,12 @@ use std::time::Duration;
 use clap::Args;
 
 use caustic::Error;
+use caustic::farm::part_meta::settings_hash;
+use caustic::farm::{PartMeta, Shard};
 use caustic::pipeline::prepare;
 use caustic::render::output::{OutputFormat, write_image};
-use caustic::render::part_meta::settings_hash;
 use caustic::render::passes::{CheckpointPlan, PassPlan, render_in_passes};
-use caustic::render::{
-    Layer, PartMeta, Region, RenderError, RenderJob, RenderOptions, Shard, write_layers,
-};
+use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, write_layers};
 
 use super::{SceneArgs, count, print_warnings};
 

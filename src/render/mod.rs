@@ -3,13 +3,10 @@
 pub mod film;
 pub mod job;
 pub mod layers;
-pub mod metrics;
 pub mod options;
 pub mod output;
-pub mod part_meta;
 pub mod passes;
 pub mod pixel_sums;
-pub mod shard;
 pub mod tiles;
 pub mod trace_pixel;
 
@@ -19,7 +16,5 @@ pub use layers::{Layer, UnknownLayer, encode_layers, write_layers};
 pub use options::{
     ProgressiveStats, Region, RenderError, RenderOptions, RenderOutput, RenderStats,
 };
-pub use part_meta::PartMeta;
 pub use pixel_sums::PixelSums;
-pub use shard::Shard;
 pub use trace_pixel::{trace_pixel, trace_pixel_with};

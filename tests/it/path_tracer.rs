@@ -1,8 +1,8 @@
 //! The path tracer against Whitted where both are exact, on every scene, across threads,
 //! regions, passes and samplers, and statistically against a committed converged reference.
 
+use caustic::analysis::metrics::read_film;
 use caustic::pipeline::{SceneOverrides, prepare};
-use caustic::render::metrics::read_film;
 use caustic::render::{Film, PixelSums, Region, RenderJob, RenderOptions, render};
 
 use crate::common;
@@ -247,7 +247,7 @@ fn path_converges_to_the_committed_reference() {
             let mut o = cornell_path(32, 32, spp, "Independent");
             o.seed = Some(seed);
             let (f, _) = common::render_file(&file, &o, &RenderOptions::default());
-            total += caustic::render::metrics::compare(&f, &reference)
+            total += caustic::analysis::metrics::compare(&f, &reference)
                 .expect("same size")
                 .rel_mse;
         }

@@ -15,7 +15,7 @@ use glam::Vec3;
 
 use crate::common;
 
-use caustic::render::metrics::read_film;
+use caustic::analysis::metrics::read_film;
 use caustic::render::output::write_image;
 use caustic::render::{Film, RenderOptions};
 

@@ -370,7 +370,7 @@ fn grazing(texture: &str, filter: &str, spp: u32, eye_x: f32) -> Film {
 }
 
 fn rmse(a: &Film, b: &Film) -> f64 {
-    caustic::render::metrics::compare(a, b)
+    caustic::analysis::metrics::compare(a, b)
         .expect("same size")
         .rmse
 }

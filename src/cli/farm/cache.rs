@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use caustic::Error;
+use caustic::farm::part_meta::settings_hash;
 use caustic::pipeline::{SceneOverrides, prepare};
-use caustic::render::part_meta::settings_hash;
 use caustic::render::{RenderJob, RenderOptions};
 
 use super::manifest::{Manifest, PHOTONS, SCENE};

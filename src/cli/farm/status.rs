@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use caustic::Error;
-use caustic::render::part_meta::format_ranges;
+use caustic::farm::part_meta::format_ranges;
 
 use super::manifest::Manifest;
 

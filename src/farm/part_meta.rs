@@ -6,9 +6,9 @@
 
 use std::ops::Range;
 
-use super::Region;
-use super::pixel_sums::fnv1a;
 use crate::integrators::photon::cache::cache_key;
+use crate::render::Region;
+use crate::render::pixel_sums::fnv1a;
 use crate::render_scene::RenderScene;
 
 /// First line of the metadata: the format and its version.

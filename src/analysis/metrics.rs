@@ -4,8 +4,8 @@ use glam::Vec3;
 
 use std::path::{Path, PathBuf};
 
-use super::output::to_srgb8;
-use super::{Film, Region};
+use crate::render::output::to_srgb8;
+use crate::render::{Film, Region};
 use crate::texture::srgb_to_linear;
 
 /// Error figures of one colour channel (or of all three pooled), in linear radiance units.

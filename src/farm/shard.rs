@@ -2,7 +2,7 @@
 //! whole image (a set of samples per pixel, never a set of tiles), so a shard that fails or is
 //! late lowers the sample count of the merged image and never leaves a hole; the ranges of the
 //! N shards partition `0..S` exactly, so merging all of them gives the bytes of one render
-//! ([`super::PixelSums::merge`] is exact).
+//! ([`crate::render::PixelSums::merge`] is exact).
 
 use std::ops::Range;
 

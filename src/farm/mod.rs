@@ -1,0 +1,10 @@
+//! Render farms, above the renderer: what a `.part` film records about the render it holds
+//! ([`PartMeta`], the settings hash that tells whether parts belong together) and how a render
+//! is split into shards of sample indices ([`Shard`]). The commands that plan, run and merge
+//! farm jobs are in the binary (`caustic farm`, `caustic merge`).
+
+pub mod part_meta;
+pub mod shard;
+
+pub use part_meta::PartMeta;
+pub use shard::Shard;
