@@ -23,6 +23,7 @@
 pub mod accel;
 pub mod analysis;
 pub mod bench;
+pub mod binfile;
 pub mod compile;
 pub mod error;
 pub mod farm;

@@ -6,10 +6,10 @@
 
 use std::ops::Range;
 
-use crate::integrators::photon::cache::cache_key;
+use crate::binfile::fnv1a;
 use crate::render::Region;
-use crate::render::pixel_sums::fnv1a;
 use crate::render_scene::RenderScene;
+use crate::render_scene::hash::photon_key;
 
 /// First line of the metadata: the format and its version.
 const HEADER: &str = "caustic-part 1";
@@ -52,9 +52,9 @@ pub struct PartMeta {
     pub seconds: f64,
 }
 
-/// A 64-bit hash of everything in `scene` that decides pixel values: the photon cache's key
+/// A 64-bit hash of everything in `scene` that decides pixel values: the photon key
 /// (geometry, materials, textures with their texels, lights, photon settings, seed, sampler;
-/// see [`crate::integrators::photon::cache`]), every render parameter (size, samples per
+/// see [`crate::render_scene::hash`]), every render parameter (size, samples per
 /// pixel, depths, integrator, exposure, background, ...), the camera, and the crate version.
 /// FNV-1a over those (accidental mismatches, not adversaries). Two renders with the same hash
 /// and disjoint sample ranges merge into the render of their union.
@@ -63,7 +63,7 @@ pub fn settings_hash(scene: &RenderScene) -> u64 {
     let text = format!(
         "{HEADER}\n{}\n{:016x}\n{:?}\n{:?}",
         env!("CARGO_PKG_VERSION"),
-        cache_key(scene),
+        photon_key(scene),
         scene.params,
         scene.camera
     );

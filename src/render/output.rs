@@ -2,12 +2,20 @@
 //! in the target directory renamed into place, so a failed or interrupted write leaves nothing).
 //! [`check_output_path`] refuses an unwritable target before any rendering is done.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use image::{ImageFormat, RgbImage};
 
 use super::Film;
+use crate::binfile::{AtomicWrite, parent_dir};
+
+/// How images (and the other files the commands write) are written: hidden `.caustic-*.tmp`
+/// temporary files, and the permissions of any new file (0o666 less the umask), not tempfile's
+/// owner-only 0o600.
+const IMAGES: AtomicWrite = AtomicWrite {
+    temp_prefix: ".caustic-",
+    owner_only: false,
+};
 
 /// Why an image could not be written. Every message starts with `error:` and names the path the
 /// user gave, never the temporary file.
@@ -137,24 +145,6 @@ pub fn write_image(film: &Film, path: &Path, exposure: f32) -> Result<(), Output
     write_atomic(path, &bytes)
 }
 
-/// The folder an output file goes in (`.` for a bare file name).
-fn parent_dir(path: &Path) -> PathBuf {
-    match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    }
-}
-
-/// A temporary-file builder for the atomic write: hidden name, and the permissions of any newly
-/// created file (0o666 less the umask), not tempfile's owner-only 0o600.
-fn temp_builder() -> tempfile::Builder<'static, 'static> {
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".caustic-").suffix(".tmp");
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    builder
-}
-
 /// An OS error without the context `tempfile` attaches (` at path "…/.caustic-XXXX.tmp"`, which
 /// means nothing to the user): the OS's own sentence, same kind.
 fn bare(e: std::io::Error) -> std::io::Error {
@@ -217,7 +207,7 @@ pub fn check_writable(path: &Path) -> Result<(), OutputError> {
         }
     }
     // Dropping the probe removes it.
-    temp_builder().tempfile_in(&dir).map_err(|e| {
+    IMAGES.temp_builder().tempfile_in(&dir).map_err(|e| {
         refuse(format!(
             "cannot create files in the folder `{}`: {}",
             dir.display(),
@@ -230,15 +220,10 @@ pub fn check_writable(path: &Path) -> Result<(), OutputError> {
 /// Writes `bytes` to a temporary file beside `path`, then renames it over `path`. Errors name
 /// `path`, not the temporary file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-    let io = |source| OutputError::Io {
+    IMAGES.write(path, bytes).map_err(|source| OutputError::Io {
         path: path.to_path_buf(),
         source: bare(source),
-    };
-    let mut tmp = temp_builder().tempfile_in(parent_dir(path)).map_err(io)?;
-    tmp.write_all(bytes).map_err(io)?;
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    })
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ use std::path::Path;
 use glam::{DVec3, Vec3};
 
 use super::Film;
+use crate::binfile::{Reader, fnv1a};
 
 /// Fixed-point scale of the sums: samples are rounded to multiples of 2⁻⁶⁴ (about 5.4e-20) before
 /// summing, so even a light of a microwatt keeps 11 significant digits; sums saturate at
@@ -218,38 +219,36 @@ impl PixelSums {
         if fnv1a(body) != stored {
             return Err(bad("checksum mismatch (truncated or corrupt)"));
         }
-        let mut r = Reader {
-            bytes: body,
-            at: MAGIC.len(),
-        };
-        let width = u32::from_le_bytes(r.take::<4>().ok_or_else(|| bad("truncated"))?);
-        let height = u32::from_le_bytes(r.take::<4>().ok_or_else(|| bad("truncated"))?);
-        let meta_len = u64::from_le_bytes(r.take::<8>().ok_or_else(|| bad("truncated"))?);
+        let mut r = Reader::new(body);
+        let truncated = |_| bad("truncated");
+        r.take(MAGIC.len()).map_err(truncated)?;
+        let width = r.u32().map_err(truncated)?;
+        let height = r.u32().map_err(truncated)?;
+        let meta_len = r.u64().map_err(truncated)?;
         let n = width as usize * height as usize;
         let expected = (meta_len as usize)
             .checked_add(n.checked_mul(100).ok_or_else(|| bad("absurd size"))?)
-            .and_then(|x| x.checked_add(r.at))
+            .and_then(|x| x.checked_add(r.position()))
             .ok_or_else(|| bad("absurd size"))?;
         if expected != body.len() {
             return Err(bad("size does not match its header"));
         }
-        let meta = std::str::from_utf8(&body[r.at..r.at + meta_len as usize])
+        let meta = std::str::from_utf8(r.take(meta_len as usize).map_err(truncated)?)
             .map_err(|_| bad("metadata is not UTF-8"))?
             .to_string();
-        r.at += meta_len as usize;
         let mut film = Self::new(width, height);
         for s in &mut film.sums {
             for c in s.iter_mut() {
-                *c = i128::from_le_bytes(r.take::<16>().ok_or_else(|| bad("truncated"))?);
+                *c = r.i128().map_err(truncated)?;
             }
         }
         for s in &mut film.squares {
             for c in s.iter_mut() {
-                *c = i128::from_le_bytes(r.take::<16>().ok_or_else(|| bad("truncated"))?);
+                *c = r.i128().map_err(truncated)?;
             }
         }
         for c in &mut film.counts {
-            *c = u32::from_le_bytes(r.take::<4>().ok_or_else(|| bad("truncated"))?);
+            *c = r.u32().map_err(truncated)?;
         }
         Ok((film, meta))
     }
@@ -273,29 +272,6 @@ impl PixelSums {
     pub fn write(&self, path: &Path, metadata: &str) -> Result<(), super::output::OutputError> {
         super::output::write_atomic(path, &self.to_bytes(metadata))
     }
-}
-
-struct Reader<'a> {
-    bytes: &'a [u8],
-    at: usize,
-}
-
-impl Reader<'_> {
-    fn take<const N: usize>(&mut self) -> Option<[u8; N]> {
-        let s = self.bytes.get(self.at..self.at + N)?;
-        self.at += N;
-        s.try_into().ok()
-    }
-}
-
-/// FNV-1a, 64 bits: detects truncation and corruption of film files (not an adversary).
-pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in bytes {
-        h ^= u64::from(*b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod geometry;
+pub mod hash;
 pub mod light;
 pub mod light_sampler;
 pub mod material;

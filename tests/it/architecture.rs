@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 /// (module directory, crate modules it may use besides itself), lowest layer first.
 const RULES: &[(&str, &[&str])] = &[
+    ("src/binfile", &[]),
     ("src/geometry", &[]),
     ("src/sampling", &["geometry"]),
     ("src/texture", &["geometry", "sampling"]),
@@ -17,11 +18,14 @@ const RULES: &[(&str, &[&str])] = &[
     ("src/bench", &["geometry", "sampling", "accel"]),
     (
         "src/render_scene",
-        &["geometry", "sampling", "texture", "shading", "accel"],
+        &[
+            "binfile", "geometry", "sampling", "texture", "shading", "accel",
+        ],
     ),
     (
         "src/integrators",
         &[
+            "binfile",
             "geometry",
             "sampling",
             "texture",
@@ -34,6 +38,7 @@ const RULES: &[(&str, &[&str])] = &[
     (
         "src/render",
         &[
+            "binfile",
             "geometry",
             "sampling",
             "texture",
@@ -47,6 +52,7 @@ const RULES: &[(&str, &[&str])] = &[
     (
         "src/analysis",
         &[
+            "binfile",
             "geometry",
             "sampling",
             "texture",
@@ -61,6 +67,7 @@ const RULES: &[(&str, &[&str])] = &[
     (
         "src/farm",
         &[
+            "binfile",
             "geometry",
             "sampling",
             "texture",
@@ -76,6 +83,7 @@ const RULES: &[(&str, &[&str])] = &[
     (
         "src/compile",
         &[
+            "binfile",
             "geometry",
             "sampling",
             "texture",

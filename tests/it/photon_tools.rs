@@ -199,9 +199,13 @@ fn a_corrupt_or_truncated_file_is_reported_rebuilt_and_never_trusted() {
         assert_eq!(std::fs::read(&file).expect("rebuilt"), good, "{what}");
     }
     // The decoder names what is wrong.
-    let e = decode(&scene, &good[..40], cache_key(&scene)).expect_err("truncated");
+    let e = decode(&scene, &good[..40], cache_key(&scene))
+        .expect_err("truncated")
+        .to_string();
     assert!(e.contains("checksum") || e.contains("truncated"), "{e}");
-    let e = decode(&scene, b"not a cache file at all, no", 0).expect_err("magic");
+    let e = decode(&scene, b"not a cache file at all, no", 0)
+        .expect_err("magic")
+        .to_string();
     assert!(e.contains("signature"), "{e}");
     assert_eq!(&good[..16], MAGIC);
 }
