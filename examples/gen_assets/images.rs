@@ -282,3 +282,50 @@ pub fn ramp_height() -> GrayImage {
         Luma([(x as f32 / max * 255.0 + 0.5) as u8])
     })
 }
+
+/// Width of the generated HDR sky (equirectangular, 2:1).
+pub const SKY_WIDTH: u32 = 128;
+/// Height of the generated HDR sky.
+pub const SKY_HEIGHT: u32 = 64;
+/// Centre of the sky's sun in image coordinates `(u, v)` (v = θ/π from the zenith): 36°
+/// above the horizon.
+pub const SKY_SUN_UV: (f32, f32) = (0.3, 0.3);
+
+/// A procedural linear-radiance sky for environment lighting (issue #25), equirectangular with
+/// row 0 at the zenith (the convention of `render_scene::light::environment`): a blue-to-white
+/// gradient above the horizon, a dim brown ground below it, and a sun (a bright spot, peak
+/// radiance ≈ 200, radius ≈ 2 texels) with a soft glow. Only `+ − × ÷` in floating point, so
+/// the values do not depend on the platform's maths library.
+#[must_use]
+pub fn sky() -> image::Rgb32FImage {
+    let (w, h) = (SKY_WIDTH, SKY_HEIGHT);
+    image::Rgb32FImage::from_fn(w, h, |x, y| {
+        let s = (x as f32 + 0.5) / w as f32;
+        let t = (y as f32 + 0.5) / h as f32;
+        // Elevation proxy: 1 at the zenith, 0 at the horizon, −1 at the nadir.
+        let e = 1.0 - 2.0 * t;
+        let base = if e > 0.0 {
+            let k = 1.0 - (1.0 - e) * (1.0 - e);
+            let (zenith, horizon) = ([0.25, 0.45, 0.9], [0.9, 0.95, 1.0]);
+            [0, 1, 2].map(|c| lerp(horizon[c], zenith[c], k))
+        } else {
+            [0.12, 0.1, 0.08]
+        };
+        // The sun: distance in (2·Δu, Δv) so one unit is the same angle along both axes at
+        // the horizon; Δu wraps around.
+        let mut du = s - SKY_SUN_UV.0;
+        if du > 0.5 {
+            du -= 1.0;
+        } else if du < -0.5 {
+            du += 1.0;
+        }
+        let dv = t - SKY_SUN_UV.1;
+        let r2 = 4.0 * du * du + dv * dv;
+        let disc = (1.0 - r2 / (0.03 * 0.03)).max(0.0);
+        let glow = (1.0 - r2 / (0.2 * 0.2)).max(0.0);
+        let sun = 200.0 * disc * disc;
+        let halo = 1.5 * glow * glow;
+        let tint = [1.0, 0.9, 0.75];
+        image::Rgb([0, 1, 2].map(|c| base[c] + (sun + halo) * tint[c]))
+    })
+}

@@ -7,6 +7,8 @@
 //! - `tiles_height.png`, `tiles_color.png`: a seamless 128×128 height map of 4×4 bevelled square
 //!   tiles with grout, and the matching colour image.
 //! - `ramp_height.png`: a 64×64 linear ramp in x, for bump mapping with an analytic tilt.
+//! - `sky.exr`: a 128×64 equirectangular linear HDR sky (gradient, ground, sun) for environment
+//!   lighting.
 //!
 //! The image generators live in `images.rs` so `tests/assets.rs` can check the committed files.
 
@@ -71,5 +73,14 @@ fn main() -> std::io::Result<()> {
     grey("tiles_height.png", images::tiles_height())?;
     rgb("tiles_color.png", images::tiles_color())?;
     grey("ramp_height.png", images::ramp_height())?;
+    let sky = images::sky();
+    let path = root.join("sky.exr");
+    sky.save(&path).map_err(std::io::Error::other)?;
+    println!(
+        "assets/sky.exr: {}×{} linear RGB float, {} bytes",
+        sky.width(),
+        sky.height(),
+        std::fs::metadata(&path)?.len()
+    );
     Ok(())
 }

@@ -344,3 +344,13 @@ fn cone_one_minus_cos(r2: f32, dist2: f32) -> f32 {
 
 #[cfg(test)]
 mod tests;
+
+// The light shapes of issue #25, standalone until they are wired in as `Light` variants.
+pub mod distant;
+pub mod environment;
+pub mod infinite;
+pub mod rect;
+pub mod spot;
+pub mod triangle_mesh;
+#[cfg(test)]
+mod test_support;

@@ -124,6 +124,30 @@ impl AliasTable {
         Some((i, self.bins[i].pmf))
     }
 
+    /// Like [`AliasTable::sample`], and also returns `u` remapped to a fresh uniform in
+    /// `[0, 1)`, independent of the choice (the position of `u` within the part of the column
+    /// that chose the entry), so one number can pick an entry and then drive a second warp.
+    #[inline]
+    #[must_use]
+    pub fn sample_remapped(&self, u: f32) -> Option<(usize, f32, f32)> {
+        let n = self.bins.len();
+        if n == 0 {
+            return None;
+        }
+        let scaled = f64::from(u.clamp(0.0, 1.0)) * n as f64;
+        let column = (scaled as usize).min(n - 1);
+        let within = (scaled - column as f64).clamp(0.0, 1.0);
+        let bin = self.bins[column];
+        let keep = f64::from(bin.keep);
+        let (i, rest) = if within < keep {
+            (column, within / keep)
+        } else {
+            (bin.alias as usize, (within - keep) / (1.0 - keep))
+        };
+        let rest = (rest as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        Some((i, self.bins[i].pmf, rest))
+    }
+
     /// Probability of entry `i` (0 out of range).
     #[inline]
     #[must_use]
@@ -209,6 +233,28 @@ mod tests {
         }
         // The extreme uniforms stay in range.
         assert!(t.sample(0.0).is_some() && t.sample(1.0 - f32::EPSILON / 2.0).is_some());
+    }
+
+    #[test]
+    fn remapped_uniform_is_uniform_within_each_choice() {
+        use crate::sampling::chi2::pearson;
+        let t = AliasTable::new(&[3.0, 1.0, 6.0]);
+        let mut r = Rng::new(4, 4);
+        let mut counts = vec![0u64; 30];
+        let mut per = [0u64; 3];
+        for _ in 0..90_000 {
+            let (i, pmf, rest) = t.sample_remapped(r.next_f32()).unwrap();
+            assert_eq!(pmf, t.pmf(i));
+            assert!((0.0..1.0).contains(&rest));
+            per[i] += 1;
+            counts[i * 10 + ((rest * 10.0) as usize).min(9)] += 1;
+        }
+        // Each entry's remapped uniforms fill its 10 bins evenly, and entries keep their pmf.
+        let expected: Vec<f64> = (0..30)
+            .map(|k| 90_000.0 * f64::from(t.pmf(k / 10)) / 10.0)
+            .collect();
+        let res = pearson(&counts, &expected);
+        assert!(res.p_value > 0.001, "{res:?} {per:?}");
     }
 
     #[test]

@@ -79,6 +79,28 @@ pub fn cosine_hemisphere(u: (f32, f32), n: Vec3) -> Vec3 {
     Frame::from_normal(n).to_world(Vec3::new(r * phi.cos(), r * phi.sin(), z))
 }
 
+/// A point uniformly distributed on the unit disc from `u ∈ [0, 1)²` by Shirley and Chiu's
+/// concentric map ("A Low Distortion Map Between Disk and Square", JGT 1997): squares around the
+/// centre go to circles, so stratified samples stay stratified. Density `1/π` per unit area;
+/// the square's boundary (`max(|2u − 1|) = 1`) maps to the unit circle.
+#[inline]
+#[must_use]
+pub fn concentric_disk(u: (f32, f32)) -> (f32, f32) {
+    let (a, b) = (2.0 * u.0 - 1.0, 2.0 * u.1 - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, phi) = if a.abs() > b.abs() {
+        (a, std::f32::consts::FRAC_PI_4 * (b / a))
+    } else {
+        (
+            b,
+            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (a / b),
+        )
+    };
+    (r * phi.cos(), r * phi.sin())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -104,5 +126,29 @@ mod tests {
             .sum::<f32>()
             / 100_000.0;
         assert!((mean - 2.0 / 3.0).abs() < 0.005, "{mean}");
+    }
+
+    #[test]
+    fn concentric_disk_is_uniform_and_maps_the_border_to_the_circle() {
+        use crate::sampling::chi2::pearson;
+        // Equal-area bins: 4 rings of equal r² width × 8 sectors.
+        let mut r = Rng::new(5, 0);
+        let mut counts = vec![0u64; 32];
+        let n = 64_000;
+        for _ in 0..n {
+            let (x, y) = concentric_disk(r.next_2d());
+            let r2 = x * x + y * y;
+            assert!(r2 <= 1.0 + 1e-6);
+            let ring = ((r2 * 4.0) as usize).min(3);
+            let phi = y.atan2(x).rem_euclid(TAU);
+            let sector = ((phi / TAU * 8.0) as usize).min(7);
+            counts[ring * 8 + sector] += 1;
+        }
+        let res = pearson(&counts, &vec![f64::from(n) / 32.0; 32]);
+        assert!(res.p_value > 0.01, "{res:?}");
+        for t in [0.0, 0.3, 0.5, 0.9] {
+            let (x, y) = concentric_disk((1.0, t));
+            assert!(((x * x + y * y).sqrt() - 1.0).abs() < 1e-6);
+        }
     }
 }

@@ -76,6 +76,23 @@ fn committed_pngs_are_what_the_generator_makes() {
 }
 
 #[test]
+fn the_committed_sky_is_what_the_generator_makes() {
+    let file = committed("sky.exr").to_rgb32f();
+    let generated = images::sky();
+    assert_eq!(file.dimensions(), generated.dimensions());
+    let differ = file
+        .as_raw()
+        .iter()
+        .zip(generated.as_raw())
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    assert_eq!(differ, 0, "sky.exr: regenerate with `cargo run --example gen_assets`");
+    // Linear HDR: the sun is far brighter than the sky, the ground darker; all finite.
+    let max = generated.as_raw().iter().fold(0.0f32, |m, &v| m.max(v));
+    assert!(max > 100.0 && generated.as_raw().iter().all(|v| v.is_finite() && *v >= 0.0));
+}
+
+#[test]
 fn committed_pngs_are_small() {
     for name in [
         "hardwood.png",

@@ -1,0 +1,241 @@
+//! Triangle-mesh area light: every triangle of an emissive mesh emits uniform radiance. Next
+//! event estimation picks a triangle by an alias table over the areas and a uniform point on it,
+//! so points are uniform over the whole mesh (area density `1/A`), converted to solid angle by
+//! `d² / |cos θ_l|` (pbrt-v4 §12.3's area sampling; our own code).
+//!
+//! Radiance is constant today. Texture hook: a textured emitter will take `le` from the
+//! triangle's uv at the sampled barycentrics — [`MeshLightSample::triangle`] and
+//! [`MeshLightSample::barycentrics`] are what it needs; the alias weights may then include
+//! each triangle's mean texture luminance.
+
+use glam::Vec3;
+use std::f32::consts::PI;
+
+use super::{EmissionSample, LightSample};
+use crate::geometry::Ray;
+use crate::geometry::triangle::{TriRay, intersect_triangle};
+use crate::sampling::alias::AliasTable;
+use crate::sampling::warp::cosine_hemisphere;
+
+/// An emissive triangle mesh (world space).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshLight {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Triangles as vertex indices; the emitting side of a one-sided light is the one the
+    /// winding's normal `(p1 − p0) × (p2 − p0)` points to.
+    pub triangles: Vec<[u32; 3]>,
+    /// Emitted radiance per channel (W/(m²·sr)).
+    pub radiance: Vec3,
+    /// Emits on both sides of every triangle.
+    pub two_sided: bool,
+    /// Total area (m²) of the non-degenerate triangles.
+    pub area: f32,
+    /// Triangle choice by area.
+    table: AliasTable,
+}
+
+/// Where on the mesh a light sample landed (for textured emission and for the hit record).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshLightSample {
+    /// The incident-light sample.
+    pub light: LightSample,
+    /// Index of the triangle.
+    pub triangle: usize,
+    /// Barycentric weights of its three vertices.
+    pub barycentrics: [f32; 3],
+}
+
+impl MeshLight {
+    /// The mesh light; `None` if no triangle has a positive, finite area or an index is out of
+    /// range (the compiler validates meshes before this).
+    #[must_use]
+    pub fn new(
+        positions: Vec<Vec3>,
+        triangles: Vec<[u32; 3]>,
+        radiance: Vec3,
+        two_sided: bool,
+    ) -> Option<Self> {
+        let n = positions.len();
+        if triangles.iter().flatten().any(|&i| i as usize >= n) {
+            return None;
+        }
+        let areas: Vec<f32> = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .collect();
+        let table = AliasTable::new(&areas);
+        if table.is_empty() {
+            return None;
+        }
+        let area = table.total() as f32;
+        Some(Self {
+            positions,
+            triangles,
+            radiance,
+            two_sided,
+            area,
+            table,
+        })
+    }
+
+    /// The vertices of triangle `i`.
+    #[inline]
+    fn vertices(&self, i: usize) -> [Vec3; 3] {
+        self.triangles[i].map(|v| self.positions[v as usize])
+    }
+
+    /// The unit geometric normal of triangle `i` (winding order).
+    #[inline]
+    #[must_use]
+    pub fn normal(&self, i: usize) -> Vec3 {
+        let [a, b, c] = self.vertices(i);
+        (b - a).cross(c - a).normalize_or_zero()
+    }
+
+    /// Total emitted flux (W): `π L A`, twice that when two-sided.
+    #[must_use]
+    pub fn power(&self) -> Vec3 {
+        self.radiance * (PI * self.area * if self.two_sided { 2.0 } else { 1.0 })
+    }
+
+    /// Radiance leaving a point of normal `n` (the triangle's geometric normal) in the unit
+    /// direction `w`: `L` on an emitting side, 0 behind a one-sided light.
+    #[inline]
+    #[must_use]
+    pub fn le(&self, n: Vec3, w: Vec3) -> Vec3 {
+        if self.two_sided || n.dot(w) > 0.0 {
+            self.radiance
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// A uniform point on the mesh from `u`: `u.0` picks the triangle (and is remapped), then
+    /// the pair is warped onto it. Returns the triangle, barycentrics and the point.
+    #[inline]
+    fn sample_point(&self, u: (f32, f32)) -> Option<(usize, [f32; 3], Vec3)> {
+        let (i, _, u0) = self.table.sample_remapped(u.0)?;
+        let s = u0.sqrt();
+        let (b0, b1) = (1.0 - s, u.1 * s);
+        let b = [b0, b1, 1.0 - b0 - b1];
+        let [p0, p1, p2] = self.vertices(i);
+        Some((i, b, p0 * b[0] + p1 * b[1] + p2 * b[2]))
+    }
+
+    /// Samples a direction towards the mesh from `p` (uniform by area; solid-angle density `d²
+    /// / (A |cos θ_l|)`). `None` for a black light, a point on a triangle's back (one-sided:
+    /// no light goes that way; [`MeshLight::pdf_li`] gives such directions density 0), or a
+    /// grazing point.
+    #[must_use]
+    pub fn sample_li(&self, p: Vec3, u: (f32, f32)) -> Option<MeshLightSample> {
+        if self.radiance == Vec3::ZERO {
+            return None;
+        }
+        let (i, barycentrics, point) = self.sample_point(u)?;
+        let n = self.normal(i);
+        let d = point - p;
+        let dist2 = d.length_squared();
+        let distance = dist2.sqrt();
+        let wi = d / distance;
+        let cos_l = -n.dot(wi);
+        if !(self.two_sided || cos_l > 0.0) {
+            return None;
+        }
+        let pdf = dist2 / (self.area * cos_l.abs());
+        let weight = self.radiance / pdf;
+        (pdf.is_finite() && pdf > 0.0 && weight.is_finite()).then_some(MeshLightSample {
+            light: LightSample {
+                wi,
+                distance,
+                point,
+                radiance: self.radiance,
+                pdf,
+                delta: false,
+                weight,
+            },
+            triangle: i,
+            barycentrics,
+        })
+    }
+
+    /// Solid-angle density of [`MeshLight::sample_li`] at `p` for the sample point `point` on
+    /// a triangle of unit normal `n` (what an integrator knows after its BSDF ray hit the
+    /// mesh): `|p − point|² / (A |cos θ_l|)`, 0 on the back of a one-sided light.
+    #[inline]
+    #[must_use]
+    pub fn pdf_li_hit(&self, p: Vec3, point: Vec3, n: Vec3) -> f32 {
+        let d = point - p;
+        let dist2 = d.length_squared();
+        let cos_l = -n.dot(d) / dist2.sqrt();
+        if !(self.two_sided || cos_l > 0.0) {
+            return 0.0;
+        }
+        let pdf = dist2 / (self.area * cos_l.abs());
+        if pdf.is_finite() { pdf } else { 0.0 }
+    }
+
+    /// Solid-angle density of [`MeshLight::sample_li`] for the unit direction `wi` from `p`:
+    /// the sum of [`MeshLight::pdf_li_hit`] over every triangle the line meets (an occluded
+    /// triangle is still sampled). O(triangles): a reference for tests, not for rendering.
+    #[must_use]
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3) -> f32 {
+        let ray = Ray::new(p, wi);
+        let tri_ray = TriRay::new(&ray);
+        (0..self.triangles.len())
+            .filter_map(|i| {
+                let [a, b, c] = self.vertices(i);
+                let hit = intersect_triangle(&tri_ray, a, b, c, f32::INFINITY)?;
+                Some(self.pdf_li_hit(p, p + wi * hit.t, self.normal(i)))
+            })
+            .sum()
+    }
+
+    /// A ray leaving the mesh: a uniform point (`pdf_pos = 1/A`) and a cosine-weighted
+    /// direction about the emitting side's normal (`pdf_dir = cos θ/π`; two-sided: the side by
+    /// `u_dir.0 < ½` and `|cos θ|/(2π)`), carrying the whole power per sample.
+    #[must_use]
+    pub fn sample_le(&self, u_pos: (f32, f32), u_dir: (f32, f32)) -> Option<EmissionSample> {
+        if self.radiance == Vec3::ZERO || !self.radiance.is_finite() {
+            return None;
+        }
+        let (i, _, origin) = self.sample_point(u_pos)?;
+        let n = self.normal(i);
+        let (normal, u, side_pdf) = if !self.two_sided {
+            (n, u_dir, 1.0)
+        } else if u_dir.0 < 0.5 {
+            (n, (2.0 * u_dir.0, u_dir.1), 0.5)
+        } else {
+            (-n, (2.0 * u_dir.0 - 1.0, u_dir.1), 0.5)
+        };
+        let dir = cosine_hemisphere(u, normal);
+        let cos_t = dir.dot(normal);
+        (cos_t > 0.0).then(|| EmissionSample {
+            origin,
+            normal,
+            dir,
+            le: self.radiance,
+            pdf_pos: 1.0 / self.area,
+            pdf_dir: side_pdf * cos_t / PI,
+        })
+    }
+
+    /// `(pdf_pos, pdf_dir)` of [`MeshLight::sample_le`] for a ray leaving a point of the
+    /// triangle with geometric normal `n` in the unit `dir`.
+    #[must_use]
+    pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+        let c = n.dot(dir);
+        let pdf_dir = if self.two_sided {
+            c.abs() / (2.0 * PI)
+        } else {
+            c.max(0.0) / PI
+        };
+        (1.0 / self.area, pdf_dir)
+    }
+}
+
+#[cfg(test)]
+mod tests;
