@@ -4,7 +4,7 @@
 use super::*;
 use crate::render_scene::light::test_support::stratified;
 use crate::sampling::Rng;
-use crate::sampling::chi2::{SphereBins, chi2_test, integrate_sphere, sidak_alpha};
+use crate::sampling::chi2::{SphereBins, chi2_test, integrate_sphere, pearson, sidak_alpha};
 
 fn scene() -> SceneSphere {
     SceneSphere::new(Vec3::ZERO, 3.0)
@@ -78,29 +78,101 @@ fn lookups_hit_texel_centres_exactly_and_interpolate_between() {
     assert!((l.le(d) - want).abs().max_element() < 1e-4);
 }
 
+/// χ² of directions binned on a `(u, v)` grid of the map's frame (each texel split 2 × 2, so
+/// bins never straddle a texel edge) against the counts `pdf` predicts: the integral over each
+/// bin of `pdf(ω) dω = pdf(ω(u, v)) · 2π² sin θ du dv` by the midpoint rule on 4 × 4 points
+/// (exact when `pdf` is the map's piecewise-constant density over `2π² sin θ`, the claim under
+/// test; a wrong Jacobian or a misplaced map makes the product vary and the counts disagree).
+/// Solid-angle bins would not do here: `pdf_li` is discontinuous along every texel edge and
+/// grows as 1/sin θ towards the poles, which defeats the sphere histogram's quadrature.
+fn chi2_uv(
+    l: &EnvironmentLight,
+    seed: u64,
+    mut sample: impl FnMut(&mut Rng) -> Option<Vec3>,
+    pdf: impl Fn(Vec3) -> f32,
+) -> crate::sampling::chi2::Chi2Result {
+    let (bu, bv) = (32usize, 16usize);
+    let n = 400_000;
+    let mut counts = vec![0u64; bu * bv + 1];
+    let mut rng = Rng::new(seed, 0);
+    for _ in 0..n {
+        match sample(&mut rng) {
+            Some(w) => {
+                let (u, v) = direction_to_uv(l.to_map(w));
+                counts[((v * bv as f32) as usize).min(bv - 1) * bu + ((u * bu as f32) as usize).min(bu - 1)] += 1;
+            }
+            None => counts[bu * bv] += 1,
+        }
+    }
+    let mut expected: Vec<f64> = uv_bin_mass(l, bu, bv, &pdf).iter().map(|p| p * f64::from(n)).collect();
+    let inside: f64 = expected.iter().sum();
+    expected.push((f64::from(n) - inside).max(0.0));
+    pearson(&counts, &expected)
+}
+
+/// The mass `pdf` gives each of `bu × bv` bins of the map's `(u, v)` (see [`chi2_uv`]).
+fn uv_bin_mass(l: &EnvironmentLight, bu: usize, bv: usize, pdf: &impl Fn(Vec3) -> f32) -> Vec<f64> {
+    let sub = 4;
+    let (du, dv) = (1.0 / (bu * sub) as f64, 1.0 / (bv * sub) as f64);
+    (0..bu * bv)
+        .map(|b| {
+            let (bx, by) = (b % bu, b / bu);
+            let mut p = 0.0;
+            for j in 0..sub {
+                for i in 0..sub {
+                    let u = ((bx * sub + i) as f64 + 0.5) * du;
+                    let v = ((by * sub + j) as f64 + 0.5) * dv;
+                    let (d, sin_t) = uv_to_direction(u as f32, v as f32);
+                    let jac = 2.0 * std::f64::consts::PI.powi(2) * f64::from(sin_t);
+                    p += f64::from(pdf(l.to_world(d))) * jac * du * dv;
+                }
+            }
+            p
+        })
+        .collect()
+}
+
 #[test]
 fn sample_li_passes_chi2_against_pdf_li_and_a_wrong_pdf_fails() {
-    let cases = [("image", sky(0.7)), ("constant", EnvironmentLight::constant(Vec3::ONE, scene()))];
-    let alpha = sidak_alpha(0.01, 2 * cases.len());
-    for (i, (label, l)) in cases.iter().enumerate() {
-        let bins = SphereBins::sphere(Vec3::Y, 24, 48);
-        let r = chi2_test(400_000, i as u64, &bins, |rng| l.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi), |w| l.pdf_li(Vec3::ZERO, w));
-        eprintln!("environment sample_li χ² {label}: {r:?}");
-        assert!(r.passes(alpha) && r.rejected == 0 && r.dof > 500, "{label}: {r:?}");
-        let e = chi2_test(400_000, 10 + i as u64, &bins, |rng| l.sample_le(rng.next_2d(), rng.next_2d()).map(|s| s.dir), |w| l.pdf_le(w).1);
-        eprintln!("environment sample_le dir χ² {label}: {e:?}");
-        assert!(e.passes(alpha) && e.rejected == 0, "{label}: {e:?}");
-        let total = integrate_sphere(Vec3::Y, |w| l.pdf_li(Vec3::ZERO, w));
-        assert!((total - 1.0).abs() < 2e-3, "{label}: ∫pdf = {total}");
-    }
-    // The image's samples against the uniform density, and against the unrotated map's.
+    let alpha = sidak_alpha(0.01, 4);
+    // The image map, in the map's (u, v).
     let l = sky(0.7);
-    let bins = SphereBins::sphere(Vec3::Y, 24, 48);
+    let li = chi2_uv(&l, 1, |rng| l.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi), |w| l.pdf_li(Vec3::ZERO, w));
+    eprintln!("environment sample_li χ² image: {li:?}");
+    assert!(li.passes(alpha) && li.dof > 400, "{li:?}");
+    let le = chi2_uv(&l, 2, |rng| l.sample_le(rng.next_2d(), rng.next_2d()).map(|s| -s.dir), |w| l.pdf_le(-w).1);
+    eprintln!("environment sample_le dir χ² image: {le:?}");
+    assert!(le.passes(alpha) && le.dof > 400, "{le:?}");
+    // Its density has unit mass (exactly, in (u, v); and by the sphere quadrature, which the
+    // 1/sin θ poles and texel edges limit to ~1e-4).
+    let mass: f64 = uv_bin_mass(&l, 32, 16, &|w| l.pdf_li(Vec3::ZERO, w)).iter().sum();
+    assert!((mass - 1.0).abs() < 1e-5, "{mass}");
+    let sphere = integrate_sphere(Vec3::Y, |w| l.pdf_li(Vec3::ZERO, w));
+    assert!((sphere - 1.0).abs() < 1e-3, "{sphere}");
+    // Wrong claims are rejected: the uniform density, the unrotated map's density, and the
+    // map's density without the sin θ of the Jacobian (renormalised).
     let sample = |rng: &mut Rng| l.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi);
-    let uniform = chi2_test(400_000, 20, &bins, sample, |_| 1.0 / (4.0 * PI));
+    let uniform = chi2_uv(&l, 4, sample, |_| 1.0 / (4.0 * PI));
     let unrotated = sky(0.0);
-    let turned = chi2_test(400_000, 21, &bins, sample, |w| unrotated.pdf_li(Vec3::ZERO, w));
-    assert!(uniform.p_value < 1e-6 && turned.p_value < 1e-6, "{uniform:?} {turned:?}");
+    let turned = chi2_uv(&l, 5, sample, |w| unrotated.pdf_li(Vec3::ZERO, w));
+    let no_jacobian = chi2_uv(&l, 6, sample, |w| {
+        let d = l.to_map(w);
+        l.pdf_li(Vec3::ZERO, w) * (d.x * d.x + d.z * d.z).sqrt() * (PI / 4.0) * PI
+    });
+    eprintln!(
+        "environment χ² wrong pdfs (must fail): uniform {:.0}, unrotated {:.0}, no sin θ {:.0}",
+        uniform.statistic, turned.statistic, no_jacobian.statistic
+    );
+    assert!(uniform.p_value < 1e-6 && turned.p_value < 1e-6 && no_jacobian.p_value < 1e-6);
+    // The constant environment, in solid-angle bins.
+    let c = EnvironmentLight::constant(Vec3::ONE, scene());
+    let bins = SphereBins::sphere(Vec3::Y, 24, 48);
+    let r = chi2_test(400_000, 7, &bins, |rng| c.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi), |w| c.pdf_li(Vec3::ZERO, w));
+    eprintln!("environment sample_li χ² constant: {r:?}");
+    assert!(r.passes(alpha) && r.rejected == 0 && r.dof > 500, "{r:?}");
+    let e = chi2_test(400_000, 8, &bins, |rng| c.sample_le(rng.next_2d(), rng.next_2d()).map(|s| s.dir), |w| c.pdf_le(w).1);
+    eprintln!("environment sample_le dir χ² constant: {e:?}");
+    assert!(e.passes(alpha) && e.rejected == 0, "{e:?}");
 }
 
 /// E at the origin on a plane of normal `n`, by quadrature of `le` (θ, φ midpoint rule).
@@ -183,3 +255,4 @@ fn bad_maps_are_errors_and_black_maps_emit_nothing() {
     assert_eq!(black.pdf_li(Vec3::ZERO, Vec3::Y), 0.0);
     assert!(black.sample_le((0.5, 0.5), (0.5, 0.5)).is_none());
 }
+
