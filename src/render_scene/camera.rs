@@ -129,10 +129,11 @@ impl Camera {
             } => {
                 let u = 2.0 * fx / width as f32 - 1.0;
                 let v = 1.0 - 2.0 * fy / height as f32;
-                let focus = self.eye + (self.forward + self.right * u + self.up * v) * focus_distance;
+                let focus =
+                    self.eye + (self.forward + self.right * u + self.up * v) * focus_distance;
                 let (lx, ly) = concentric_disk(u_lens);
-                let origin = self.eye
-                    + (self.right.normalize() * lx + self.up.normalize() * ly) * radius;
+                let origin =
+                    self.eye + (self.right.normalize() * lx + self.up.normalize() * ly) * radius;
                 Ray::new(origin, (focus - origin).normalize())
             }
         }

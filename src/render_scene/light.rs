@@ -351,6 +351,6 @@ pub mod environment;
 pub mod infinite;
 pub mod rect;
 pub mod spot;
-pub mod triangle_mesh;
 #[cfg(test)]
 mod test_support;
+pub mod triangle_mesh;

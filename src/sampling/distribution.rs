@@ -159,9 +159,17 @@ impl Distribution1D {
         let n = self.func.len();
         let u = u.clamp(0.0, ONE_MINUS_EPSILON);
         // First index whose cdf exceeds u, minus one: the last cell starting at or before u.
-        let i = self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(n - 1);
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .saturating_sub(1)
+            .min(n - 1);
         let (a, b) = (self.cdf[i], self.cdf[i + 1]);
-        let du = if b > a { ((u - a) / (b - a)).clamp(0.0, 1.0) } else { 0.0 };
+        let du = if b > a {
+            ((u - a) / (b - a)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         (i, du)
     }
 }
@@ -306,7 +314,10 @@ mod tests {
             let (cx, cy) = ((s.x * w as f32) as usize, (s.y * h as f32) as usize);
             counts[cy * w + cx] += 1;
         }
-        let expected: Vec<f64> = func.iter().map(|&v| f64::from(v) / total * n as f64).collect();
+        let expected: Vec<f64> = func
+            .iter()
+            .map(|&v| f64::from(v) / total * n as f64)
+            .collect();
         let r = pearson(&counts, &expected);
         eprintln!("Distribution2D cell χ²: {r:?}");
         assert!(r.p_value > 0.01 && r.impossible == 0, "{r:?}");

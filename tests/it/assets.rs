@@ -86,10 +86,19 @@ fn the_committed_sky_is_what_the_generator_makes() {
         .zip(generated.as_raw())
         .filter(|(a, b)| a.to_bits() != b.to_bits())
         .count();
-    assert_eq!(differ, 0, "sky.exr: regenerate with `cargo run --example gen_assets`");
+    assert_eq!(
+        differ, 0,
+        "sky.exr: regenerate with `cargo run --example gen_assets`"
+    );
     // Linear HDR: the sun is far brighter than the sky, the ground darker; all finite.
     let max = generated.as_raw().iter().fold(0.0f32, |m, &v| m.max(v));
-    assert!(max > 100.0 && generated.as_raw().iter().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(
+        max > 100.0
+            && generated
+                .as_raw()
+                .iter()
+                .all(|v| v.is_finite() && *v >= 0.0)
+    );
 }
 
 #[test]

@@ -46,8 +46,14 @@ fn the_pinhole_is_unchanged_in_rays_and_in_its_debug_text() {
     for (fx, fy) in [(0.0, 0.0), (13.25, 77.5), (199.9, 149.9)] {
         let a = c.ray(fx, fy, W, H);
         let b = c.ray_lens(fx, fy, W, H, (0.3, 0.9));
-        assert_eq!(a.origin.to_array().map(f32::to_bits), b.origin.to_array().map(f32::to_bits));
-        assert_eq!(a.dir.to_array().map(f32::to_bits), b.dir.to_array().map(f32::to_bits));
+        assert_eq!(
+            a.origin.to_array().map(f32::to_bits),
+            b.origin.to_array().map(f32::to_bits)
+        );
+        assert_eq!(
+            a.dir.to_array().map(f32::to_bits),
+            b.dir.to_array().map(f32::to_bits)
+        );
     }
 }
 
@@ -107,7 +113,8 @@ fn points_on_the_focal_plane_stay_within_one_pixel() {
             worst = worst.max(((gx - fx).powi(2) + (gy - fy).powi(2)).sqrt());
         }
         eprintln!("thin lens, focal plane point at ({fx}, {fy}): spread {worst:.2e} px");
-        assert!(worst < 1.0 && worst < 0.01, "{worst} px");
+        // Well within the one pixel the issue asks for: the lens focuses the plane exactly.
+        assert!(worst < 0.01, "{worst} px");
     }
 }
 
@@ -125,11 +132,19 @@ fn points_off_the_focal_plane_spread_to_the_circle_of_confusion() {
                 .collect();
             let diameter = film
                 .iter()
-                .flat_map(|p| film.iter().map(move |q| ((p.0 - q.0).powi(2) + (p.1 - q.1).powi(2)).sqrt()))
+                .flat_map(|p| {
+                    film.iter()
+                        .map(move |q| ((p.0 - q.0).powi(2) + (p.1 - q.1).powi(2)).sqrt())
+                })
                 .fold(0.0, f32::max);
             let want = 2.0 * a * (d - fd).abs() / (d * fd) * px_per_tan;
-            eprintln!("thin lens d={d} at ({fx}, {fy}): CoC {diameter:.3} px, formula {want:.3} px");
-            assert!((diameter / want - 1.0).abs() < 0.05, "d={d}: {diameter} vs {want}");
+            eprintln!(
+                "thin lens d={d} at ({fx}, {fy}): CoC {diameter:.3} px, formula {want:.3} px"
+            );
+            assert!(
+                (diameter / want - 1.0).abs() < 0.05,
+                "d={d}: {diameter} vs {want}"
+            );
         }
     }
 }

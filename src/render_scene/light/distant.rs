@@ -36,7 +36,12 @@ impl DistantLight {
     /// angle out of range, or a radiance that overflows `f32` (a cone too narrow to sample:
     /// use 0 for a delta light).
     #[must_use]
-    pub fn new(to_light: Vec3, irradiance: Vec3, angular_radius: f32, scene: SceneSphere) -> Option<Self> {
+    pub fn new(
+        to_light: Vec3,
+        irradiance: Vec3,
+        angular_radius: f32,
+        scene: SceneSphere,
+    ) -> Option<Self> {
         let to_light = to_light.try_normalize()?;
         if !(0.0..std::f32::consts::FRAC_PI_2).contains(&angular_radius) {
             return None;
@@ -233,15 +238,33 @@ mod tests {
         for alpha in [SUN, 5f32.to_radians()] {
             let l = DistantLight::new(dir, Vec3::ONE, alpha, scene()).unwrap();
             let bins = SphereBins::cap(dir, 16, 32, 1.25 * f64::from(l.one_minus_cos));
-            let r = chi2_test(200_000, 1, &bins, |rng| l.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi), |w| l.pdf_li(Vec3::ZERO, w));
+            let r = chi2_test(
+                200_000,
+                1,
+                &bins,
+                |rng| l.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi),
+                |w| l.pdf_li(Vec3::ZERO, w),
+            );
             eprintln!("distant sample_li χ² α={alpha}: {r:?}");
             assert!(r.passes(0.005) && r.rejected == 0 && r.dof > 300, "{r:?}");
-            let le = chi2_test(200_000, 2, &bins, |rng| l.sample_le(rng.next_2d(), rng.next_2d()).map(|s| -s.dir), |w| l.pdf_le(-w).1);
+            let le = chi2_test(
+                200_000,
+                2,
+                &bins,
+                |rng| l.sample_le(rng.next_2d(), rng.next_2d()).map(|s| -s.dir),
+                |w| l.pdf_le(-w).1,
+            );
             eprintln!("distant sample_le dir χ² α={alpha}: {le:?}");
             assert!(le.passes(0.005) && le.rejected == 0, "{le:?}");
             // A cone 3 % wider claimed: rejected.
             let wide = DistantLight::new(dir, Vec3::ONE, alpha * 1.03, scene()).unwrap();
-            let wrong = chi2_test(200_000, 3, &bins, |rng| l.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi), |w| wide.pdf_li(Vec3::ZERO, w));
+            let wrong = chi2_test(
+                200_000,
+                3,
+                &bins,
+                |rng| l.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi),
+                |w| wide.pdf_li(Vec3::ZERO, w),
+            );
             assert!(wrong.p_value < 1e-6, "{wrong:?}");
         }
     }
@@ -249,7 +272,8 @@ mod tests {
     #[test]
     fn photons_cover_the_scene_disc_uniformly_with_the_stated_power() {
         for alpha in [0.0, 2f32.to_radians()] {
-            let l = DistantLight::new(Vec3::new(1.0, 2.0, 0.5), Vec3::splat(3.0), alpha, scene()).unwrap();
+            let l = DistantLight::new(Vec3::new(1.0, 2.0, 0.5), Vec3::splat(3.0), alpha, scene())
+                .unwrap();
             let mut rng = Rng::new(9, 0);
             let n = 64_000;
             let mut counts = vec![0u64; 32];
@@ -276,7 +300,11 @@ mod tests {
             let flux = flux / f64::from(n);
             assert!((flux / f64::from(l.power().x) - 1.0).abs() < 1e-5, "{flux}");
             let disc = f64::from(3.0 * PI * 25.0);
-            let cone = if alpha > 0.0 { 2.0 / (1.0 + f64::from(alpha.cos())) } else { 1.0 };
+            let cone = if alpha > 0.0 {
+                2.0 / (1.0 + f64::from(alpha.cos()))
+            } else {
+                1.0
+            };
             assert!((flux / (disc * cone) - 1.0).abs() < 1e-5);
         }
     }

@@ -307,7 +307,10 @@ impl EnvironmentLight {
 pub fn direction_to_uv(d: Vec3) -> (f32, f32) {
     let phi = d.x.atan2(-d.z).rem_euclid(TAU);
     let theta = d.y.clamp(-1.0, 1.0).acos();
-    ((phi / TAU).min(1.0 - f32::EPSILON / 2.0), (theta / PI).min(1.0 - f32::EPSILON / 2.0))
+    (
+        (phi / TAU).min(1.0 - f32::EPSILON / 2.0),
+        (theta / PI).min(1.0 - f32::EPSILON / 2.0),
+    )
 }
 
 /// The unit direction in the map's frame at `(u, v)`, and its `sin θ`.

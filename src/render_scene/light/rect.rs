@@ -62,8 +62,7 @@ impl RectLight {
         if !(area > 0.0 && area.is_finite() && corner.is_finite()) {
             return None;
         }
-        let is_rectangle =
-            edge_u.dot(edge_v).abs() <= 1e-4 * edge_u.length() * edge_v.length();
+        let is_rectangle = edge_u.dot(edge_v).abs() <= 1e-4 * edge_u.length() * edge_v.length();
         Some(Self {
             corner,
             edge_u,
@@ -260,7 +259,12 @@ impl SphericalRect {
     /// The rectangle `corner + s·eu + t·ev` (perpendicular edges) seen from `p`; `None` when
     /// `p` lies in its plane.
     fn new(p: Vec3, corner: Vec3, eu: Vec3, ev: Vec3) -> Option<Self> {
-        let (o, s, eu, ev) = (p.as_dvec3(), corner.as_dvec3(), eu.as_dvec3(), ev.as_dvec3());
+        let (o, s, eu, ev) = (
+            p.as_dvec3(),
+            corner.as_dvec3(),
+            eu.as_dvec3(),
+            ev.as_dvec3(),
+        );
         let (lu, lv) = (eu.length(), ev.length());
         let x = eu / lu;
         let y = ev / lv;

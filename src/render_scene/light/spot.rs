@@ -32,9 +32,15 @@ impl SpotLight {
     /// `0 < outer ≤ π` (an `inner` above `outer` is lowered to it). `None` when the
     /// direction is zero or the angles are out of range (validation reports those).
     #[must_use]
-    pub fn new(position: Vec3, direction: Vec3, intensity: Vec3, inner: f32, outer: f32) -> Option<Self> {
+    pub fn new(
+        position: Vec3,
+        direction: Vec3,
+        intensity: Vec3,
+        inner: f32,
+        outer: f32,
+    ) -> Option<Self> {
         let axis = direction.try_normalize()?;
-        if !(outer > 0.0 && outer <= PI && inner >= 0.0) || !position.is_finite() {
+        if !(outer > 0.0 && outer <= PI && inner >= 0.0 && position.is_finite()) {
             return None;
         }
         let inner = inner.min(outer);
@@ -72,8 +78,7 @@ impl SpotLight {
     /// integrates to half its interval in `cos θ`.
     #[must_use]
     pub fn power(&self) -> Vec3 {
-        self.intensity
-            * (TAU * ((1.0 - self.cos_inner) + 0.5 * (self.cos_inner - self.cos_outer)))
+        self.intensity * (TAU * ((1.0 - self.cos_inner) + 0.5 * (self.cos_inner - self.cos_outer)))
     }
 
     /// The delta sample towards the light from `p` (`u` unused): radiance `I(θ)/d²`, pdf 1,
@@ -230,7 +235,8 @@ mod tests {
         eprintln!("spot sample_le χ²: {r:?}");
         assert!(r.passes(0.01) && r.rejected == 0, "{r:?}");
         // Claiming a cone of 38° is rejected.
-        let narrow = SpotLight::new(l.position, l.axis, l.intensity, 0.3, 38f32.to_radians()).unwrap();
+        let narrow =
+            SpotLight::new(l.position, l.axis, l.intensity, 0.3, 38f32.to_radians()).unwrap();
         let wrong = chi2_test(200_000, 3, &bins, sample, |w| narrow.pdf_le(w).1);
         eprintln!("spot sample_le χ² against a 38° cone (must fail): {wrong:?}");
         assert!(wrong.p_value < 1e-6, "{wrong:?}");

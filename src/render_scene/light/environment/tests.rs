@@ -66,7 +66,10 @@ fn lookups_hit_texel_centres_exactly_and_interpolate_between() {
     for (x, y) in [(3usize, 2usize), (0, 0), (15, 7), (8, 4)] {
         let (d, _) = uv_to_direction((x as f32 + 0.5) / 16.0, (y as f32 + 0.5) / 8.0);
         let got = l.le(d);
-        assert!((got - texels[y * 16 + x]).abs().max_element() < 2e-3 * got.max_element().max(1.0), "({x},{y})");
+        assert!(
+            (got - texels[y * 16 + x]).abs().max_element() < 2e-3 * got.max_element().max(1.0),
+            "({x},{y})"
+        );
     }
     // Halfway between texels (4, 2) and (5, 2): the mean of the two.
     let (d, _) = uv_to_direction(5.0 / 16.0, 2.5 / 8.0);
@@ -99,12 +102,16 @@ fn chi2_uv(
         match sample(&mut rng) {
             Some(w) => {
                 let (u, v) = direction_to_uv(l.to_map(w));
-                counts[((v * bv as f32) as usize).min(bv - 1) * bu + ((u * bu as f32) as usize).min(bu - 1)] += 1;
+                counts[((v * bv as f32) as usize).min(bv - 1) * bu
+                    + ((u * bu as f32) as usize).min(bu - 1)] += 1;
             }
             None => counts[bu * bv] += 1,
         }
     }
-    let mut expected: Vec<f64> = uv_bin_mass(l, bu, bv, &pdf).iter().map(|p| p * f64::from(n)).collect();
+    let mut expected: Vec<f64> = uv_bin_mass(l, bu, bv, &pdf)
+        .iter()
+        .map(|p| p * f64::from(n))
+        .collect();
     let inside: f64 = expected.iter().sum();
     expected.push((f64::from(n) - inside).max(0.0));
     pearson(&counts, &expected)
@@ -137,15 +144,27 @@ fn sample_li_passes_chi2_against_pdf_li_and_a_wrong_pdf_fails() {
     let alpha = sidak_alpha(0.01, 4);
     // The image map, in the map's (u, v).
     let l = sky(0.7);
-    let li = chi2_uv(&l, 1, |rng| l.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi), |w| l.pdf_li(Vec3::ZERO, w));
+    let li = chi2_uv(
+        &l,
+        1,
+        |rng| l.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi),
+        |w| l.pdf_li(Vec3::ZERO, w),
+    );
     eprintln!("environment sample_li χ² image: {li:?}");
     assert!(li.passes(alpha) && li.dof > 400, "{li:?}");
-    let le = chi2_uv(&l, 2, |rng| l.sample_le(rng.next_2d(), rng.next_2d()).map(|s| -s.dir), |w| l.pdf_le(-w).1);
+    let le = chi2_uv(
+        &l,
+        2,
+        |rng| l.sample_le(rng.next_2d(), rng.next_2d()).map(|s| -s.dir),
+        |w| l.pdf_le(-w).1,
+    );
     eprintln!("environment sample_le dir χ² image: {le:?}");
     assert!(le.passes(alpha) && le.dof > 400, "{le:?}");
     // Its density has unit mass (exactly, in (u, v); and by the sphere quadrature, which the
     // 1/sin θ poles and texel edges limit to ~1e-4).
-    let mass: f64 = uv_bin_mass(&l, 32, 16, &|w| l.pdf_li(Vec3::ZERO, w)).iter().sum();
+    let mass: f64 = uv_bin_mass(&l, 32, 16, &|w| l.pdf_li(Vec3::ZERO, w))
+        .iter()
+        .sum();
     assert!((mass - 1.0).abs() < 1e-5, "{mass}");
     let sphere = integrate_sphere(Vec3::Y, |w| l.pdf_li(Vec3::ZERO, w));
     assert!((sphere - 1.0).abs() < 1e-3, "{sphere}");
@@ -167,10 +186,22 @@ fn sample_li_passes_chi2_against_pdf_li_and_a_wrong_pdf_fails() {
     // The constant environment, in solid-angle bins.
     let c = EnvironmentLight::constant(Vec3::ONE, scene());
     let bins = SphereBins::sphere(Vec3::Y, 24, 48);
-    let r = chi2_test(400_000, 7, &bins, |rng| c.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi), |w| c.pdf_li(Vec3::ZERO, w));
+    let r = chi2_test(
+        400_000,
+        7,
+        &bins,
+        |rng| c.sample_li(Vec3::ZERO, rng.next_2d()).map(|s| s.wi),
+        |w| c.pdf_li(Vec3::ZERO, w),
+    );
     eprintln!("environment sample_li χ² constant: {r:?}");
     assert!(r.passes(alpha) && r.rejected == 0 && r.dof > 500, "{r:?}");
-    let e = chi2_test(400_000, 8, &bins, |rng| c.sample_le(rng.next_2d(), rng.next_2d()).map(|s| s.dir), |w| c.pdf_le(w).1);
+    let e = chi2_test(
+        400_000,
+        8,
+        &bins,
+        |rng| c.sample_le(rng.next_2d(), rng.next_2d()).map(|s| s.dir),
+        |w| c.pdf_le(w).1,
+    );
     eprintln!("environment sample_le dir χ² constant: {e:?}");
     assert!(e.passes(alpha) && e.rejected == 0, "{e:?}");
 }
@@ -245,14 +276,19 @@ fn photon_flux_matches_the_power_estimate() {
 #[test]
 fn bad_maps_are_errors_and_black_maps_emit_nothing() {
     let e = EnvironmentLight::image(4, 2, vec![Vec3::ONE; 7], 0.0, scene()).unwrap_err();
-    assert_eq!(e.to_string(), "environment map: 4×2 needs 8 texels, found 7");
+    assert_eq!(
+        e.to_string(),
+        "environment map: 4×2 needs 8 texels, found 7"
+    );
     let mut t = vec![Vec3::ONE; 8];
     t[5] = Vec3::new(1.0, f32::NAN, 0.0);
     let e = EnvironmentLight::image(4, 2, t, 0.0, scene()).unwrap_err();
-    assert!(matches!(e, EnvironmentError::Texel { x: 1, y: 1, .. }), "{e}");
+    assert!(
+        matches!(e, EnvironmentError::Texel { x: 1, y: 1, .. }),
+        "{e}"
+    );
     let black = EnvironmentLight::image(4, 2, vec![Vec3::ZERO; 8], 0.0, scene()).unwrap();
     assert!(black.sample_li(Vec3::ZERO, (0.5, 0.5)).is_none());
     assert_eq!(black.pdf_li(Vec3::ZERO, Vec3::Y), 0.0);
     assert!(black.sample_le((0.5, 0.5), (0.5, 0.5)).is_none());
 }
-

@@ -50,16 +50,26 @@ fn irradiance_matches_lamberts_polygon_formula() {
     let cases = [
         (Vec3::ZERO, Vec3::Y, true),
         (Vec3::new(0.7, 1.2, 0.3), Vec3::Y, true),
-        (Vec3::new(-2.0, 0.5, 1.0), Vec3::new(0.3, 1.0, -0.2).normalize(), true),
+        (
+            Vec3::new(-2.0, 0.5, 1.0),
+            Vec3::new(0.3, 1.0, -0.2).normalize(),
+            true,
+        ),
         (Vec3::new(0.2, 1.95, 0.1), Vec3::Y, true),
-        (Vec3::new(30.0, -300.0, 20.0), Vec3::new(-0.1, 1.0, -0.05).normalize(), false),
+        (
+            Vec3::new(30.0, -300.0, 20.0),
+            Vec3::new(-0.1, 1.0, -0.05).normalize(),
+            false,
+        ),
     ];
     for (i, (p, n, spherical)) in cases.into_iter().enumerate() {
         assert_eq!(l.spherical(p).is_some(), spherical, "case {i}");
         let want = lambert_polygon_irradiance(p, n, &corners(&l), 1.0);
         let got = nee_irradiance(&l, p, n, 1024, i as u64);
         let rel = got / want - 1.0;
-        eprintln!("rect E case {i} (spherical {spherical}): NEE {got:.6e} Lambert {want:.6e} rel {rel:.2e}");
+        eprintln!(
+            "rect E case {i} (spherical {spherical}): NEE {got:.6e} Lambert {want:.6e} rel {rel:.2e}"
+        );
         assert!(rel.abs() < 1e-3, "case {i}: {got} vs {want}");
     }
 }
@@ -68,7 +78,11 @@ fn irradiance_matches_lamberts_polygon_formula() {
 fn spherical_samples_land_on_the_rectangle_with_the_density_pdf_li_reports() {
     let l = ceiling(true);
     let mut rng = Rng::new(1, 1);
-    for p in [Vec3::ZERO, Vec3::new(0.3, 2.5, 0.2), Vec3::new(3.0, 1.99, 0.0)] {
+    for p in [
+        Vec3::ZERO,
+        Vec3::new(0.3, 2.5, 0.2),
+        Vec3::new(3.0, 1.99, 0.0),
+    ] {
         let s = l.spherical(p).expect("spherical");
         for _ in 0..2000 {
             let smp = l.sample_li(p, rng.next_2d()).expect("lit");
@@ -108,7 +122,10 @@ fn one_sided_lights_are_dark_behind() {
     assert!(two.sample_li(above, (0.5, 0.5)).is_some());
     assert!(two.pdf_li(above, Vec3::NEG_Y) > 0.0);
     // In the plane: nothing.
-    assert!(two.sample_li(Vec3::new(5.0, 2.0, 0.0), (0.5, 0.5)).is_none());
+    assert!(
+        two.sample_li(Vec3::new(5.0, 2.0, 0.0), (0.5, 0.5))
+            .is_none()
+    );
     assert!(RectLight::new(Vec3::ZERO, Vec3::X, Vec3::X * 2.0, Vec3::ONE, false).is_none());
     assert!((l.power() - l.radiance * (PI * 2.0)).abs().max_element() < 1e-5);
     assert!((two.power() - l.power() * 2.0).abs().max_element() < 1e-5);
@@ -139,14 +156,16 @@ fn sample_li_passes_chi2_against_pdf_li_and_a_wrong_pdf_fails() {
         let sample = |rng: &mut Rng| l.sample_li(p, rng.next_2d()).map(|s| s.wi);
         let r = chi2_test(200_000, 10 + i as u64, &bins, sample, |w| l.pdf_li(p, w));
         eprintln!("rect sample_li χ² {label}: {r:?}");
-        assert!(r.passes(alpha) && r.rejected == 0 && r.dof > 100, "{label}: {r:?}");
+        assert!(
+            r.passes(alpha) && r.rejected == 0 && r.dof > 100,
+            "{label}: {r:?}"
+        );
     }
     // Sampling by solid angle but claiming the area density is detected.
     let p = Vec3::new(0.4, 1.3, -0.2);
     let area_pdf = |w: Vec3| {
-        rect.hit(p, w).map_or(0.0, |t| {
-            t * t / (rect.area * w.dot(rect.normal).abs())
-        })
+        rect.hit(p, w)
+            .map_or(0.0, |t| t * t / (rect.area * w.dot(rect.normal).abs()))
     };
     let (axis, extent) = cap_around(p, &corners(&rect));
     let bins = SphereBins::cap(axis, 16, 32, extent);
@@ -170,16 +189,30 @@ fn sample_le_passes_chi2_and_carries_the_power() {
             let (a, b) = (rng.next_2d(), rng.next_2d());
             l.sample_le(a, b)
         };
-        let dirs = chi2_test(200_000, 3, &bins, |rng| le(rng).map(|s| s.dir), |w| {
-            l.pdf_le(w).1
-        });
+        let dirs = chi2_test(
+            200_000,
+            3,
+            &bins,
+            |rng| le(rng).map(|s| s.dir),
+            |w| l.pdf_le(w).1,
+        );
         eprintln!("rect sample_le dir χ² two_sided={two_sided}: {dirs:?}");
         assert!(dirs.passes(0.005) && dirs.rejected == 0, "{dirs:?}");
         // The wrong claim: one-sided cosine for a two-sided light (or uniform for one-sided).
-        let wrong = chi2_test(200_000, 4, &bins, |rng| le(rng).map(|s| s.dir), |w| {
-            let c = w.dot(l.normal);
-            if two_sided { c.max(0.0) / PI } else { (c > 0.0) as u8 as f32 / (2.0 * PI) }
-        });
+        let wrong = chi2_test(
+            200_000,
+            4,
+            &bins,
+            |rng| le(rng).map(|s| s.dir),
+            |w| {
+                let c = w.dot(l.normal);
+                if two_sided {
+                    c.max(0.0) / PI
+                } else {
+                    (c > 0.0) as u8 as f32 / (2.0 * PI)
+                }
+            },
+        );
         assert!(wrong.p_value < 1e-6, "{wrong:?}");
         // Positions: uniform over an 8 × 8 grid of the parallelogram's (s, t); flux = Φ.
         let mut rng = Rng::new(5, 0);

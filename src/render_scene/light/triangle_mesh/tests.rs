@@ -15,7 +15,9 @@ fn fan(n: usize, r: f32, h: f32) -> MeshLight {
         let phi = std::f32::consts::TAU * k as f32 / n as f32;
         positions.push(Vec3::new(r * phi.cos(), h, r * phi.sin()));
     }
-    let triangles = (0..n as u32).map(|k| [0, 1 + k, 1 + (k + 1) % n as u32]).collect();
+    let triangles = (0..n as u32)
+        .map(|k| [0, 1 + k, 1 + (k + 1) % n as u32])
+        .collect();
     MeshLight::new(positions, triangles, Vec3::ONE, false).unwrap()
 }
 
@@ -85,9 +87,18 @@ fn sample_li_passes_chi2_against_pdf_li_and_a_wrong_pdf_fails() {
     for (i, (label, l, p)) in cases.iter().enumerate() {
         let (axis, extent) = cap_around(*p, &l.positions);
         let bins = SphereBins::cap(axis, 16, 32, extent);
-        let r = chi2_test(200_000, i as u64, &bins, |rng| l.sample_li(*p, rng.next_2d()).map(|s| s.light.wi), |w| l.pdf_li(*p, w));
+        let r = chi2_test(
+            200_000,
+            i as u64,
+            &bins,
+            |rng| l.sample_li(*p, rng.next_2d()).map(|s| s.light.wi),
+            |w| l.pdf_li(*p, w),
+        );
         eprintln!("mesh sample_li χ² {label}: {r:?}");
-        assert!(r.passes(alpha) && r.rejected == 0 && r.dof > 100, "{label}: {r:?}");
+        assert!(
+            r.passes(alpha) && r.rejected == 0 && r.dof > 100,
+            "{label}: {r:?}"
+        );
     }
     // Claiming each triangle is picked with probability ½ (not by area) is detected.
     let l = layered();
@@ -107,7 +118,13 @@ fn sample_li_passes_chi2_against_pdf_li_and_a_wrong_pdf_fails() {
     };
     let (axis, extent) = cap_around(p, &l.positions);
     let bins = SphereBins::cap(axis, 16, 32, extent);
-    let wrong = chi2_test(200_000, 7, &bins, |rng| l.sample_li(p, rng.next_2d()).map(|s| s.light.wi), wrong_pdf);
+    let wrong = chi2_test(
+        200_000,
+        7,
+        &bins,
+        |rng| l.sample_li(p, rng.next_2d()).map(|s| s.light.wi),
+        wrong_pdf,
+    );
     eprintln!("mesh sample_li χ² against an equal-pick pdf (must fail): {wrong:?}");
     assert!(wrong.p_value < 1e-6, "{wrong:?}");
 }
@@ -148,7 +165,16 @@ fn sample_le_is_uniform_by_area_cosine_in_direction_and_carries_the_power() {
         assert!((flux / f64::from(n) / f64::from(l.power().x) - 1.0).abs() < 1e-4);
         // Directions about the emitting side's normal are cosine-distributed.
         let bins = SphereBins::sphere(Vec3::Z, 16, 32);
-        let d = chi2_test(100_000, 3, &bins, |rng| l.sample_le(rng.next_2d(), rng.next_2d()).map(|s| local(s.normal, s.dir)), |w| w.z.max(0.0) / PI);
+        let d = chi2_test(
+            100_000,
+            3,
+            &bins,
+            |rng| {
+                l.sample_le(rng.next_2d(), rng.next_2d())
+                    .map(|s| local(s.normal, s.dir))
+            },
+            |w| w.z.max(0.0) / PI,
+        );
         assert!(d.passes(0.005), "{d:?}");
     }
 }
