@@ -12,8 +12,9 @@ Convention differences and how each scene neutralises them:
   quad         Mitsuba's `rectangle` + `area` emitter is one-sided along its +z normal, radiance
                L; caustic's one-sided quad emits along edge_u × edge_v with the same L. The
                mapping is common.rect_to_world (no difference left).
-  mesh         A triangle fan (32 triangles, a disc of radius 0.4 at y = 2.2 facing down) as a
-               Mitsuba `ply`-free mesh built with mi.Mesh; one-sided by winding in both.
+  mesh         A triangle fan (32 triangles, a disc of radius 0.4 at y = 2.2 facing down),
+               written as an OBJ under the temp folder and loaded with face normals; one-sided
+               by winding in both.
   spot         Mitsuba's `spot` falls off LINEARLY IN ANGLE from beam_width to cutoff_angle;
                caustic (pbrt-v4) uses smoothstep in COSINE between the outer and inner cones.
                The two agree inside the inner cone and outside the outer one, so the scene uses
@@ -78,19 +79,16 @@ def scene_quad(mi, spp, seed):
 
 def scene_mesh(mi, spp, seed):
     """An emissive triangle fan (a disc of radius 0.4 at y = 2.2, facing down, L = 10)."""
-    import numpy as np
+    import tempfile
     n, r, h = 32, 0.4, 2.2
-    verts = [[0, h, 0]] + [[r * math.cos(2 * math.pi * k / n), h, r * math.sin(2 * math.pi * k / n)] for k in range(n)]
-    faces = [[0, 1 + k, 1 + (k + 1) % n] for k in range(n)]  # winding normal −y, as caustic's
-    mesh = mi.Mesh("fan", vertex_count=len(verts), face_count=len(faces), has_vertex_normals=False)
-    params = mi.traverse(mesh)
-    params["vertex_positions"] = np.array(verts, dtype=np.float32).ravel()
-    params["faces"] = np.array(faces, dtype=np.uint32).ravel()
-    params.update()
-    mesh.set_bsdf(mi.load_dict(common.black()))
-    mesh.set_emitter(mi.load_dict({"type": "area", "radiance": {"type": "rgb", "value": [10, 10, 10]}}))
+    verts = [(0, h, 0)] + [(r * math.cos(2 * math.pi * k / n), h, r * math.sin(2 * math.pi * k / n)) for k in range(n)]
+    faces = [(1, 2 + k, 2 + (k + 1) % n) for k in range(n)]  # 1-based; winding normal −y, as caustic's
+    obj = Path(tempfile.gettempdir()) / "caustic_mitsuba_fan.obj"
+    obj.write_text("".join(f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in verts)
+                   + "".join(f"f {a} {b} {c}\n" for a, b, c in faces))
     d = base(mi, spp, seed)
-    d["fan"] = mesh
+    d["fan"] = {"type": "obj", "filename": str(obj), "face_normals": True, "bsdf": common.black(),
+                "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [10, 10, 10]}}}
     return d
 
 
