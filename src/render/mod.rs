@@ -1,5 +1,6 @@
 //! Rendering: the render job and its tile loop, the film and its mergeable sums, image output.
 
+pub mod exr;
 pub mod film;
 pub mod job;
 pub mod layers;
