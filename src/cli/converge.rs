@@ -173,7 +173,7 @@ fn measure(
     let params = &prepared.render_scene.params;
     if (params.width, params.height) != (reference.film.width, reference.film.height) {
         return Err(Error::Usage(format!(
-            "error: the reference `{}` is {}×{} but the scene renders {}×{}; give --width {} \
+            "the reference `{}` is {}×{} but the scene renders {}×{}; give --width {} \
              --height {} or a reference of the scene's size",
             reference.path.display(),
             reference.film.width,
@@ -204,7 +204,7 @@ fn measure(
         let film = job.snapshot();
         let c = reference
             .compare(&film, Path::new(&name), exposure, None)
-            .map_err(|e| Error::Usage(format!("error: {e}")))?;
+            .map_err(|e| Error::Usage(e.to_string()))?;
         points.push(Point {
             spp: target,
             seconds: render_time.as_secs_f64(),
@@ -268,13 +268,13 @@ fn csv(series: &[Series]) -> String {
 pub fn run(args: &ConvergeArgs) -> Result<(), Error> {
     if args.scene.integrator.is_some() {
         return Err(Error::Usage(
-            "error: converge measures the integrators of --integrators (e.g. `--integrators \
+            "converge measures the integrators of --integrators (e.g. `--integrators \
              path,whitted`); --integrator is for `render`"
                 .into(),
         ));
     }
     if args.threads == Some(0) {
-        return Err(Error::Usage("error: --threads must be at least 1".into()));
+        return Err(Error::Usage("--threads must be at least 1".into()));
     }
     // Each integrator once, in the order given.
     let mut integrators: Vec<IntegratorArg> = Vec::new();
@@ -285,7 +285,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), Error> {
     }
     std::fs::create_dir_all(&args.output).map_err(|e| {
         Error::Usage(format!(
-            "error: cannot create the output folder `{}`: {e}",
+            "cannot create the output folder `{}`: {e}",
             args.output.display()
         ))
     })?;
@@ -293,8 +293,8 @@ pub fn run(args: &ConvergeArgs) -> Result<(), Error> {
     for name in ["convergence.csv", "convergence.json", "convergence.png"] {
         caustic::render::output::check_writable(&path(name))?;
     }
-    let reference = Reference::read(&args.reference)
-        .map_err(|e| Error::Usage(format!("error: --reference: {e}")))?;
+    let reference =
+        Reference::read(&args.reference).map_err(|e| Error::Usage(format!("--reference: {e}")))?;
     let load_before = load_average();
     let share = args.time / u32::try_from(integrators.len()).unwrap_or(u32::MAX).max(1);
     let show = !args.quiet && std::io::stderr().is_terminal();

@@ -102,7 +102,7 @@ pub fn run(args: &FarmArgs) -> Result<(), Error> {
 }
 
 fn usage(text: String) -> Error {
-    Error::Usage(format!("error: {text}"))
+    Error::Usage(text)
 }
 
 fn io(path: &Path, e: &std::io::Error) -> Error {

@@ -11,7 +11,7 @@ use caustic::render::{Film, Region};
 
 /// Reads the reference of `--compare`, if given.
 pub fn load(path: Option<&Path>) -> Result<Option<Reference>, Error> {
-    path.map(|p| Reference::read(p).map_err(|e| Error::Usage(format!("error: --compare: {e}"))))
+    path.map(|p| Reference::read(p).map_err(|e| Error::Usage(format!("--compare: {e}"))))
         .transpose()
 }
 
@@ -31,7 +31,7 @@ pub fn check_size(
         format!(" or the {}×{} of --region", r.width, r.height)
     });
     Err(Error::Usage(format!(
-        "error: --compare: the reference `{}` is {}×{} but the image is {width}×{height}{crop}; \
+        "--compare: the reference `{}` is {}×{} but the image is {width}×{height}{crop}; \
          give --width/--height to match it",
         reference.path.display(),
         size.0,
@@ -51,7 +51,7 @@ pub fn check(
 ) -> Result<(), Error> {
     let c = reference
         .compare(film, output, exposure, region)
-        .map_err(|e| Error::Usage(format!("error: --compare: {e}")))?;
+        .map_err(|e| Error::Usage(format!("--compare: {e}")))?;
     if let Some(note) = &c.note {
         eprintln!("{note}");
     }
@@ -74,7 +74,7 @@ pub fn check(
     );
     match max_rmse {
         Some(max) if fails => Err(Error::Mismatch(format!(
-            "error: `{}` is further from the reference `{}` than allowed: RMSE {:.6} > \
+            "`{}` is further from the reference `{}` than allowed: RMSE {:.6} > \
              --max-rmse {max} (the image was written; exit code 3)",
             output.display(),
             reference.path.display(),

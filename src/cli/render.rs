@@ -173,7 +173,7 @@ pub(super) fn parse_region(text: &str) -> Result<Region, Error> {
             height: *h,
         }),
         _ => Err(Error::Usage(format!(
-            "error: --region `{text}`: expected four non-negative integers X,Y,W,H, e.g. `--region 64,64,128,128`"
+            "--region `{text}`: expected four non-negative integers X,Y,W,H, e.g. `--region 64,64,128,128`"
         ))),
     }
 }
@@ -252,7 +252,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if !is_part(&output) {
         if args.shard.is_some() {
             return Err(Error::Usage(format!(
-                "error: --shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
+                "--shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
                 output.display()
             )));
         }
@@ -261,7 +261,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if !args.layers.is_empty() && !matches!(OutputFormat::for_path(&output), Ok(OutputFormat::Exr))
     {
         return Err(Error::Usage(format!(
-            "error: --layers are written into an EXR file: the output `{}` must end in `.exr`",
+            "--layers are written into an EXR file: the output `{}` must end in `.exr`",
             output.display()
         )));
     }
@@ -270,17 +270,17 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         .as_deref()
         .map(Shard::parse)
         .transpose()
-        .map_err(|e| Error::Usage(format!("error: {e}")))?;
+        .map_err(|e| Error::Usage(e.to_string()))?;
     if let Some(cp) = &args.checkpoint {
         if OutputFormat::for_path(cp).is_err() {
             return Err(Error::Usage(format!(
-                "error: --checkpoint `{}`: the checkpoint must end in `.png` or `.exr`",
+                "--checkpoint `{}`: the checkpoint must end in `.png` or `.exr`",
                 cp.display()
             )));
         }
         if same_file(cp, &output) {
             return Err(Error::Usage(format!(
-                "error: --checkpoint `{}` is the output file; give it a name of its own",
+                "--checkpoint `{}` is the output file; give it a name of its own",
                 cp.display()
             )));
         }
@@ -292,7 +292,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let region = args.region.as_deref().map(parse_region).transpose()?;
     let reference = super::golden::load(args.compare.as_deref())?;
     if args.threads == Some(0) {
-        return Err(Error::Usage("error: --threads must be at least 1".into()));
+        return Err(Error::Usage("--threads must be at least 1".into()));
     }
     let mut overrides = args.scene.overrides();
     if args.time.is_some() && overrides.samples_per_pixel.is_none() {
@@ -314,7 +314,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let samples = match &args.samples {
         Some(r) if r.end > spp => {
             return Err(Error::Usage(format!(
-                "error: --samples {}..{}: the render has {spp} samples per pixel, so END must be at most {spp}",
+                "--samples {}..{}: the render has {spp} samples per pixel, so END must be at most {spp}",
                 r.start, r.end
             )));
         }
@@ -322,7 +322,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         None => shard
             .map(|s| s.samples(spp))
             .transpose()
-            .map_err(|e| Error::Usage(format!("error: {e}")))?,
+            .map_err(|e| Error::Usage(e.to_string()))?,
     };
     let first_sample = samples.as_ref().map_or(0, |r| r.start);
     let hash = is_part(&output).then(|| settings_hash(&prepared.render_scene));

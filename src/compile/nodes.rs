@@ -124,9 +124,9 @@ impl Flattener<'_> {
                             self.mesh(&xf, &mesh, *smooth, |_| object);
                         }
                     }
-                    Err(msg) => self
+                    Err(e) => self
                         .errors
-                        .push(Diagnostic::error(format!("{path}.file"), msg)),
+                        .push(Diagnostic::error(format!("{path}.file"), e.to_string())),
                 }
             }
         }
