@@ -6,6 +6,7 @@ pub mod path;
 pub mod photon;
 pub mod progressive;
 pub mod shadow;
+pub mod splat;
 pub mod trace_log;
 pub mod whitted;
 
