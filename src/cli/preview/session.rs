@@ -71,8 +71,6 @@ impl Session<'_> {
             let mut s = self.shared.status();
             s.generation += 1;
             s.phase = Phase::Loading;
-            s.started = Instant::now();
-            s.stopped = None;
         }
         let prepared = match prepare(&self.settings.scene, &self.settings.overrides) {
             Ok(p) => p,
@@ -125,7 +123,9 @@ impl Session<'_> {
             let mut s = self.shared.status();
             s.phase = Phase::Failed;
             s.error = Some(text);
-            s.stopped = Some(s.started.elapsed());
+            // The figures stay those of the image shown (the last good one).
+            let elapsed = s.started.elapsed();
+            s.stopped.get_or_insert(elapsed);
         }
         self.watch_files();
         loop {
@@ -176,6 +176,8 @@ impl Session<'_> {
         let region = self.settings.region;
         let mut s = self.shared.status();
         s.phase = Phase::Photons;
+        s.started = Instant::now();
+        s.stopped = None;
         s.preparing = if traces {
             let ph = &prepared.scene.photons;
             format!(

@@ -127,7 +127,6 @@ mod tests {
             textures: {
                 "wood": Bitmap(file: "tex/wood.png"),
                 "bumps": HeightMap(file: "tex/h.png", depth: 0.01),
-                "veins": Marble(),
             },
             materials: { "m": (color: (0.5, 0.5, 0.5)) },
             nodes: [
