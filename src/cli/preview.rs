@@ -25,9 +25,7 @@ use caustic::render::metrics::Reference;
 use caustic::render::output::OutputFormat;
 use caustic::render::{Layer, Region, Shard};
 
-use super::render::{
-    BUDGET_SPP_CAP, RenderArgs, default_output, is_part, parse_region, same_file,
-};
+use super::render::{BUDGET_SPP_CAP, RenderArgs, default_output, is_part, parse_region, same_file};
 use state::{Msg, Shared};
 
 /// Arguments of `caustic preview`: those of `render`, and the port.
@@ -102,8 +100,7 @@ impl Settings {
         }
         let mut layers: Vec<Layer> = args.layers.iter().flatten().copied().collect();
         layers.dedup();
-        if !layers.is_empty() && !matches!(OutputFormat::for_path(&output), Ok(OutputFormat::Exr))
-        {
+        if !layers.is_empty() && !matches!(OutputFormat::for_path(&output), Ok(OutputFormat::Exr)) {
             return Err(usage(format!(
                 "--layers are written into an EXR file: the output `{}` must end in `.exr`",
                 output.display()
@@ -180,10 +177,7 @@ impl Settings {
                 r.start, r.end
             )),
             (Some(r), _) => Ok(Some(r.clone())),
-            (None, Some(s)) => s
-                .samples(spp)
-                .map(Some)
-                .map_err(|e| format!("error: {e}")),
+            (None, Some(s)) => s.samples(spp).map(Some).map_err(|e| format!("error: {e}")),
             (None, None) => Ok(None),
         }
     }
@@ -214,7 +208,10 @@ pub fn run(args: &PreviewArgs) -> Result<(), Error> {
         let _ = tx.send(Msg::Changed);
     })
     .map_err(|e| Error::Usage(format!("error: cannot watch files for changes: {e}")))?;
-    println!("preview of `{}` at http://127.0.0.1:{port}/ (Ctrl-C to stop)", settings.scene.display());
+    println!(
+        "preview of `{}` at http://127.0.0.1:{port}/ (Ctrl-C to stop)",
+        settings.scene.display()
+    );
     let render_shared = Arc::clone(&shared);
     let settings = &settings;
     std::thread::scope(|scope| {

@@ -43,7 +43,10 @@ fn wait_for<T>(what: &str, limit: Duration, mut f: impl FnMut() -> Option<T>) ->
         if let Some(v) = f() {
             return v;
         }
-        assert!(start.elapsed() < limit, "timed out after {limit:?} waiting for {what}");
+        assert!(
+            start.elapsed() < limit,
+            "timed out after {limit:?} waiting for {what}"
+        );
         std::thread::sleep(Duration::from_millis(50));
     }
 }
@@ -273,7 +276,10 @@ impl Preview {
             if let Some(s) = self.child.try_wait().expect("wait") {
                 break s;
             }
-            assert!(start.elapsed() < Duration::from_secs(10), "no exit after SIGINT");
+            assert!(
+                start.elapsed() < Duration::from_secs(10),
+                "no exit after SIGINT"
+            );
             std::thread::sleep(Duration::from_millis(20));
         };
         let mut err = String::new();
@@ -303,7 +309,10 @@ fn render(scene: &Path, flags: &[&str], out: &Path) -> (bool, String) {
         .current_dir(scene.parent().expect("scene folder"))
         .output()
         .expect("caustic render runs");
-    (o.status.success(), String::from_utf8_lossy(&o.stderr).into_owned())
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
 }
 
 /// The RGB bytes of a PNG.
@@ -324,7 +333,16 @@ fn temporaries(dir: &Path) -> Vec<PathBuf> {
 }
 
 /// Small and slow enough to see several passes on one thread.
-const FLAGS: &[&str] = &["--width", "64", "--height", "48", "--spp", "256", "--threads", "1"];
+const FLAGS: &[&str] = &[
+    "--width",
+    "64",
+    "--height",
+    "48",
+    "--spp",
+    "256",
+    "--threads",
+    "1",
+];
 
 #[test]
 fn the_preview_page_refines_follows_edits_shows_diagnostics_and_saves() {
@@ -340,7 +358,8 @@ fn the_preview_page_refines_follows_edits_shows_diagnostics_and_saves() {
     };
     let dir = tempfile::tempdir().expect("tmp");
     let scene = dir.path().join("scene.ron");
-    let original = std::fs::read_to_string(common::root().join("scenes/cornell.ron")).expect("cornell");
+    let original =
+        std::fs::read_to_string(common::root().join("scenes/cornell.ron")).expect("cornell");
     std::fs::write(&scene, &original).expect("write scene");
     let out = dir.path().join("out.png");
     let mut flags = FLAGS.to_vec();
@@ -368,12 +387,19 @@ fn the_preview_page_refines_follows_edits_shows_diagnostics_and_saves() {
     });
     let reference = dir.path().join("ref.png");
     assert!(render(&scene, FLAGS, &reference).0);
-    assert_eq!(done.rgb, png_rgb(&reference), "the page's image is the render's");
+    assert_eq!(
+        done.rgb,
+        png_rgb(&reference),
+        "the page's image is the render's"
+    );
     let noise = browser.text("#noise");
     assert!(noise.ends_with('%'), "noise figure {noise:?}");
 
     // An edit restarts the render: the red wall turns blue.
-    let edited = original.replace("\"red\": (color: (0.70, 0.12, 0.10))", "\"red\": (color: (0.10, 0.12, 0.70))");
+    let edited = original.replace(
+        "\"red\": (color: (0.70, 0.12, 0.10))",
+        "\"red\": (color: (0.10, 0.12, 0.70))",
+    );
     assert_ne!(edited, original, "the edit applies");
     std::fs::write(&scene, &edited).expect("edit");
     let restarted = wait_for("the edited scene's image", long, || {
@@ -381,7 +407,10 @@ fn the_preview_page_refines_follows_edits_shows_diagnostics_and_saves() {
     });
     assert!(render(&scene, FLAGS, &reference).0);
     let edited_pixels = png_rgb(&reference);
-    assert_eq!(restarted.rgb, edited_pixels, "the page shows the edited scene");
+    assert_eq!(
+        restarted.rgb, edited_pixels,
+        "the page shows the edited scene"
+    );
     assert_ne!(restarted.rgb, done.rgb);
 
     // A broken edit shows the command line's diagnostic and keeps the last image.
@@ -392,11 +421,19 @@ fn the_preview_page_refines_follows_edits_shows_diagnostics_and_saves() {
     });
     let (ok, cli) = render(&scene, FLAGS, &reference);
     assert!(!ok);
-    assert_eq!(diagnostic.trim_end(), cli.trim_end(), "the CLI's diagnostic, as is");
+    assert_eq!(
+        diagnostic.trim_end(),
+        cli.trim_end(),
+        "the CLI's diagnostic, as is"
+    );
     assert!(diagnostic.contains("scene.ron:"), "{diagnostic}");
     assert!(diagnostic.contains('^'), "{diagnostic}");
     assert!(diagnostic.contains("radius"), "did you mean: {diagnostic}");
-    assert_eq!(browser.canvas().rgb, edited_pixels, "the last good image stays");
+    assert_eq!(
+        browser.canvas().rgb,
+        edited_pixels,
+        "the last good image stays"
+    );
 
     // The fix clears it and the render resumes.
     std::fs::write(&scene, &edited).expect("fix");
@@ -478,13 +515,17 @@ fn the_preview_restarts_when_an_asset_changes_and_stops_cleanly_on_ctrl_c() {
         (s["phase"] == "done").then(|| s["generation"].as_u64().unwrap_or(0))
     };
     let g1 = wait_for("the first render", limit, || done(&preview));
-    let red = image::load_from_memory(&preview.get("/image.png")).expect("png").to_rgb8();
+    let red = image::load_from_memory(&preview.get("/image.png"))
+        .expect("png")
+        .to_rgb8();
     // The texture turns green: the render restarts and the image follows.
     textured_scene(dir.path(), [30, 200, 30]);
     let g2 = wait_for("the restart after the texture", limit, || {
         done(&preview).filter(|g| *g > g1)
     });
-    let green = image::load_from_memory(&preview.get("/image.png")).expect("png").to_rgb8();
+    let green = image::load_from_memory(&preview.get("/image.png"))
+        .expect("png")
+        .to_rgb8();
     let mean = |img: &image::RgbImage, c: usize| {
         img.pixels().map(|p| f64::from(p.0[c])).sum::<f64>() / f64::from(img.width() * img.height())
     };
@@ -492,12 +533,19 @@ fn the_preview_restarts_when_an_asset_changes_and_stops_cleanly_on_ctrl_c() {
     assert!(mean(&green, 1) > mean(&green, 0), "green texture");
     // The mesh changes (a bigger triangle): another restart, within a second of the write.
     let written = Instant::now();
-    std::fs::write(dir.path().join("tri.obj"), "v -2 -2 0\nv 2 -2 0\nv 0 2 0\nf 1 2 3\n")
-        .expect("mesh");
+    std::fs::write(
+        dir.path().join("tri.obj"),
+        "v -2 -2 0\nv 2 -2 0\nv 0 2 0\nf 1 2 3\n",
+    )
+    .expect("mesh");
     wait_for("the restart after the mesh", limit, || {
         (preview.status()["generation"].as_u64().unwrap_or(0) > g2).then_some(())
     });
-    assert!(written.elapsed() < Duration::from_secs(5), "restart took {:?}", written.elapsed());
+    assert!(
+        written.elapsed() < Duration::from_secs(5),
+        "restart took {:?}",
+        written.elapsed()
+    );
     // An unknown path is not found; Ctrl-C ends the server with exit code 130 and leaves no
     // temporary file.
     assert_eq!(preview.get("/nope"), b"not found");

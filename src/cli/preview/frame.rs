@@ -176,7 +176,10 @@ mod tests {
         let sq: f64 = (a.film.pixels.iter().zip(&b.film.pixels))
             .map(|(x, y)| (*x - *y).as_dvec3().length_squared())
             .sum();
-        (predicted, (sq / (3.0 * a.film.pixels.len() as f64) / 2.0).sqrt())
+        (
+            predicted,
+            (sq / (3.0 * a.film.pixels.len() as f64) / 2.0).sqrt(),
+        )
     }
 
     #[test]
@@ -187,11 +190,17 @@ mod tests {
         // samples the two agree.
         let (predicted, measured) = predicted_and_measured("Independent");
         let ratio = predicted / measured;
-        assert!((0.85..1.18).contains(&ratio), "predicted {predicted}, measured {measured}");
+        assert!(
+            (0.85..1.18).contains(&ratio),
+            "predicted {predicted}, measured {measured}"
+        );
         // Owen-scrambled Sobol points are not independent: their mean converges faster than
         // the sample variance says, so the figure is an upper estimate there (docs/preview.md).
         let (predicted, measured) = predicted_and_measured("Sobol");
-        assert!(predicted > measured, "predicted {predicted}, measured {measured}");
+        assert!(
+            predicted > measured,
+            "predicted {predicted}, measured {measured}"
+        );
     }
 
     #[test]

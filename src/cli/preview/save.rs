@@ -33,7 +33,7 @@ pub fn save(
     let written = if s.part {
         let meta = PartMeta {
             hash: settings_hash(&prepared.render_scene),
-            samples: vec![first..end],
+            samples: std::iter::once(first..end).collect(),
             spp: p.samples_per_pixel,
             width: p.width,
             height: p.height,

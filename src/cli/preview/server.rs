@@ -91,9 +91,15 @@ pub fn handle(request: Request, shared: &Arc<Shared>, to_render: &Sender<Msg>) {
 /// sRGB-encoded as `render` writes PNGs.
 fn image(request: Request, url: &str, shared: &Shared) {
     let Some(frame) = shared.frame() else {
-        return text(request, 503, "no image yet: the first pass has not finished");
+        return text(
+            request,
+            503,
+            "no image yet: the first pass has not finished",
+        );
     };
-    let view = query(url, "layer").and_then(View::parse).unwrap_or(View::Beauty);
+    let view = query(url, "layer")
+        .and_then(View::parse)
+        .unwrap_or(View::Beauty);
     let exposure = query(url, "exposure")
         .and_then(|e| e.parse::<f32>().ok())
         .filter(|e| e.is_finite() && *e >= 0.0)
@@ -105,7 +111,10 @@ fn image(request: Request, url: &str, shared: &Shared) {
                 .with_header(header("Content-Type", "image/png"))
                 .with_header(header("Cache-Control", "no-store"))
                 .with_header(header("X-Caustic-Spp", &frame.spp.to_string()))
-                .with_header(header("X-Caustic-Generation", &frame.generation.to_string()));
+                .with_header(header(
+                    "X-Caustic-Generation",
+                    &frame.generation.to_string(),
+                ));
             let _ = request.respond(response);
         }
         Err(e) => text(request, 500, &format!("cannot encode the image: {e}")),

@@ -154,7 +154,7 @@ impl Session<'_> {
                 Ok(Msg::Pause(p)) => self.pause(p),
                 Ok(Msg::Save(reply)) => {
                     let _ = reply.send(Err(
-                        "not saved: the scene changed and its render restarts".into(),
+                        "not saved: the scene changed and its render restarts".into()
                     ));
                 }
             }

@@ -135,16 +135,19 @@ mod tests {
                 Sphere(material: "m", center: (0, 0, 0), radius: 1),
             ],
         )"#;
-        let source = caustic::scene::SourceFile::new(Path::new("/s/x.ron"), text.into())
-            .expect("source");
+        let source =
+            caustic::scene::SourceFile::new(Path::new("/s/x.ron"), text.into()).expect("source");
         let scene = source.parse().expect("parses");
-        let got: Vec<PathBuf> = asset_files(&scene, Path::new("/s"))
-            .into_iter()
-            .collect();
-        let want: Vec<PathBuf> = ["/s/a.obj", "/s/deep/b.obj", "/s/tex/h.png", "/s/tex/wood.png"]
-            .iter()
-            .map(PathBuf::from)
-            .collect();
+        let got: Vec<PathBuf> = asset_files(&scene, Path::new("/s")).into_iter().collect();
+        let want: Vec<PathBuf> = [
+            "/s/a.obj",
+            "/s/deep/b.obj",
+            "/s/tex/h.png",
+            "/s/tex/wood.png",
+        ]
+        .iter()
+        .map(PathBuf::from)
+        .collect();
         assert_eq!(got, want);
     }
 }
