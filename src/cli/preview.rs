@@ -26,7 +26,7 @@ use caustic::render::output::OutputFormat;
 use caustic::render::{Layer, Region, Shard};
 
 use super::render::{BUDGET_SPP_CAP, RenderArgs, default_output, is_part, parse_region, same_file};
-use state::{Msg, Shared};
+use state::{Msg, Phase, Shared};
 
 /// Arguments of `caustic preview`: those of `render`, and the port.
 #[derive(Args)]
@@ -213,23 +213,29 @@ pub fn run(args: &PreviewArgs) -> Result<(), Error> {
         settings.scene.display()
     );
     let render_shared = Arc::clone(&shared);
-    let settings = &settings;
-    std::thread::scope(|scope| {
-        let renderer = scope.spawn(move || {
-            session::run(settings, &render_shared, &from_server, &mut watch);
-        });
-        while !shared.quit.load(Ordering::SeqCst) && !renderer.is_finished() {
-            match server.recv_timeout(Duration::from_millis(100)) {
-                Ok(Some(request)) => server::handle(request, &shared, &to_render),
-                Ok(None) => {}
-                Err(e) => eprintln!("warning: the preview's server: {e}"),
-            }
-        }
-        // Ctrl-C: stop the pass in progress and let the render thread end (a save under way
-        // finishes first, so no temporary file is left).
-        shared.cancel_render();
-        let _ = to_render.send(Msg::Quit);
+    let renderer = std::thread::spawn(move || {
+        session::run(&settings, &render_shared, &from_server, &mut watch);
     });
+    while !shared.quit.load(Ordering::SeqCst) && !renderer.is_finished() {
+        match server.recv_timeout(Duration::from_millis(100)) {
+            Ok(Some(request)) => server::handle(request, &shared, &to_render),
+            Ok(None) => {}
+            Err(e) => eprintln!("warning: the preview's server: {e}"),
+        }
+    }
+    // Ctrl-C: stop the pass in progress and let the render thread end: a save or checkpoint
+    // under way finishes first, so no temporary file is left. While the scene loads or photons
+    // are traced nothing is being written, and that work does not look at the cancel flag:
+    // then the process ends without waiting for it.
+    shared.cancel_render();
+    let _ = to_render.send(Msg::Quit);
+    while !renderer.is_finished() {
+        if matches!(shared.status().phase, Phase::Loading | Phase::Photons) {
+            return Err(Error::Interrupted("interrupted: preview stopped".into()));
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let _ = renderer.join();
     Err(Error::Interrupted("interrupted: preview stopped".into()))
 }
 
