@@ -12,6 +12,7 @@ mod photons;
 mod pixel_font;
 mod plot;
 mod plot_backend;
+mod preview;
 mod render;
 
 use std::path::PathBuf;
@@ -62,6 +63,9 @@ enum Command {
     /// Render on a Slurm cluster: `farm plan` writes a job folder, `sbatch DIR/render.sbatch`
     /// runs it, `farm status DIR` reports progress (docs/farm.md).
     Farm(farm::FarmArgs),
+    /// Serve a live preview on 127.0.0.1: the render refining pass by pass, restarted whenever
+    /// the scene or an asset it uses changes; takes every `render` flag (docs/preview.md).
+    Preview(preview::PreviewArgs),
 }
 
 /// Runs one command.
@@ -79,6 +83,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Photons(args) => photons::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::Farm(args) => farm::run(&args),
+        Command::Preview(args) => preview::run(&args),
     }
 }
 

@@ -21,50 +21,50 @@ use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, writ
 use super::{SceneArgs, count, print_warnings};
 
 /// Samples per pixel a `--time` render may reach when `--spp` is not given.
-const BUDGET_SPP_CAP: u32 = 1 << 20;
+pub(super) const BUDGET_SPP_CAP: u32 = 1 << 20;
 
 /// Arguments of `caustic render`.
 #[derive(Args)]
 pub struct RenderArgs {
     #[command(flatten)]
-    scene: SceneArgs,
+    pub(super) scene: SceneArgs,
     /// Output image (.png, .exr, or .part for the mergeable film of per-pixel sums); default:
     /// the scene's name with .png in the current directory.
     #[arg(short, long)]
-    output: Option<PathBuf>,
+    pub(super) output: Option<PathBuf>,
     /// Worker threads (default: all cores).
     #[arg(long)]
-    threads: Option<usize>,
+    pub(super) threads: Option<usize>,
     /// Render only the crop X,Y,W,H (pixels from the top-left); its pixels equal the full render's.
     #[arg(long, value_name = "X,Y,W,H")]
-    region: Option<String>,
+    pub(super) region: Option<String>,
     /// No progress bar and no warnings.
     #[arg(short, long)]
-    quiet: bool,
+    pub(super) quiet: bool,
     /// Print scene and BVH statistics.
     #[arg(long)]
-    stats: bool,
+    pub(super) stats: bool,
     /// Render for this long (e.g. `30s`, `2m`, `1.5h`, or seconds), in passes of samples per
     /// pixel, then write the image; the summary says how many samples per pixel it reached.
     /// `--spp`, if given, still caps the samples.
     #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
-    time: Option<Duration>,
+    pub(super) time: Option<Duration>,
     /// Render in passes of samples per pixel and save the image so far to FILE (.png or .exr,
     /// not the output) after a pass once `--checkpoint-every` seconds have passed since the last
     /// save. Ctrl-C
     /// leaves the last complete checkpoint there; it is removed once the final image is written.
     /// The final image is the same, bit for bit, as without checkpoints.
     #[arg(long, value_name = "FILE")]
-    checkpoint: Option<PathBuf>,
+    pub(super) checkpoint: Option<PathBuf>,
     /// After writing the image, compare it with this reference (PNG or EXR; for a `--region`
     /// render the reference may be the whole image or the crop) and print RMSE, relMSE, mean
     /// absolute error and bias.
     #[arg(long, value_name = "REF")]
-    compare: Option<PathBuf>,
+    pub(super) compare: Option<PathBuf>,
     /// With `--compare`: a golden-image check: exit with code 3 (the image is still written)
     /// when the RMSE against the reference is above this.
     #[arg(long, value_name = "RMSE", requires = "compare", value_parser = parse_max_rmse)]
-    max_rmse: Option<f64>,
+    pub(super) max_rmse: Option<f64>,
     /// Time between checkpoints: seconds, or with a unit (`90s`, `5m`); 0: after every pass.
     #[arg(
         long,
@@ -73,28 +73,28 @@ pub struct RenderArgs {
         requires = "checkpoint",
         value_parser = parse_seconds
     )]
-    checkpoint_every: Duration,
+    pub(super) checkpoint_every: Duration,
     /// Keep the photon maps in this folder and reuse them while only the camera, the image
     /// size or the samples change (photon integrator; a corrupt file is rebuilt).
     #[arg(long, value_name = "DIR")]
-    photon_cache: Option<PathBuf>,
+    pub(super) photon_cache: Option<PathBuf>,
     /// Render only shard I of N (numbered from 1): the sample indices ⌊(I−1)·S/N⌋ to
     /// ⌊I·S/N⌋ − 1 of every pixel (S: samples per pixel), into the mergeable film (the output
     /// must end in `.part`). `caustic merge` joins the shards into the image of one render.
     #[arg(long, value_name = "I/N", conflicts_with = "compare")]
-    shard: Option<String>,
+    pub(super) shard: Option<String>,
     /// Render only the sample indices START to END − 1 of every pixel (of the render's
     /// samples per pixel): with a `.part` output, a shard of your own choosing; as an image,
     /// what merging such parts gives.
     #[arg(long, value_name = "START..END", conflicts_with_all = ["compare", "shard"], value_parser = parse_samples)]
-    samples: Option<Range<u32>>,
+    pub(super) samples: Option<Range<u32>>,
     /// Also write these layers into the `.exr` output beside the image, comma-separated:
     /// specular (emitters and background seen directly or through mirrors and glass), direct
     /// (light after one diffuse or glossy bounce), caustic (light through mirrors or glass onto
     /// a diffuse surface), indirect (two or more bounces), variance (of each pixel's mean),
     /// samples (per pixel); `all` for every one. The four light kinds add up to the image.
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_layers)]
-    layers: Vec<Vec<Layer>>,
+    pub(super) layers: Vec<Vec<Layer>>,
 }
 
 fn parse_layers(text: &str) -> Result<Vec<Layer>, String> {
@@ -178,7 +178,7 @@ pub(super) fn parse_region(text: &str) -> Result<Region, Error> {
     }
 }
 
-fn default_output(scene: &Path) -> PathBuf {
+pub(super) fn default_output(scene: &Path) -> PathBuf {
     let stem = scene
         .file_stem()
         .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
@@ -234,7 +234,7 @@ impl Interrupt {
 
 /// Whether two paths name the same file (lexically after making them absolute, or the same
 /// existing file).
-fn same_file(a: &Path, b: &Path) -> bool {
+pub(super) fn same_file(a: &Path, b: &Path) -> bool {
     if let (Ok(x), Ok(y)) = (a.canonicalize(), b.canonicalize()) {
         return x == y;
     }
@@ -465,7 +465,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     Ok(())
 }
 
-fn print_stats(s: &caustic::compile::CompileStats) {
+pub(super) fn print_stats(s: &caustic::compile::CompileStats) {
     eprintln!(
         "scene: {} ({} dropped), {}, {}, {}, {}, {}",
         count(s.triangles, "triangle"),

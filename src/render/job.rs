@@ -225,6 +225,19 @@ impl<'a> RenderJob<'a> {
         &self.sums
     }
 
+    /// The per-kind-of-light-path statistics so far, in `LightPath::ALL` order, when the job
+    /// keeps them ([`RenderOptions::light_paths`]).
+    #[must_use]
+    pub fn parts(&self) -> Option<&[PixelSums]> {
+        self.parts.as_deref()
+    }
+
+    /// Rays traced so far (by complete passes), for a live rays-per-second figure.
+    #[must_use]
+    pub fn rays_traced(&self) -> u64 {
+        self.stats.rays
+    }
+
     /// Renders every sample of another `region` of the same image with this job's prepared
     /// integrator (its photon maps are built once, by [`RenderJob::new`]) and returns that
     /// region's output; the job can then render further regions. For tools that render many

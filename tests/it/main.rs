@@ -23,6 +23,7 @@ mod passes;
 mod path_tracer;
 mod photon_map;
 mod photon_tools;
+mod preview;
 mod primitives;
 mod progressive;
 mod queries;
