@@ -32,6 +32,7 @@ pub mod render;
 pub mod render_scene;
 pub mod sampling;
 pub mod scene;
+pub mod settings;
 pub mod shading;
 pub mod texture;
 
