@@ -291,7 +291,10 @@ mod tests {
         let e = ron::from_str::<Holder>("(integrator: Pathh)").unwrap_err();
         assert!(e.to_string().contains("Pathh"), "{e}");
         let e = ron::from_str::<Holder>("(integrator: 3)").unwrap_err();
-        assert!(e.to_string().contains("an integrator: one of `Whitted`"), "{e}");
+        assert!(
+            e.to_string().contains("an integrator: one of `Whitted`"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -12,9 +12,9 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use crate::accel::BvhStats;
+use crate::render_scene::PhotonParams;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::render_scene::{Camera, Light, ObjectInfo, RenderParams, RenderScene};
-use crate::render_scene::PhotonParams;
 use crate::scene::Diagnostic;
 use crate::scene::schema::{self, CameraSpec, LightSpec, SceneFile};
 

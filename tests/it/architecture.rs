@@ -151,7 +151,11 @@ fn lower_layers_do_not_import_upper_ones() {
             continue;
         }
         // The bottom layer may not use itself as an excuse to import anything.
-        let every_layer: &[&str] = if EVERY_LAYER.contains(&me) { &[] } else { EVERY_LAYER };
+        let every_layer: &[&str] = if EVERY_LAYER.contains(&me) {
+            &[]
+        } else {
+            EVERY_LAYER
+        };
         assert!(!files.is_empty(), "{dir} has no sources");
         for file in files {
             let text = std::fs::read_to_string(&file).expect("read");
