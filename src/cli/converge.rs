@@ -192,7 +192,7 @@ fn measure(
     let mut job = RenderJob::new(&prepared.render_scene, &options)?;
     let prepare_seconds = t.elapsed().as_secs_f64();
     let name = integrator.cli_name();
-    let bar = progress_bar(show, &name, share);
+    let bar = progress_bar(show, name, share);
     let cap = job.samples_per_pixel();
     let mut points = Vec::new();
     let mut render_time = Duration::ZERO;
