@@ -137,6 +137,12 @@ fn override_record(o: &SceneOverrides) -> Vec<String> {
             out.push(format!("{path}={v}"));
         }
     }
+    if let Some(i) = o.integrator {
+        out.push(format!("render.integrator={}", i.name()));
+    }
+    if let Some(s) = o.sampler {
+        out.push(format!("render.sampler={}", s.name()));
+    }
     out
 }
 
