@@ -4,7 +4,7 @@
 //!
 //! **Contract.** A splat `add(x, y, v)` is a radiance contribution (W sr⁻¹ m⁻², linear RGB) of
 //! one camera sample — whichever pixel that sample was taken for — to pixel `(x, y)`. When the
-//! buffer is merged into the film ([`crate::render::PixelSums::add_splats`]), the splats are
+//! buffer is merged into the film (`PixelSums::add_splats`, in the renderer), the splats are
 //! added to the pixel's sum of samples and, like the film's own samples, divided by the pixel's
 //! sample count (the render's samples per pixel): a splat of `v` stands for a sample of value `v`
 //! taken for that pixel, and a pixel's value is `(Σ samples + Σ splats) / spp`. Splats carry no
