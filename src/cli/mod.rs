@@ -7,6 +7,8 @@ mod debug_pixel;
 mod error_image;
 mod farm;
 mod golden;
+mod golden_report;
+mod max_rmse;
 mod merge;
 mod photons;
 mod pixel_font;
@@ -62,6 +64,10 @@ enum Command {
     /// Render on a Slurm cluster: `farm plan` writes a job folder, `sbatch DIR/render.sbatch`
     /// runs it, `farm status DIR` reports progress (docs/farm.md).
     Farm(farm::FarmArgs),
+    /// Noise-aware snapshot tests: `golden update SCENES… -o DIR` stores each render with its
+    /// per-pixel variance; `golden check SCENES… --golden DIR` renders again and says "same
+    /// within noise" or "changed" (exit code 3) by a block z-test (docs/golden.md).
+    Golden(golden::GoldenArgs),
 }
 
 /// Runs one command.
@@ -79,6 +85,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Photons(args) => photons::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::Farm(args) => farm::run(&args),
+        Command::Golden(args) => golden::run(&args),
     }
 }
 

@@ -291,7 +291,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         caustic::render::output::check_writable(path)?;
     }
     let region = args.region.as_deref().map(parse_region).transpose()?;
-    let reference = super::golden::load(args.compare.as_deref())?;
+    let reference = super::max_rmse::load(args.compare.as_deref())?;
     if args.threads == Some(0) {
         return Err(Error::Usage("error: --threads must be at least 1".into()));
     }
@@ -308,7 +308,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     }
     if let Some(reference) = &reference {
         let p = &prepared.render_scene.params;
-        super::golden::check_size(reference, p.width, p.height, region)?;
+        super::max_rmse::check_size(reference, p.width, p.height, region)?;
     }
     let exposure = prepared.render_scene.params.exposure;
     let spp = prepared.render_scene.params.samples_per_pixel;
@@ -454,7 +454,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         );
     }
     if let Some(reference) = &reference {
-        super::golden::check(
+        super::max_rmse::check(
             reference,
             &out.film,
             &output,

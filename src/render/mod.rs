@@ -1,6 +1,7 @@
 //! Rendering: integrators, the tile scheduler, the film and image output.
 
 pub mod film;
+pub mod golden;
 pub mod layers;
 pub mod metrics;
 pub mod output;
