@@ -199,13 +199,16 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
                 time.as_secs()
             )));
         }
-        let total = a.shards.checked_mul(TIME_PLAN_SPP_PER_SHARD).ok_or_else(|| {
-            usage(format!(
-                "--shards {}: at most {} shards in a plan in time",
-                a.shards,
-                u32::MAX / TIME_PLAN_SPP_PER_SHARD
-            ))
-        })?;
+        let total = a
+            .shards
+            .checked_mul(TIME_PLAN_SPP_PER_SHARD)
+            .ok_or_else(|| {
+                usage(format!(
+                    "--shards {}: at most {} shards in a plan in time",
+                    a.shards,
+                    u32::MAX / TIME_PLAN_SPP_PER_SHARD
+                ))
+            })?;
         overrides.samples_per_pixel = Some(total);
     }
     let source_path = &a.scene.scene;

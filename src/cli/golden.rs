@@ -118,10 +118,7 @@ fn scene_list(first: &Path, more: &[PathBuf]) -> Result<Vec<PathBuf>, Error> {
                 .map(|e| e.path())
                 .filter(|p| {
                     p.is_file()
-                        && matches!(
-                            p.extension().and_then(|e| e.to_str()),
-                            Some("ron" | "toml")
-                        )
+                        && matches!(p.extension().and_then(|e| e.to_str()), Some("ron" | "toml"))
                 })
                 .collect();
             if found.is_empty() {
@@ -179,7 +176,11 @@ fn record(o: &SceneOverrides) -> Vec<(String, String)> {
 /// The golden's recorded overrides, then the check's own on top (its `--set`s after the
 /// golden's, its flags instead of the golden's); the seed is the check's, or the golden's + 1
 /// so that the two renders' noise is independent.
-fn combined(golden: &GoldenMeta, own: &SceneOverrides, path: &Path) -> Result<SceneOverrides, Error> {
+fn combined(
+    golden: &GoldenMeta,
+    own: &SceneOverrides,
+    path: &Path,
+) -> Result<SceneOverrides, Error> {
     let mut o = SceneOverrides::default();
     for (key, value) in &golden.overrides {
         let num = || {
@@ -369,5 +370,13 @@ fn check_one(
     })?;
     let overrides = combined(&golden.meta, own, &golden_path)?;
     let r = render_scene(path, &overrides, a.threads, a.quiet, Some(golden.meta.seed))?;
-    report::report(path, &golden, &r.estimates, &r.meta, r.hash_at_seed, test, error_dir)
+    report::report(
+        path,
+        &golden,
+        &r.estimates,
+        &r.meta,
+        r.hash_at_seed,
+        test,
+        error_dir,
+    )
 }

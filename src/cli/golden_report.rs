@@ -106,7 +106,11 @@ pub fn report(
         } else {
             println!(
                 "{name}: {} since the golden was written (comparing the pixels all the same):",
-                if diff.len() == 1 { "1 setting changed".to_string() } else { format!("{} settings changed", diff.len()) }
+                if diff.len() == 1 {
+                    "1 setting changed".to_string()
+                } else {
+                    format!("{} settings changed", diff.len())
+                }
             );
             for d in diff.iter().take(SETTINGS_LISTED) {
                 println!("  {d}");
@@ -146,7 +150,9 @@ pub fn report(
         image.display()
     );
     let listed = if moved.is_empty() {
-        println!("  no single block beyond the limit (the χ² or whole-image test saw a change spread over the image); the largest:");
+        println!(
+            "  no single block beyond the limit (the χ² or whole-image test saw a change spread over the image); the largest:"
+        );
         v.largest(LISTED)
     } else {
         moved.into_iter().take(LISTED).collect()
@@ -229,9 +235,8 @@ fn write_error_image(
         }
     }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Error::Usage(format!("error: cannot create `{}`: {e}", dir.display()))
-        })?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::Usage(format!("error: cannot create `{}`: {e}", dir.display())))?;
     }
     error_image::write_png(&img, path)?;
     Ok(())
@@ -253,7 +258,10 @@ mod tests {
         assert_eq!(
             out,
             vec![
-                ("lights[0].Sphere.power".to_string(), "[45,43,39]".to_string()),
+                (
+                    "lights[0].Sphere.power".to_string(),
+                    "[45,43,39]".to_string()
+                ),
                 ("render.seed".into(), "3".into()),
                 ("render.width".into(), "64".into()),
             ]

@@ -38,24 +38,37 @@ fn unchanged_cornell_passes_and_three_small_changes_fail_at_every_seed() {
     let golden = cornell(32, 1, &[]);
     let changes: [(&str, &str); 3] = [
         ("light 5 % dimmer", "lights[0].power=[42.75, 40.85, 37.05]"),
-        ("red wall 0.05 darker", "materials.red.color=[0.65, 0.12, 0.10]"),
-        ("glass ball 1 cm to the right", "nodes[1].center=[0.43, 0.38, 0.3]"),
+        (
+            "red wall 0.05 darker",
+            "materials.red.color=[0.65, 0.12, 0.10]",
+        ),
+        (
+            "glass ball 1 cm to the right",
+            "nodes[1].center=[0.43, 0.38, 0.3]",
+        ),
     ];
     let mut false_alarms = Vec::new();
     let mut missed = Vec::new();
     let mut max_z_unchanged = 0.0f64;
     let mut min_z_changed = [f64::INFINITY; 3];
     for seed in 2..22 {
-        let v = test.compare(&golden, &cornell(32, seed, &[])).expect("same size");
+        let v = test
+            .compare(&golden, &cornell(32, seed, &[]))
+            .expect("same size");
         max_z_unchanged = max_z_unchanged.max(v.max_abs_z());
         if v.changed() {
             false_alarms.push(seed);
         }
         for (i, (what, set)) in changes.iter().enumerate() {
-            let v = test.compare(&golden, &cornell(32, seed, &[set])).expect("same size");
+            let v = test
+                .compare(&golden, &cornell(32, seed, &[set]))
+                .expect("same size");
             min_z_changed[i] = min_z_changed[i].min(v.max_abs_z());
             if !v.changed() {
-                missed.push(format!("{what} at seed {seed}: max |z| {:.2}", v.max_abs_z()));
+                missed.push(format!(
+                    "{what} at seed {seed}: max |z| {:.2}",
+                    v.max_abs_z()
+                ));
             }
         }
     }
@@ -69,7 +82,10 @@ fn unchanged_cornell_passes_and_three_small_changes_fail_at_every_seed() {
     );
     // At α = 0.01 the count of false alarms in 20 is binomial(20, ≤ 0.01): 2 or more has a
     // chance below 1.7 %.
-    assert!(false_alarms.len() <= 1, "false alarms at seeds {false_alarms:?}");
+    assert!(
+        false_alarms.len() <= 1,
+        "false alarms at seeds {false_alarms:?}"
+    );
     assert!(missed.is_empty(), "{missed:#?}");
 }
 
@@ -86,7 +102,9 @@ fn a_path_traced_golden_passes_a_path_ppm_render_of_the_same_scene() {
         "photons.global=0",
     ];
     for seed in [2, 3] {
-        let v = test.compare(&golden, &cornell(16, seed, &ppm)).expect("same size");
+        let v = test
+            .compare(&golden, &cornell(16, seed, &ppm))
+            .expect("same size");
         assert!(
             !v.changed(),
             "seed {seed}: max |z| {:.2} of {:.2}, Σz² {:?} of {:?}, image z {:?}",
@@ -99,7 +117,11 @@ fn a_path_traced_golden_passes_a_path_ppm_render_of_the_same_scene() {
     }
     let mut dim = ppm.to_vec();
     dim.push("lights[0].power=[42.75, 40.85, 37.05]");
-    assert!(test.compare(&golden, &cornell(16, 2, &dim)).unwrap().changed());
+    assert!(
+        test.compare(&golden, &cornell(16, 2, &dim))
+            .unwrap()
+            .changed()
+    );
 }
 
 #[test]
@@ -108,25 +130,52 @@ fn the_command_line_exits_0_or_3_names_changed_settings_and_writes_the_error_ima
     let g = dir.path().join("golden");
     let gs = g.to_str().expect("utf-8");
     let out = common::caustic(&[
-        "golden", "update", "scenes/cornell.ron", "-o", gs, "--width", "32", "--height", "32",
-        "--spp", "16",
+        "golden",
+        "update",
+        "scenes/cornell.ron",
+        "-o",
+        gs,
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--spp",
+        "16",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(g.join("cornell.ron.golden").is_file());
     // The recorded size and samples are applied again: no flags needed.
     let out = common::caustic(&["golden", "check", "scenes/cornell.ron", "--golden", gs]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{stdout}");
-    assert!(stdout.contains("same within noise") && stdout.contains("seed 2, golden's 1"), "{stdout}");
+    assert!(
+        stdout.contains("same within noise") && stdout.contains("seed 2, golden's 1"),
+        "{stdout}"
+    );
     let out = common::caustic(&[
-        "golden", "check", "scenes/cornell.ron", "--golden", gs, "--set",
+        "golden",
+        "check",
+        "scenes/cornell.ron",
+        "--golden",
+        gs,
+        "--set",
         "lights[0].power=[40, 43, 39]",
     ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(3), "{stdout}");
     assert!(stdout.contains("1 setting changed"), "{stdout}");
-    assert!(stdout.contains("lights[0].Sphere.power: [45.0,43.0,39.0] → [40.0,43.0,39.0]"), "{stdout}");
-    assert!(stdout.contains("CHANGED") && stdout.contains("block at "), "{stdout}");
+    assert!(
+        stdout.contains("lights[0].Sphere.power: [45.0,43.0,39.0] → [40.0,43.0,39.0]"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("CHANGED") && stdout.contains("block at "),
+        "{stdout}"
+    );
     let err = g.join("cornell.ron.error.png");
     let img = image::open(&err).expect("error image written").to_rgb8();
     assert!(img.width() >= 32 * 7, "zoomed: {}", img.width());
@@ -134,5 +183,8 @@ fn the_command_line_exits_0_or_3_names_changed_settings_and_writes_the_error_ima
     let out = common::caustic(&["golden", "check", "scenes/water.ron", "--golden", gs]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("caustic golden update scenes/water.ron"), "{stderr}");
+    assert!(
+        stderr.contains("caustic golden update scenes/water.ron"),
+        "{stderr}"
+    );
 }

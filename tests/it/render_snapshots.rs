@@ -19,16 +19,35 @@ use crate::common;
 fn every_scene_matches_its_golden_image_within_noise() {
     if std::env::var_os("UPDATE_SNAPSHOTS").is_some() {
         let out = common::caustic(&[
-            "golden", "update", "scenes/", "-o", "tests/golden/", "--width", "64", "--height",
-            "64", "--spp", "4", "--quiet",
+            "golden",
+            "update",
+            "scenes/",
+            "-o",
+            "tests/golden/",
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--spp",
+            "4",
+            "--quiet",
         ]);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     for path in common::scene_files() {
         let name = path.file_name().and_then(|n| n.to_str()).expect("name");
         let golden = common::root().join(format!("tests/golden/{name}.golden"));
         let g = GoldenImage::read(&golden).unwrap_or_else(|e| panic!("{e}"));
-        let mean = g.estimates.mean.iter().map(|p| p.max_element()).sum::<f32>()
+        let mean = g
+            .estimates
+            .mean
+            .iter()
+            .map(|p| p.max_element())
+            .sum::<f32>()
             / g.estimates.mean.len() as f32;
         assert!(mean > 0.01, "{name}: the golden image is black");
     }
@@ -62,6 +81,10 @@ fn the_snapshot_check_catches_a_change_of_light_transport() {
         "lights[0].power=[38.0, 36.5, 33.0]",
     ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(out.status.code(), Some(3), "a 15% dimmer light passed: {stdout}");
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "a 15% dimmer light passed: {stdout}"
+    );
     assert!(dir.path().join("cornell.ron.error.png").is_file());
 }

@@ -84,8 +84,9 @@ pub struct BlockZ {
     pub golden: [f64; 3],
     /// The render's block mean per channel.
     pub test: [f64; 3],
-    /// (test − golden) over its standard error, per channel; ±∞ for a difference where
-    /// neither image has noise, NaN where either mean is not a number.
+    /// (test − golden) over its standard error, per channel (the error floored at 10⁻⁶ of the
+    /// means, so a difference where neither image has noise is very large); NaN where either
+    /// mean is not a number.
     pub z: [f64; 3],
 }
 
@@ -131,7 +132,9 @@ impl Verdict {
     /// Whether some channel's whole-image z is beyond its limit.
     #[must_use]
     pub fn global_rejects(&self) -> bool {
-        self.image_z.iter().any(|z| !(z.abs() <= self.image_z_limit))
+        self.image_z
+            .iter()
+            .any(|z| !(z.abs() <= self.image_z_limit))
     }
 
     /// Whether some channel's Σ z² is above its χ² limit.
@@ -351,6 +354,9 @@ mod tests {
                 alarms += 1;
             }
         }
+        eprintln!(
+            "block test, synthetic exponential samples: {alarms} false alarms of 400 at α 0.05"
+        );
         assert!((3..=33).contains(&alarms), "{alarms} false alarms of 400");
     }
 
@@ -365,26 +371,36 @@ mod tests {
         // whole image's z is about 4 · 2.4 = 9.6 against a limit of about 3.3.
         let t = synthetic(32, 8, &mut rng, |i| base(i) * 1.15);
         let v = test.compare(&g, &t).unwrap();
-        assert!(v.changed() && v.chi2_rejects(), "{:?} {:?}", v.chi2, v.chi2_limit);
+        assert!(
+            v.changed() && v.chi2_rejects(),
+            "{:?} {:?}",
+            v.chi2,
+            v.chi2_limit
+        );
         assert!(v.global_rejects(), "{:?} {}", v.image_z, v.image_z_limit);
         // One 4×4 patch four times as bright: only the block holding it moves (z about 7).
         let patch = |i: u32| {
             let (x, y) = (i % 32, i / 32);
-            base(i) * if (9..13).contains(&x) && (18..22).contains(&y) { 4.0 } else { 1.0 }
+            base(i)
+                * if (9..13).contains(&x) && (18..22).contains(&y) {
+                    4.0
+                } else {
+                    1.0
+                }
         };
         let t = synthetic(32, 8, &mut rng, patch);
         let v = test.compare(&g, &t).unwrap();
         let moved = v.moved();
         assert!(v.changed() && !moved.is_empty());
         assert!(moved.iter().all(|b| (b.x, b.y) == (8, 16)), "{moved:?}");
-        // The same image is not changed, and a noiseless difference is infinitely far.
+        // The same image is not changed, and a noiseless difference is very far.
         assert!(!test.compare(&g, &g).unwrap().changed());
         let mut flat = g.clone();
         flat.variance.iter_mut().for_each(|v| *v = Vec3::ZERO);
         let mut other = flat.clone();
         other.mean[0].x += 0.5;
         let v = test.compare(&flat, &other).unwrap();
-        assert!(v.blocks[0].z[0].is_infinite() && v.changed());
+        assert!(v.blocks[0].z[0] > 1e3 && v.changed(), "{:?}", v.blocks[0].z);
         let small = synthetic(8, 2, &mut rng, base);
         assert_eq!(
             test.compare(&g, &small).unwrap_err(),

@@ -337,7 +337,11 @@ mod tests {
         let e = golden().estimates;
         // Pixel 0: samples 0.5, 1.5, 1.0 → mean 1, sample variance 0.25, of the mean 0.25/3.
         assert_eq!(e.mean[0].x, 1.0);
-        assert!((e.variance[0].x - 0.25 / 3.0).abs() < 1e-6, "{}", e.variance[0]);
+        assert!(
+            (e.variance[0].x - 0.25 / 3.0).abs() < 1e-6,
+            "{}",
+            e.variance[0]
+        );
         assert!((e.variance[0].y - 1.0 / 3.0).abs() < 1e-6);
         assert_eq!(e.variance[0].z, 0.0);
         // Pixel 4: 2 and 4 → variance 2, of the mean 1. Pixel 5: one sample, no estimate.
@@ -351,7 +355,10 @@ mod tests {
         let bytes = g.to_bytes();
         assert_eq!(GoldenImage::from_bytes(&bytes, "g").unwrap(), g);
         for cut in [0, 20, bytes.len() / 2, bytes.len() - 1] {
-            assert!(GoldenImage::from_bytes(&bytes[..cut], "g").is_err(), "{cut}");
+            assert!(
+                GoldenImage::from_bytes(&bytes[..cut], "g").is_err(),
+                "{cut}"
+            );
         }
         let mut flipped = bytes.clone();
         flipped[bytes.len() - 30] ^= 4;
