@@ -7,6 +7,8 @@ mod debug_pixel;
 mod error_image;
 mod farm;
 mod golden;
+mod golden_report;
+mod max_rmse;
 mod merge;
 mod photons;
 mod pixel_font;
@@ -67,6 +69,10 @@ enum Command {
     /// Serve a live preview on 127.0.0.1: the render refining pass by pass, restarted whenever
     /// the scene or an asset it uses changes; takes every `render` flag (docs/preview.md).
     Preview(preview::PreviewArgs),
+    /// Noise-aware snapshot tests: `golden update SCENES… -o DIR` stores each render with its
+    /// per-pixel variance; `golden check SCENES… --golden DIR` renders again and says "same
+    /// within noise" or "changed" (exit code 3) by a block z-test (docs/golden.md).
+    Golden(golden::GoldenArgs),
 }
 
 /// Runs one command.
@@ -85,6 +91,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Merge(args) => merge::run(&args),
         Command::Farm(args) => farm::run(&args),
         Command::Preview(args) => preview::run(&args),
+        Command::Golden(args) => golden::run(&args),
     }
 }
 

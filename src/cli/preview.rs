@@ -84,7 +84,7 @@ pub struct Settings {
 impl Settings {
     /// Checks the flags as `render` does before any work.
     fn new(args: &RenderArgs) -> Result<Self, Error> {
-        let usage = |m: String| Error::Usage(format!("error: {m}"));
+        let usage = |m: String| Error::Usage(format!("{m}"));
         let output = args
             .output
             .clone()
@@ -156,7 +156,7 @@ impl Settings {
                 output,
                 part,
                 layers,
-                reference: super::golden::load(args.compare.as_deref())?,
+                reference: super::max_rmse::load(args.compare.as_deref())?,
                 max_rmse: args.max_rmse,
             },
         })
@@ -168,7 +168,7 @@ impl Settings {
     fn sample_range(&self, prepared: &Prepared) -> Result<Option<Range<u32>>, String> {
         let p = &prepared.render_scene.params;
         if let Some(reference) = &self.save.reference {
-            super::golden::check_size(reference, p.width, p.height, self.region)
+            super::max_rmse::check_size(reference, p.width, p.height, self.region)
                 .map_err(|e| crate::error_text(&e))?;
         }
         let spp = p.samples_per_pixel;
@@ -193,7 +193,7 @@ pub fn run(args: &PreviewArgs) -> Result<(), Error> {
     let address = format!("127.0.0.1:{}", args.port.unwrap_or(0));
     let server = tiny_http::Server::http(&address).map_err(|e| {
         Error::Usage(format!(
-            "error: cannot serve the preview on {address}: {e}{}",
+            "cannot serve the preview on {address}: {e}{}",
             if args.port.is_some() {
                 "; choose another --port, or leave it out for a free one"
             } else {
@@ -208,7 +208,7 @@ pub fn run(args: &PreviewArgs) -> Result<(), Error> {
         s.cancel_render();
         let _ = tx.send(Msg::Changed);
     })
-    .map_err(|e| Error::Usage(format!("error: cannot watch files for changes: {e}")))?;
+    .map_err(|e| Error::Usage(format!("cannot watch files for changes: {e}")))?;
     println!(
         "preview of `{}` at http://127.0.0.1:{port}/ (Ctrl-C to stop)",
         settings.scene.display()

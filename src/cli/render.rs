@@ -290,7 +290,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         caustic::render::output::check_writable(path)?;
     }
     let region = args.region.as_deref().map(parse_region).transpose()?;
-    let reference = super::golden::load(args.compare.as_deref())?;
+    let reference = super::max_rmse::load(args.compare.as_deref())?;
     if args.threads == Some(0) {
         return Err(Error::Usage("--threads must be at least 1".into()));
     }
@@ -307,7 +307,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     }
     if let Some(reference) = &reference {
         let p = &prepared.render_scene.params;
-        super::golden::check_size(reference, p.width, p.height, region)?;
+        super::max_rmse::check_size(reference, p.width, p.height, region)?;
     }
     let exposure = prepared.render_scene.params.exposure;
     let spp = prepared.render_scene.params.samples_per_pixel;
@@ -325,6 +325,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             .map_err(|e| Error::Usage(e.to_string()))?,
     };
     let first_sample = samples.as_ref().map_or(0, |r| r.start);
+    let samples_taken = samples.clone();
     let hash = is_part(&output).then(|| settings_hash(&prepared.render_scene));
     let terminal = !args.quiet && std::io::stderr().is_terminal();
     let mut layers: Vec<Layer> = args.layers.iter().flatten().copied().collect();
@@ -335,14 +336,25 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         progress: terminal && args.time.is_none(),
         cancel: Some(interrupt.start_rendering()),
         photon_cache: args.photon_cache.clone(),
-        samples,
+        samples: samples_taken,
         light_paths: layers.iter().any(|l| matches!(l, Layer::Part(_))),
     };
     let job = RenderJob::new(&prepared.render_scene, &options)?;
+    let maps = job.integrator().photon_maps();
     if !args.quiet
-        && let Some(maps) = job.integrator().photon_maps()
+        && let Some(maps) = maps
     {
         eprintln!("{}", maps.summary);
+    }
+    if !args.quiet
+        && maps.is_none()
+        && let Some(dir) = &args.photon_cache
+    {
+        eprintln!(
+            "warning: --photon-cache `{}` is ignored: the {:?} integrator keeps no photon maps to cache (only `--integrator photon` does; ppm and path-ppm trace fresh maps every pass)",
+            dir.display(),
+            prepared.render_scene.params.integrator
+        );
     }
     let plan = PassPlan {
         checkpoint: args.checkpoint.as_deref().map(|path| CheckpointPlan {
@@ -414,12 +426,25 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let st = &out.stats;
     let secs = st.elapsed.as_secs_f64();
     let reached = st.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1);
+    // A shard or `--samples` range says which samples of the render's it took.
+    let range = match &samples {
+        Some(r) if reached > 0 => format!(
+            " (samples {}..{} of {spp})",
+            r.start,
+            r.start + reached as u32
+        ),
+        Some(r) => format!(" (none of samples {}..{} of {spp})", r.start, r.end),
+        None => String::new(),
+    };
+    let p = &prepared.render_scene.params;
     println!(
-        "{}: {}×{}, {} spp, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
+        "{}: {}×{}, {} spp{range}, {:?} integrator, {:?} sampler, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
         output.display(),
         out.film.width,
         out.film.height,
         reached,
+        p.integrator,
+        p.sampler,
         st.rays,
         secs,
         st.rays as f64 / secs.max(1e-9) / 1e6,
@@ -441,7 +466,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         );
     } else if st.photon_estimates > 0 && !args.quiet {
         eprintln!(
-            "photons: {} estimates, {:.1}% cut short by the largest radius",
+            "photons: {} estimates, {:.1}% cut short by the largest radius (photons.max_radius): those found fewer than the photons they ask for (photons.gather) within it, so they average fewer photons and are noisier; if the image looks blotchy, trace more photons (--photons, --caustic-photons) or raise --max-radius (which blurs more)",
             st.photon_estimates,
             100.0 * st.photon_radius_cut as f64 / st.photon_estimates as f64
         );
@@ -453,7 +478,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         );
     }
     if let Some(reference) = &reference {
-        super::golden::check(
+        super::max_rmse::check(
             reference,
             &out.film,
             &output,

@@ -2,6 +2,7 @@
 
 pub mod exr;
 pub mod film;
+pub mod golden;
 pub mod job;
 pub mod layers;
 pub mod options;

@@ -12,6 +12,7 @@ mod determinism;
 mod doc_images;
 mod doc_snippets;
 mod farm;
+mod golden;
 mod hard_cases;
 mod interrupt;
 mod kdtree;

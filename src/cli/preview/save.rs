@@ -60,7 +60,7 @@ pub fn save(
     );
     eprintln!("{message}");
     if let Some(reference) = &s.reference {
-        let checked = super::super::golden::check(
+        let checked = super::super::max_rmse::check(
             reference,
             &job.snapshot(),
             output,

@@ -81,13 +81,18 @@ impl std::fmt::Display for PhotonSummary {
             let t = PhotonSummary::total(per_light);
             writeln!(
                 f,
-                "photons: {name} map: {} stored of {} emitted, max radius {radius:.4}{}",
+                "photons: {name} map: {} stored of {} emitted, max radius {radius:.4}{}; {}",
                 t.stored,
                 t.emitted,
                 if self.auto_radius {
                     " (from the scene's size)"
                 } else {
                     ""
+                },
+                if name == "caustic" {
+                    "only photons that reach a diffuse surface through mirrors or glass are stored, and they alone draw the caustics: few stored means blotchy caustics (raise --caustic-photons)"
+                } else {
+                    "stored photons carry the indirect light: few stored means blotchy indirect light (raise --photons)"
                 }
             )?;
             for (i, c) in per_light.iter().enumerate() {
