@@ -5,8 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use caustic::compile::mesh::{ObjMesh, parse_obj};
+use caustic::pipeline::SceneOverrides;
+use caustic::render::RenderOptions;
 
-use crate::common::{caustic, root};
+use crate::common::{caustic, render_file, root};
 
 /// A folder of `tests/reported/`.
 fn case(name: &str) -> PathBuf {
@@ -75,4 +77,34 @@ fn obj_files_with_cr_only_line_endings_read_as_the_lf_file() {
         "the input has CR-only line endings"
     );
     assert_eq!(render("cr.obj"), render("lf.obj"));
+}
+
+// ---- The largest search radius only caps searches ----------------------------------------------
+
+/// `path` rendered through the library with `overrides`; the image's mean over channels.
+fn mean_of(path: &Path, overrides: &SceneOverrides) -> f64 {
+    let (film, _) = render_file(path, overrides, &RenderOptions::default());
+    let m = film.mean();
+    f64::from(m.x + m.y + m.z) / 3.0
+}
+
+#[test]
+fn a_generous_largest_radius_does_not_change_the_estimate() {
+    // A 1 mm integrating sphere (albedo 0.8, point light at its centre): L = 0.8 · 5 / π =
+    // 1.2732 everywhere. Its 50-photon discs are ~2e-5 wide, so no largest radius from 1 cm up
+    // cuts a search; the answer must not move with it (it was 0.255 at 1, from a disc raised to
+    // 1e-3 of the largest radius).
+    let scene = case("estimate-radius-floor").join("small_origin.ron");
+    let exact = 0.8 * 5.0 / std::f64::consts::PI;
+    for r in [0.01f32, 1.0, 100.0] {
+        let overrides = SceneOverrides {
+            sets: vec![format!("photons.max_radius={r:?}")],
+            ..SceneOverrides::default()
+        };
+        let m = mean_of(&scene, &overrides);
+        assert!(
+            (m / exact - 1.0).abs() < 0.03,
+            "max radius {r}: mean {m}, exact {exact}"
+        );
+    }
 }

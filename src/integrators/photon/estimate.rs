@@ -25,7 +25,9 @@
 //! crowd, wide where they are sparse), which a single radius per pass cannot do.
 //!
 //! A radius of 0 (all k photons at one point) is raised to [`MIN_RADIUS_FRACTION`] of the
-//! largest radius, so coincident photons give a finite estimate.
+//! largest radius, so coincident photons give a finite estimate. Any other radius is used as
+//! found: the largest radius only caps a search and never widens a disc, so once it no longer
+//! cuts searches short the estimate does not depend on it (issue 29, estimate-radius-floor).
 
 use std::cell::RefCell;
 
@@ -34,7 +36,8 @@ use glam::Vec3;
 use crate::photon::{KdTree, KnnHeap, Photon};
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
-/// The smallest estimate radius as a fraction of the map's largest radius.
+/// The radius given to an estimate whose k nearest photons all lie at one point (a zero radius),
+/// as a fraction of the map's largest radius.
 pub const MIN_RADIUS_FRACTION: f32 = 1e-3;
 
 /// The kernel weighing photons by distance within the estimate's disc.
@@ -192,8 +195,13 @@ impl PhotonMap {
                 let far = heap.iter().max_by(|a, b| a.dist2.total_cmp(&b.dist2));
                 (heap.max_dist2().unwrap_or(max2), far.map(|n| n.index))
             };
-            let min_r = self.max_radius * MIN_RADIUS_FRACTION;
-            let r2 = r2.max(min_r * min_r) * self.shrink * self.shrink;
+            let r2 = if r2 > 0.0 {
+                r2
+            } else {
+                let min_r = self.max_radius * MIN_RADIUS_FRACTION;
+                min_r * min_r
+            };
+            let r2 = r2 * self.shrink * self.shrink;
             let r = r2.sqrt();
             let photons = self.tree.items();
             let mut sum = Vec3::ZERO;
@@ -405,6 +413,39 @@ mod tests {
         let e = map.estimate(Vec3::ZERO, Vec3::Z, &up_frame(), &white_lambert());
         assert!(e.radiance.is_finite() && e.radiance.x > 0.0);
         assert_eq!(e.radius, MIN_RADIUS_FRACTION);
+    }
+
+    #[test]
+    fn the_largest_radius_only_caps_the_disc() {
+        // Issue 29 (estimate-radius-floor): photons 1e-5 apart (a 1 mm part) read the same
+        // density whether the largest radius is 1 cm or 100 m, as long as it does not cut the
+        // search; the exact irradiance of a uniform density λ is λ.
+        let mut rng = Rng::new(4, 3);
+        let side = 2e-3f32;
+        let n = 40_000;
+        let photons: Vec<Photon> = (0..n)
+            .map(|_| {
+                let (a, b) = rng.next_2d();
+                let p = Vec3::new(side * (a - 0.5), side * (b - 0.5), 0.0);
+                Photon::new(p, -Vec3::Z, Vec3::Z, Vec3::ONE)
+            })
+            .collect();
+        let lambda = n as f32 / (side * side);
+        for max_radius in [1e-2, 1.0, 100.0] {
+            let tree = KdTree::build(photons.clone()).expect("tree");
+            let map = PhotonMap::new(tree, 50, max_radius, Kernel::Box);
+            let mut sum = 0.0f64;
+            let mut queries = Rng::new(5, 9);
+            for _ in 0..200 {
+                let (a, b) = queries.next_2d();
+                let p = Vec3::new(side * 0.5 * (a - 0.5), side * 0.5 * (b - 0.5), 0.0);
+                let e = map.irradiance(p, Vec3::Z);
+                assert!(!e.cut && e.radius < 1e-4, "{e:?}");
+                sum += f64::from(e.radiance.x / lambda);
+            }
+            let ratio = sum / 200.0;
+            assert!((ratio - 1.0).abs() < 0.03, "max radius {max_radius}: {ratio}");
+        }
     }
 
     #[test]
