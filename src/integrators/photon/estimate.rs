@@ -1,7 +1,7 @@
 //! The radiance estimate from a photon map (Jensen 2001, §7.1): the `k` nearest photons within
 //! the map's largest radius, each weighted by the BSDF, over the area of their disc.
 //!
-//! `L(x, ωo) ≈ Σₚ w(dₚ) f(ωo, ωₚ) Φₚ · |ns·ωₚ|/|ng·ωₚ| / (π r² c)` where
+//! `L(x, ωo) ≈ Σₚ w(dₚ) f(ωo, ωₚ) Φₚ · |ns·ωₚ|/|nₚ·ωₚ| / (π r² c)` where
 //! - `r` is the distance of the k-th nearest photon, which itself is left out of the sum: the
 //!   k − 1 photons strictly inside the disc make the estimate unbiased for a uniform density
 //!   (π r_k² λ is Gamma(k)-distributed, so E[(k − 1)/(π r_k²)] = λ; García et al., CGF 2012);
@@ -9,8 +9,14 @@
 //!   every photon counts;
 //! - `w` is the kernel and `c` its normalisation (box: 1, 1; Jensen's cone `1 − d/(k r)`:
 //!   `c = 1 − 2/(3k)`), so a uniform density reads its true value whichever kernel is used;
-//! - `|ns·ωₚ|/|ng·ωₚ|` turns the flux that crossed the geometric surface into the cosine the
-//!   shading normal implies (the camera side of Veach's adjoint rule, §5.3);
+//! - `|ns·ωₚ|/|nₚ·ωₚ|` turns the flux that crossed the geometric surface into the cosine the
+//!   shading normal implies (the camera side of Veach's adjoint rule, §5.3). `nₚ` is the
+//!   geometric normal where the photon *landed* (stored with it), not the query's: on a
+//!   smooth-shaded low-poly mesh a disc near a facet edge holds photons of the neighbouring
+//!   facet, whose flux per area went with their own facet's cosine; dividing by the query
+//!   facet's (near a terminator, ~0) multiplied them 10-25× (issue 29, smooth-normal-photons).
+//!   The divisor is floored at [`MIN_LANDING_COSINE`] against octahedral rounding of grazing
+//!   photons;
 //! - photons from the other side of the surface or from another surface are rejected: their
 //!   stored normal must face the query's normal (`nₚ·ng > 0.1`) and their direction must arrive
 //!   from the side of `ωo` (`ωₚ·ng > 10⁻²`), the tests of Mitsuba 0.6's photon map (hard case 12).
@@ -39,6 +45,10 @@ use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 /// The radius given to an estimate whose k nearest photons all lie at one point (a zero radius),
 /// as a fraction of the map's largest radius.
 pub const MIN_RADIUS_FRACTION: f32 = 1e-3;
+
+/// Smallest landing cosine `|nₚ·ωₚ|` an estimate divides by (the stored directions are rounded
+/// to 6.5e-5 rad, so a grazing photon's could read 0 or below).
+pub const MIN_LANDING_COSINE: f32 = 1e-2;
 
 /// The kernel weighing photons by distance within the estimate's disc.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -159,9 +169,9 @@ impl PhotonMap {
     /// the camera side sees it), estimated from the nearest photons. See the module docs.
     #[must_use]
     pub fn estimate(&self, p: Vec3, wo: Vec3, fr: &ShadingFrame, bsdf: &Bsdf) -> Estimate {
-        self.gather(p, fr.ng, |ph, wi, cos_g| {
+        self.gather(p, fr.ng, |ph, wi, cos_p| {
             let cos_s = wi.dot(fr.ns).max(0.0);
-            bsdf.eval(wo, wi, fr, TransportMode::Radiance) * ph.power() * (cos_s / cos_g)
+            bsdf.eval(wo, wi, fr, TransportMode::Radiance) * ph.power() * (cos_s / cos_p)
         })
     }
 
@@ -173,8 +183,8 @@ impl PhotonMap {
     }
 
     /// The density estimate at `p` (surface normal `ng`, on the query's side): the kernel-
-    /// weighted sum of `value(photon, wi, cos θg)` over the accepted photons, over the disc's
-    /// normalised area.
+    /// weighted sum of `value(photon, wi, cos θₚ)` over the accepted photons (`cos θₚ` the
+    /// landing cosine, [`accept`]), over the disc's normalised area.
     fn gather(&self, p: Vec3, ng: Vec3, value: impl Fn(&Photon, Vec3, f32) -> Vec3) -> Estimate {
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
@@ -226,16 +236,17 @@ impl PhotonMap {
 }
 
 /// The side tests of an estimate at a point of geometric normal `ng`: the photon's incoming
-/// direction `ωₚ` and `cos θg = ωₚ·ng`, or `None` when it landed on another surface (stored
+/// direction `ωₚ` and its landing cosine `cos θₚ = ωₚ·nₚ` with its own stored geometric normal
+/// (at least [`MIN_LANDING_COSINE`]), or `None` when it landed on another surface (stored
 /// normal `nₚ·ng ≤ 0.1`) or arrived from the other side (`ωₚ·ng ≤ 10⁻²`).
 #[inline]
 fn accept(ph: &Photon, ng: Vec3) -> Option<(Vec3, f32)> {
-    if ph.normal().dot(ng) <= 0.1 {
+    let np = ph.normal();
+    if np.dot(ng) <= 0.1 {
         return None;
     }
     let wi = -ph.direction();
-    let cos_g = wi.dot(ng);
-    (cos_g > 1e-2).then_some((wi, cos_g))
+    (wi.dot(ng) > 1e-2).then(|| (wi, wi.dot(np).max(MIN_LANDING_COSINE)))
 }
 
 /// Precomputed irradiance for final gathering (Christensen, "Faster Photon Map Global
