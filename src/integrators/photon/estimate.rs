@@ -39,7 +39,7 @@ use std::cell::RefCell;
 
 use glam::Vec3;
 
-use crate::photon::{KdTree, KnnHeap, Photon};
+use crate::photon::{HasPosition, KdTree, KnnHeap, Photon};
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
 /// The radius given to an estimate whose k nearest photons all lie at one point (a zero radius),
@@ -253,15 +253,32 @@ fn accept(ph: &Photon, ng: Vec3) -> Option<(Vec3, f32)> {
 /// Illumination", JGT 4(1), 1999): the irradiance of both maps estimated once at every
 /// [`IRRADIANCE_STRIDE`]-th photon's position, so a final-gather ray that lands on a diffuse
 /// surface costs one nearest-point lookup instead of two k-nearest estimates. The radiance
-/// there is taken as `f(ωo, n) · E`: exact for Lambert surfaces, which is what indirect light
-/// at gather points mostly sees; a glossy lobe is evaluated as if the light came along the
-/// normal.
+/// there is `f(ωo, n) · E`, exact for Lambert surfaces only: the photon integrator reads the
+/// maps themselves where a surface has a Phong lobe. Each point also keeps the radius of the
+/// estimate it came from, which tells final gathering when a gather ray is too short for the
+/// estimate at its end (`integrators::photon`'s short-gather rule).
 #[derive(Debug)]
 pub struct IrradianceCache {
-    /// Points (photon records whose `power` field holds the irradiance E in W/m²).
-    tree: KdTree<Photon>,
+    /// Points (photon records whose `power` field holds the irradiance E in W/m²) with their
+    /// estimate's radius.
+    tree: KdTree<IrradiancePoint>,
     /// Largest lookup distance.
     max_radius: f32,
+}
+
+/// One point of an [`IrradianceCache`]: a photon record (position, normal, and the irradiance
+/// in its `power` field) and the radius of the sites map's estimate there (scene units).
+#[derive(Debug, Clone, Copy)]
+struct IrradiancePoint {
+    photon: Photon,
+    radius: f32,
+}
+
+impl HasPosition for IrradiancePoint {
+    #[inline]
+    fn position(&self) -> [f32; 3] {
+        HasPosition::position(&self.photon)
+    }
 }
 
 /// One irradiance point per this many photons of the map it is built on.
@@ -279,14 +296,21 @@ impl IrradianceCache {
         if maps.is_empty() || sites.is_empty() {
             return None;
         }
-        let points: Vec<Photon> = sites
+        let points: Vec<IrradiancePoint> = sites
             .photons()
             .par_iter()
             .step_by(IRRADIANCE_STRIDE)
             .map(|ph| {
                 let (p, n) = (ph.position(), ph.normal());
-                let e: Vec3 = maps.iter().map(|m| m.irradiance(p, n).radiance).sum();
-                Photon::new(p, -n, n, e)
+                let (e, radius) = maps.iter().fold((Vec3::ZERO, 0.0), |(e, r), m| {
+                    let est = m.irradiance(p, n);
+                    let r = if std::ptr::eq(*m, sites) { est.radius } else { r };
+                    (e + est.radiance, r)
+                });
+                IrradiancePoint {
+                    photon: Photon::new(p, -n, n, e),
+                    radius,
+                }
             })
             .collect();
         let max_radius = maps.iter().map(|m| m.max_radius).fold(0.0, f32::max);
@@ -316,6 +340,13 @@ impl IrradianceCache {
     /// ~25°), or `None` when no such point lies within the largest radius.
     #[must_use]
     pub fn lookup(&self, p: Vec3, ng: Vec3) -> Option<Vec3> {
+        self.lookup_with_radius(p, ng).map(|(e, _)| e)
+    }
+
+    /// [`IrradianceCache::lookup`], with the radius (scene units) of the estimate the point's
+    /// irradiance came from.
+    #[must_use]
+    pub fn lookup_with_radius(&self, p: Vec3, ng: Vec3) -> Option<(Vec3, f32)> {
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
             heap.set_k(LOOKUP_K);
@@ -325,8 +356,8 @@ impl IrradianceCache {
             let points = self.tree.items();
             heap.iter()
                 .map(|n| &points[n.index as usize])
-                .find(|q| q.normal().dot(ng) > 0.9)
-                .map(Photon::power)
+                .find(|q| q.photon.normal().dot(ng) > 0.9)
+                .map(|q| (q.photon.power(), q.radius))
         })
     }
 }

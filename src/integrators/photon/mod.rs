@@ -89,6 +89,18 @@ fn set_radiance(log: Option<&mut TraceLog>, node: Option<usize>, gathered: Vec3)
 /// Most mirror or glass bounces a final-gather ray follows before reading the maps.
 const GATHER_SPECULAR_DEPTH: u32 = 4;
 
+/// A final-gather ray shorter than this many times the radius of the estimate where it lands
+/// is "short": its end is so near the gathering point that the estimate's disc there reaches
+/// past the corner between them, where the other surface's photons are rejected and the disc
+/// is partly empty (−5 % 1 cm from a wall; issue 29, corner-final-gather). A short ray does
+/// not read that estimate: it gathers one more diffuse bounce instead (Jensen 2001, §9.3's
+/// path-traced step for short gather rays), whose own landing is usually far.
+const SHORT_GATHER: f32 = 2.0;
+
+/// Most short-ray bounces one final-gather ray takes (deep in a corner, each may land near the
+/// corner again); after them the estimate is read as it is.
+const SHORT_GATHER_BOUNCES: u32 = 3;
+
 /// The photon-mapping integrator: the maps, built once, and the camera-side estimator.
 #[derive(Debug)]
 pub struct PhotonMapper<'a> {
@@ -412,7 +424,8 @@ impl<'a> PhotonMapper<'a> {
 
     /// Indirect light at a vertex by `n` final-gather rays sampled from the BSDF's diffuse part:
     /// where each lands, its direct light, caustics and global-map radiance (following up to
-    /// four mirror or glass bounces first).
+    /// four mirror or glass bounces first; a ray shorter than [`SHORT_GATHER`] times the
+    /// landing estimate's radius takes one more BSDF-sampled bounce instead of reading it).
     #[allow(clippy::too_many_arguments)]
     fn final_gather(
         &self,
@@ -442,7 +455,8 @@ impl<'a> PhotonMapper<'a> {
             }
             let mut beta = s.weight;
             let mut ray = Ray::new(offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi), s.wi);
-            for bounce in 0..=GATHER_SPECULAR_DEPTH {
+            let (mut specular, mut shortcuts) = (0u32, 0u32);
+            loop {
                 counters.rays += 1;
                 let Some(hit) = scene.geometry.intersect(&ray) else {
                     sum += beta * scene.params.background;
@@ -455,10 +469,23 @@ impl<'a> PhotonMapper<'a> {
                 };
                 let gsh = scene.shading_point(&scene.materials[m as usize], &gp, gwo, 0.0);
                 let gfr = frame(&gsh);
+                let mut short = false;
                 if gsh.bsdf.has_local() {
                     let mut lo = self.direct(&gp, &gfr, &gsh, gwo, sampler, counters);
-                    if let Some(l) = cached_radiance(maps, &gp, &gfr, &gsh, gwo, counters) {
-                        lo += l;
+                    let near = maps
+                        .irradiance
+                        .as_ref()
+                        .and_then(|c| c.lookup_with_radius(gp.p, gfr.ng));
+                    short = shortcuts < SHORT_GATHER_BOUNCES
+                        && near.is_some_and(|(_, r)| hit.t < SHORT_GATHER * r);
+                    if short {
+                        // The caustics here still come from their map; the rest of the light
+                        // arriving here is gathered by the bounce below.
+                        if let Some(map) = &maps.caustic {
+                            lo += counted(map, gp.p, gwo, &gfr, &gsh, counters).radiance;
+                        }
+                    } else if let Some((e, _)) = near.filter(|_| lambertian(&gsh.bsdf)) {
+                        lo += gsh.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e;
                     } else {
                         for map in [&maps.caustic, &maps.global].into_iter().flatten() {
                             lo += counted(map, gp.p, gwo, &gfr, &gsh, counters).radiance;
@@ -466,7 +493,7 @@ impl<'a> PhotonMapper<'a> {
                     }
                     sum += beta * lo;
                 }
-                if bounce == GATHER_SPECULAR_DEPTH || !gsh.bsdf.has_delta() {
+                if !short && (specular == GATHER_SPECULAR_DEPTH || !gsh.bsdf.has_delta()) {
                     break;
                 }
                 let u_lobe = sampler.defer_1d();
@@ -478,7 +505,14 @@ impl<'a> PhotonMapper<'a> {
                 else {
                     break;
                 };
-                if !g.delta {
+                if g.delta {
+                    if specular == GATHER_SPECULAR_DEPTH {
+                        break;
+                    }
+                    specular += 1;
+                } else if short {
+                    shortcuts += 1;
+                } else {
                     break;
                 }
                 beta *= g.weight;
