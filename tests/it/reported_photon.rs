@@ -138,7 +138,7 @@ fn direct_photons(scene: &RenderScene, n: u64) -> Vec<Photon> {
         max_bounces: 0,
         pass: None,
     };
-    trace_map(scene, &[emitter], &CausticTargets::default(), settings).0
+    trace_map(scene, &[emitter], &CausticTargets::default(), settings, None).0
 }
 
 #[test]
@@ -310,5 +310,192 @@ fn final_gathering_near_a_concave_corner_agrees_with_the_path_tracer() {
             (fg / path - 1.0).abs() < 0.03,
             "D = {d}: final gathering {fg}, path {path}"
         );
+    }
+}
+
+// ---- Photon budgets per map, and Ctrl-C during photon passes -----------------------------------
+
+/// Errors of `text` (a RON scene) found by validation, as `path: message` lines.
+fn validation_errors(text: &str) -> Vec<String> {
+    let src = caustic::scene::SourceFile::new(Path::new("inline.ron"), text.to_string())
+        .expect("source");
+    let file = src.parse().unwrap_or_else(|e| panic!("{e}"));
+    caustic::scene::validate::validate(&file)
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| format!("{}: {}", d.path, d.message))
+        .collect()
+}
+
+/// A floor and a mirror ball under lights with the given fields, `photons.caustic` = `shared`.
+fn budget_scene(lights: &[&str], shared: u32) -> String {
+    let lights: Vec<String> = lights
+        .iter()
+        .enumerate()
+        .map(|(i, extra)| {
+            format!("Point(position: ({i}, 2, 0), power: (10, 10, 10){extra})")
+        })
+        .collect();
+    format!(
+        r#"Scene(
+    render: (width: 8, height: 8),
+    camera: Pinhole(eye: (0, 1, 4), look_at: (0, 0, 0), fov_y: 40),
+    photons: (caustic: {shared}),
+    materials: {{ "white": (color: (0.5, 0.5, 0.5)), "mirror": (color: (1, 1, 1), diffuse: 0, reflect: 1) }},
+    lights: [ {} ],
+    nodes: [ Quad(material: "white", size: (4, 4), transform: [RotateX(-90)]), Sphere(material: "mirror", center: (0, 0.5, 0), radius: 0.5) ],
+)"#,
+        lights.join(", ")
+    )
+}
+
+#[test]
+fn a_caustic_map_over_the_photon_limit_is_refused_with_its_memory() {
+    let own = |n: u32| format!(", caustic_photons: {n}");
+    let (a, b) = (own(30_000_000), own(25_000_000));
+    // Two lights' own budgets, each under the limit, add up to one map over it.
+    let e = validation_errors(&budget_scene(&[&a, &b], 1000));
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert!(
+        e[0].starts_with("lights[1].caustic_photons: the caustic map would hold 55000000 photons")
+            && e[0].contains("could need 5.3 GB"),
+        "{e:?}"
+    );
+    // A light without its own budget shares `photons.caustic`, which then counts too.
+    let e = validation_errors(&budget_scene(&[&a, ""], 30_000_000));
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert!(e[0].contains("+ photons.caustic 30000000"), "{e:?}");
+    // When every light has its own budget the shared one is unused, and sums under the limit
+    // are fine.
+    assert!(validation_errors(&budget_scene(&[&a, &own(20_000_000)], 40_000_000)).is_empty());
+    assert!(validation_errors(&budget_scene(&[&a, ""], 20_000_000)).is_empty());
+    // One field over the limit is reported once, by its own check.
+    let e = validation_errors(&budget_scene(&[&own(60_000_000), &b], 0));
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert!(e[0].starts_with("lights[0].caustic_photons: must be at most"), "{e:?}");
+
+    // The reported scene (three lights at 4e7) is refused by `check`, before any work.
+    let scene = case("photon-budget-and-cancel").join("km_plane_three_budgets.ron");
+    let o = caustic(&["check", scene.to_str().expect("utf-8")]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("the caustic map would hold 120000000 photons")
+            && stderr.contains("11.5 GB"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_raised_cancel_flag_stops_photon_tracing_promptly() {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::time::{Duration, Instant};
+
+    use caustic::render::{RenderError, render};
+
+    // 5e7 global photons over a 1 km plane: a minute of tracing on two cores, for the photon
+    // integrator's maps and for a progressive pass alike.
+    for integrator in ["Photon", "Ppm"] {
+        let overrides = SceneOverrides {
+            sets: vec![
+                "photons.global=50000000".into(),
+                format!("render.integrator={integrator}"),
+            ],
+            ..crate::common::small(8, 8, 1)
+        };
+        let scene = caustic::pipeline::prepare(
+            &case("photon-budget-and-cancel").join("km_plane.ron"),
+            &overrides,
+        )
+        .expect("prepares")
+        .render_scene;
+        let flag = Arc::new(AtomicBool::new(false));
+        let raiser = {
+            let flag = Arc::clone(&flag);
+            std::thread::spawn(move || {
+                std::thread::sleep(Duration::from_millis(300));
+                flag.store(true, Ordering::SeqCst);
+                Instant::now()
+            })
+        };
+        let options = RenderOptions {
+            threads: Some(2),
+            cancel: Some(flag),
+            ..RenderOptions::default()
+        };
+        let result = render(&scene, &options);
+        let stopped = Instant::now();
+        let raised = raiser.join().expect("raiser");
+        assert!(
+            matches!(result, Err(RenderError::Cancelled)),
+            "{integrator}: {:?}",
+            result.map(|o| o.stats)
+        );
+        let lag = stopped.saturating_duration_since(raised);
+        assert!(lag < Duration::from_secs(1), "{integrator}: stopped {lag:?} after the flag");
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_and_sigterm_stop_a_photon_pass_within_moments() {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+
+    let dir = case("photon-budget-and-cancel");
+    let tmp = tempfile::tempdir().expect("tmp");
+    // The reported commands: 5e7 photons per pass (64 s on one thread) for `ppm`, and the
+    // photon integrator's one build; the signal comes while photons are traced.
+    for (integrator, signal) in [("ppm", "-INT"), ("photon", "-TERM")] {
+        let out = tmp.path().join(format!("{integrator}.exr"));
+        let mut child = Command::new(env!("CARGO_BIN_EXE_caustic"))
+            .args([
+                "render",
+                "km_plane.ron",
+                "--integrator",
+                integrator,
+                "--photons",
+                "50000000",
+                "--spp",
+                "1",
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--threads",
+                "2",
+                "-o",
+                out.to_str().expect("utf-8"),
+            ])
+            .current_dir(&dir)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("caustic starts");
+        std::thread::sleep(Duration::from_millis(1500));
+        assert!(
+            child.try_wait().expect("wait").is_none(),
+            "{integrator}: still tracing photons after 1.5 s"
+        );
+        let status = Command::new("kill")
+            .args([signal, &child.id().to_string()])
+            .status()
+            .expect("kill runs");
+        assert!(status.success());
+        let sent = Instant::now();
+        while child.try_wait().expect("wait").is_none() && sent.elapsed() < Duration::from_secs(20)
+        {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let lag = sent.elapsed();
+        let _ = child.kill();
+        let o = child.wait_with_output().expect("output");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(130), "{integrator} {signal}: {stderr}");
+        assert!(lag < Duration::from_secs(2), "{integrator}: exited {lag:?} after {signal}");
+        assert_eq!(stderr.trim(), "interrupted: no image written");
+        assert!(!out.exists(), "no image written");
     }
 }

@@ -289,9 +289,14 @@ const LOOKUP_K: usize = 4;
 
 impl IrradianceCache {
     /// Estimates the irradiance of `maps` (summed) at every [`IRRADIANCE_STRIDE`]-th photon of
-    /// `sites` (in parallel, deterministic). `None` when there are no maps or sites.
+    /// `sites` (in parallel, deterministic). `None` when there are no maps or sites, or when
+    /// `cancel` is raised before the points are done (the rest are skipped at once).
     #[must_use]
-    pub fn build(sites: &PhotonMap, maps: &[&PhotonMap]) -> Option<Self> {
+    pub fn build(
+        sites: &PhotonMap,
+        maps: &[&PhotonMap],
+        cancel: Option<&std::sync::atomic::AtomicBool>,
+    ) -> Option<Self> {
         use rayon::prelude::*;
         if maps.is_empty() || sites.is_empty() {
             return None;
@@ -301,6 +306,12 @@ impl IrradianceCache {
             .par_iter()
             .step_by(IRRADIANCE_STRIDE)
             .map(|ph| {
+                if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+                    return IrradiancePoint {
+                        photon: Photon::default(),
+                        radius: 0.0,
+                    };
+                }
                 let (p, n) = (ph.position(), ph.normal());
                 let (e, radius) = maps.iter().fold((Vec3::ZERO, 0.0), |(e, r), m| {
                     let est = m.irradiance(p, n);
@@ -313,6 +324,9 @@ impl IrradianceCache {
                 }
             })
             .collect();
+        if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+            return None;
+        }
         let max_radius = maps.iter().map(|m| m.max_radius).fold(0.0, f32::max);
         let tree = KdTree::build(points).ok()?;
         Some(Self { tree, max_radius })

@@ -114,15 +114,21 @@ pub struct PhotonMapper<'a> {
 
 impl<'a> PhotonMapper<'a> {
     /// Traces the photons and builds the maps (`scene.params.photons`), or reads them from the
-    /// photon-map cache folder `cache` ([`cache::build_or_load`]).
+    /// photon-map cache folder `cache` ([`cache::build_or_load`]). A raised `cancel` (the
+    /// render's Ctrl-C flag) stops the build soon: the maps are then empty and
+    /// [`PhotonSummary::cancelled`], and the render must not go on.
     #[must_use]
-    pub fn new(scene: &'a RenderScene, cache: Option<&std::path::Path>) -> Self {
+    pub fn new(
+        scene: &'a RenderScene,
+        cache: Option<&std::path::Path>,
+        cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    ) -> Self {
         Self {
             scene,
             lights: LightSampler::new(&scene.lights),
             pixel_spread: scene.pixel_spread(),
             final_gather: scene.params.photons.final_gather,
-            maps: cache::build_or_load(scene, cache),
+            maps: cache::build_or_load(scene, cache, cancel),
         }
     }
 
