@@ -19,7 +19,7 @@
 //!   photons;
 //! - photons from the other side of the surface or from another surface are rejected: their
 //!   stored normal must face the query's normal (`nₚ·ng > 0.1`) and their direction must arrive
-//!   from the side of `ωo` (`ωₚ·ng > 10⁻²`), the tests of Mitsuba 0.6's photon map (hard case 12).
+//!   from the side of `ωo` (`ωₚ·ng > 0`), the tests of Mitsuba 0.6's photon map (hard case 12).
 //!
 //! Progressive passes ([`PhotonMap::set_shrink`], `integrators::photon::progressive`) read
 //! only the photons strictly inside `s·r`, `s` ∈ (0, 1], over the area `π (s r)² c`. Given
@@ -48,7 +48,7 @@ pub const MIN_RADIUS_FRACTION: f32 = 1e-3;
 
 /// Smallest landing cosine `|nₚ·ωₚ|` an estimate divides by (the stored directions are rounded
 /// to 6.5e-5 rad, so a grazing photon's could read 0 or below).
-pub const MIN_LANDING_COSINE: f32 = 1e-2;
+pub const MIN_LANDING_COSINE: f32 = 1e-3;
 
 /// The kernel weighing photons by distance within the estimate's disc.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -238,7 +238,8 @@ impl PhotonMap {
 /// The side tests of an estimate at a point of geometric normal `ng`: the photon's incoming
 /// direction `ωₚ` and its landing cosine `cos θₚ = ωₚ·nₚ` with its own stored geometric normal
 /// (at least [`MIN_LANDING_COSINE`]), or `None` when it landed on another surface (stored
-/// normal `nₚ·ng ≤ 0.1`) or arrived from the other side (`ωₚ·ng ≤ 10⁻²`).
+/// normal `nₚ·ng ≤ 0.1`) or arrived from the other side (`ωₚ·ng ≤ 0`, as the BSDF and the
+/// shadow ray see it: a facet lit at a grazing angle keeps its own photons).
 #[inline]
 fn accept(ph: &Photon, ng: Vec3) -> Option<(Vec3, f32)> {
     let np = ph.normal();
@@ -246,7 +247,7 @@ fn accept(ph: &Photon, ng: Vec3) -> Option<(Vec3, f32)> {
         return None;
     }
     let wi = -ph.direction();
-    (wi.dot(ng) > 1e-2).then(|| (wi, wi.dot(np).max(MIN_LANDING_COSINE)))
+    (wi.dot(ng) > 0.0).then(|| (wi, wi.dot(np).max(MIN_LANDING_COSINE)))
 }
 
 /// Precomputed irradiance for final gathering (Christensen, "Faster Photon Map Global
@@ -315,7 +316,11 @@ impl IrradianceCache {
                 let (p, n) = (ph.position(), ph.normal());
                 let (e, radius) = maps.iter().fold((Vec3::ZERO, 0.0), |(e, r), m| {
                     let est = m.irradiance(p, n);
-                    let r = if std::ptr::eq(*m, sites) { est.radius } else { r };
+                    let r = if std::ptr::eq(*m, sites) {
+                        est.radius
+                    } else {
+                        r
+                    };
                     (e + est.radiance, r)
                 });
                 IrradiancePoint {
@@ -500,7 +505,10 @@ mod tests {
                 sum += f64::from(e.radiance.x / lambda);
             }
             let ratio = sum / 200.0;
-            assert!((ratio - 1.0).abs() < 0.03, "max radius {max_radius}: {ratio}");
+            assert!(
+                (ratio - 1.0).abs() < 0.03,
+                "max radius {max_radius}: {ratio}"
+            );
         }
     }
 
