@@ -549,7 +549,10 @@ impl<'a> Validator<'a> {
         }
         let total: u64 = parts.iter().map(|p| u64::from(p.1)).sum();
         // One field over the limit is reported by `photon_count`.
-        if own.is_empty() || total <= u64::from(MAX_PHOTONS) || parts.iter().any(|p| p.1 > MAX_PHOTONS) {
+        if own.is_empty()
+            || total <= u64::from(MAX_PHOTONS)
+            || parts.iter().any(|p| p.1 > MAX_PHOTONS)
+        {
             return;
         }
         let list: Vec<String> = parts.iter().map(|(f, n)| format!("{f} {n}")).collect();

@@ -138,7 +138,14 @@ fn direct_photons(scene: &RenderScene, n: u64) -> Vec<Photon> {
         max_bounces: 0,
         pass: None,
     };
-    trace_map(scene, &[emitter], &CausticTargets::default(), settings, None).0
+    trace_map(
+        scene,
+        &[emitter],
+        &CausticTargets::default(),
+        settings,
+        None,
+    )
+    .0
 }
 
 #[test]
@@ -171,8 +178,8 @@ fn photons_on_a_smooth_shaded_low_poly_ball_read_the_shadow_rays_light_per_face(
     let mut faces = Vec::new();
     for t in &g.triangles {
         let c = (t[0] + t[1] + t[2]) / 3.0;
-        if (t[1] - t[0]).cross(t[2] - t[0]).length() < 1e-6 || (light - c).dot(c - centre) <= 0.0 {
-            continue; // a pole's degenerate corner, or a facet on the dark side
+        if (t[1] - t[0]).cross(t[2] - t[0]).length() < 1e-6 || (light - c).dot(c - centre) <= -0.3 {
+            continue; // a pole's degenerate corner, or a facet well on the dark side
         }
         let (mut est, mut exact, mut n) = (0.0f64, 0.0f64, 0);
         for i in 1..8 {
@@ -184,7 +191,9 @@ fn photons_on_a_smooth_shaded_low_poly_ball_read_the_shadow_rays_light_per_face(
                 let ray = Ray::new(p + out * 0.1, -out);
                 let hit = g.intersect(&ray).expect("the ball is hit");
                 let sp = g.surface(&ray, &hit);
-                let m = scene.objects[sp.object as usize].material.expect("a material");
+                let m = scene.objects[sp.object as usize]
+                    .material
+                    .expect("a material");
                 let sh = scene.shading_point(&scene.materials[m as usize], &sp, out, 0.0);
                 let fr = ShadingFrame {
                     ns: sh.ns,
@@ -218,9 +227,7 @@ fn photons_on_a_smooth_shaded_low_poly_ball_read_the_shadow_rays_light_per_face(
             off.push(format!("{:.3} (lit {:.2})", est / exact, exact / brightest));
         }
     }
-    let (e, x): (f64, f64) = faces
-        .iter()
-        .fold((0.0, 0.0), |s, f| (s.0 + f.0, s.1 + f.1));
+    let (e, x): (f64, f64) = faces.iter().fold((0.0, 0.0), |s, f| (s.0 + f.0, s.1 + f.1));
     eprintln!(
         "{checked} lit facets checked, ball mean ratio {:.4}; off by > 5 %: {off:?}",
         e / x
@@ -306,8 +313,10 @@ fn final_gathering_near_a_concave_corner_agrees_with_the_path_tracer() {
         };
         let (fg, path) = (with("Photon", 16), with("Path", 2048));
         eprintln!("D = {d}: final gathering {fg:.4}, path {path:.4}");
+        // The issue asks for 3 % at every D ≥ 1 cm; 1.5 % holds here (−0.4 % and −0.8 %), and
+        // keeps the short-ray rule needed: without it this box reads −2.6 % at 1 cm.
         assert!(
-            (fg / path - 1.0).abs() < 0.03,
+            (fg / path - 1.0).abs() < 0.015,
             "D = {d}: final gathering {fg}, path {path}"
         );
     }
@@ -317,8 +326,8 @@ fn final_gathering_near_a_concave_corner_agrees_with_the_path_tracer() {
 
 /// Errors of `text` (a RON scene) found by validation, as `path: message` lines.
 fn validation_errors(text: &str) -> Vec<String> {
-    let src = caustic::scene::SourceFile::new(Path::new("inline.ron"), text.to_string())
-        .expect("source");
+    let src =
+        caustic::scene::SourceFile::new(Path::new("inline.ron"), text.to_string()).expect("source");
     let file = src.parse().unwrap_or_else(|e| panic!("{e}"));
     caustic::scene::validate::validate(&file)
         .iter()
@@ -332,9 +341,7 @@ fn budget_scene(lights: &[&str], shared: u32) -> String {
     let lights: Vec<String> = lights
         .iter()
         .enumerate()
-        .map(|(i, extra)| {
-            format!("Point(position: ({i}, 2, 0), power: (10, 10, 10){extra})")
-        })
+        .map(|(i, extra)| format!("Point(position: ({i}, 2, 0), power: (10, 10, 10){extra})"))
         .collect();
     format!(
         r#"Scene(
@@ -372,7 +379,10 @@ fn a_caustic_map_over_the_photon_limit_is_refused_with_its_memory() {
     // One field over the limit is reported once, by its own check.
     let e = validation_errors(&budget_scene(&[&own(60_000_000), &b], 0));
     assert_eq!(e.len(), 1, "{e:?}");
-    assert!(e[0].starts_with("lights[0].caustic_photons: must be at most"), "{e:?}");
+    assert!(
+        e[0].starts_with("lights[0].caustic_photons: must be at most"),
+        "{e:?}"
+    );
 
     // The reported scene (three lights at 4e7) is refused by `check`, before any work.
     let scene = case("photon-budget-and-cancel").join("km_plane_three_budgets.ron");
@@ -433,7 +443,10 @@ fn a_raised_cancel_flag_stops_photon_tracing_promptly() {
             result.map(|o| o.stats)
         );
         let lag = stopped.saturating_duration_since(raised);
-        assert!(lag < Duration::from_secs(1), "{integrator}: stopped {lag:?} after the flag");
+        assert!(
+            lag < Duration::from_secs(1),
+            "{integrator}: stopped {lag:?} after the flag"
+        );
     }
 }
 
@@ -493,8 +506,15 @@ fn ctrl_c_and_sigterm_stop_a_photon_pass_within_moments() {
         let _ = child.kill();
         let o = child.wait_with_output().expect("output");
         let stderr = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(130), "{integrator} {signal}: {stderr}");
-        assert!(lag < Duration::from_secs(2), "{integrator}: exited {lag:?} after {signal}");
+        assert_eq!(
+            o.status.code(),
+            Some(130),
+            "{integrator} {signal}: {stderr}"
+        );
+        assert!(
+            lag < Duration::from_secs(2),
+            "{integrator}: exited {lag:?} after {signal}"
+        );
         assert_eq!(stderr.trim(), "interrupted: no image written");
         assert!(!out.exists(), "no image written");
     }

@@ -111,7 +111,13 @@ impl std::fmt::Display for PhotonSummary {
                     c.stored,
                     mean_flux(c.stored_flux),
                     if c.lost_at_depth > 0 {
-                        format!(", {} cut by max_bounces", c.lost_at_depth)
+                        format!(
+                            ", {} cut by max_bounces carrying {:.4} W, {:.2} % of the flux stored",
+                            c.lost_at_depth,
+                            mean_flux(c.lost_flux),
+                            100.0 * mean_flux(c.lost_flux)
+                                / mean_flux(c.stored_flux).max(f32::MIN_POSITIVE)
+                        )
                     } else {
                         String::new()
                     }
