@@ -65,7 +65,7 @@ pub fn run(args: &PhotonsArgs) -> Result<(), Error> {
     if !args.quiet {
         print_warnings(&prepared.warnings);
     }
-    let maps = build_or_load(&prepared.render_scene, args.photon_cache.as_deref());
+    let maps = build_or_load(&prepared.render_scene, args.photon_cache.as_deref(), None);
     if !args.quiet {
         eprintln!("{}", maps.summary);
     }

@@ -339,7 +339,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         samples: samples_taken,
         light_paths: layers.iter().any(|l| matches!(l, Layer::Part(_))),
     };
-    let job = RenderJob::new(&prepared.render_scene, &options)?;
+    let job = match RenderJob::new(&prepared.render_scene, &options) {
+        // Ctrl-C during photon tracing.
+        Err(RenderError::Cancelled) => {
+            return Err(Error::Interrupted("interrupted: no image written".into()));
+        }
+        other => other?,
+    };
     let maps = job.integrator().photon_maps();
     if !args.quiet
         && let Some(maps) = maps

@@ -216,15 +216,16 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, ObjError> {
         path: path.to_path_buf(),
         at: e.valid_up_to(),
     })?;
+    let text = normalise_line_endings(text);
     let mut mesh = ObjMesh::default();
-    let faces = check_obj_text(text, &mut mesh.names, path)?;
+    let faces = check_obj_text(&text, &mut mesh.names, path)?;
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
         ignore_points: true,
         ignore_lines: true,
     };
-    let mut reader = std::io::BufReader::new(bytes);
+    let mut reader = std::io::BufReader::new(text.as_bytes());
     // Materials come from the scene file, so .mtl files are never opened.
     let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
@@ -333,6 +334,17 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, ObjError> {
         });
     }
     Ok(mesh)
+}
+
+/// `text` with every line ending made `\n`: CRLF (Windows) and a lone CR (classic Mac OS) each
+/// end one line, as LF does, so line numbers stay those an editor shows. tobj splits lines on LF
+/// only, so a CR-only file would otherwise read as one long comment or statement.
+fn normalise_line_endings(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.contains('\r') {
+        std::borrow::Cow::Owned(text.replace("\r\n", "\n").replace('\r', "\n"))
+    } else {
+        std::borrow::Cow::Borrowed(text)
+    }
 }
 
 /// Checks the statements tobj relies on, so errors name the OBJ line: vertex records need

@@ -94,10 +94,22 @@ impl<'a> RenderJob<'a> {
         // Shared state (photon maps; a progressive integrator's first pass) is built on the
         // job's own workers.
         let integrator = pool.install(|| {
-            let mut i = Integrator::prepare_with(scene, options.photon_cache.as_deref());
+            let mut i = Integrator::prepare_cancellable(
+                scene,
+                options.photon_cache.as_deref(),
+                options.cancel.clone(),
+            );
             i.begin_pass(range.start);
             i
         });
+        // A signal during photon tracing left the maps incomplete.
+        if options
+            .cancel
+            .as_deref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+        {
+            return Err(RenderError::Cancelled);
+        }
         if range.end > scene.params.samples_per_pixel || range.start > range.end {
             return Err(RenderError::SampleRange(
                 range.start,

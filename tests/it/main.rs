@@ -30,5 +30,6 @@ mod progressive;
 mod queries;
 mod render_snapshots;
 mod reported;
+mod reported_photon;
 mod textures;
 mod watertight;
