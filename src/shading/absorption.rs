@@ -18,7 +18,9 @@ const CHANNELS: [&str; 3] = ["red", "green", "blue"];
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum AbsorptionError {
     /// A coefficient is negative (the medium would amplify light).
-    #[error("absorption coefficient of the {channel} channel is {value}; it must be ≥ 0 (per metre)")]
+    #[error(
+        "absorption coefficient of the {channel} channel is {value}; it must be ≥ 0 (per metre)"
+    )]
     NegativeCoefficient {
         /// "red", "green" or "blue".
         channel: &'static str,
@@ -26,7 +28,9 @@ pub enum AbsorptionError {
         value: f32,
     },
     /// A coefficient is NaN or infinite.
-    #[error("absorption coefficient of the {channel} channel is {value}; it must be a finite number ≥ 0 (per metre)")]
+    #[error(
+        "absorption coefficient of the {channel} channel is {value}; it must be a finite number ≥ 0 (per metre)"
+    )]
     NonFiniteCoefficient {
         /// "red", "green" or "blue".
         channel: &'static str,
@@ -35,7 +39,9 @@ pub enum AbsorptionError {
     },
     /// A colour-at-depth channel is outside `(0, 1]` (0 would absorb everything in no
     /// distance, above 1 would amplify).
-    #[error("absorption colour of the {channel} channel is {value}; it must be in (0, 1] (the fraction of light left at the given depth)")]
+    #[error(
+        "absorption colour of the {channel} channel is {value}; it must be in (0, 1] (the fraction of light left at the given depth)"
+    )]
     ColourOutOfRange {
         /// "red", "green" or "blue".
         channel: &'static str,
@@ -129,7 +135,11 @@ impl Absorption {
 /// `exp(−σ d)`, with `0 · ∞` read as 0 (no absorption keeps everything).
 #[inline]
 fn attenuate(sigma: f32, d: f32) -> f32 {
-    if sigma == 0.0 { 1.0 } else { (-sigma * d).exp() }
+    if sigma == 0.0 {
+        1.0
+    } else {
+        (-sigma * d).exp()
+    }
 }
 
 #[cfg(test)]
@@ -144,7 +154,12 @@ mod tests {
         assert_eq!(t.z, 1.0);
         // Multiplicative over path segments: T(a + b) = T(a) T(b).
         let (a, b) = (0.7, 1.9);
-        assert!((m.transmittance(a + b) - m.transmittance(a) * m.transmittance(b)).abs().max_element() < 1e-6);
+        assert!(
+            (m.transmittance(a + b) - m.transmittance(a) * m.transmittance(b))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
         assert_eq!(m.transmittance(0.0), Vec3::ONE);
         assert_eq!(m.transmittance(f32::INFINITY), Vec3::new(0.0, 0.0, 1.0));
         assert_eq!(Absorption::CLEAR.transmittance(1e30), Vec3::ONE);
@@ -174,17 +189,26 @@ mod tests {
         use AbsorptionError as E;
         assert_eq!(
             Absorption::from_coefficient([0.1, -0.2, 0.0]),
-            Err(E::NegativeCoefficient { channel: "green", value: -0.2 })
+            Err(E::NegativeCoefficient {
+                channel: "green",
+                value: -0.2
+            })
         );
         assert!(matches!(
             Absorption::from_coefficient([0.0, 0.0, f32::NAN]),
-            Err(E::NonFiniteCoefficient { channel: "blue", .. })
+            Err(E::NonFiniteCoefficient {
+                channel: "blue",
+                ..
+            })
         ));
         assert!(matches!(
             Absorption::from_coefficient([f32::INFINITY, 0.0, 0.0]),
             Err(E::NonFiniteCoefficient { channel: "red", .. })
         ));
-        assert_eq!(Absorption::from_coefficient([-0.0; 3]), Ok(Absorption::CLEAR));
+        assert_eq!(
+            Absorption::from_coefficient([-0.0; 3]),
+            Ok(Absorption::CLEAR)
+        );
         for d in [0.0, -1.0, f32::NAN, f32::INFINITY] {
             assert!(matches!(
                 Absorption::from_colour_at_depth([0.5; 3], d),
@@ -194,10 +218,18 @@ mod tests {
         for c in [0.0, -0.1, 1.01, f32::NAN] {
             assert!(matches!(
                 Absorption::from_colour_at_depth([0.5, c, 0.5], 1.0),
-                Err(E::ColourOutOfRange { channel: "green", .. })
+                Err(E::ColourOutOfRange {
+                    channel: "green",
+                    ..
+                })
             ));
         }
-        let msg = Absorption::from_coefficient([0.0, 0.0, -3.0]).unwrap_err().to_string();
-        assert!(msg.contains("blue") && msg.contains("-3") && msg.contains("≥ 0"), "{msg}");
+        let msg = Absorption::from_coefficient([0.0, 0.0, -3.0])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("blue") && msg.contains("-3") && msg.contains("≥ 0"),
+            "{msg}"
+        );
     }
 }

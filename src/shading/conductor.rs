@@ -242,7 +242,13 @@ mod tests {
 
     #[test]
     fn exact_formula_matches_complex_arithmetic_and_closed_forms() {
-        for (eta, k) in [(0.1556, 3.6024), (3.1071, 3.3314), (1.5, 0.0), (0.05, 4.4), (1.0, 1e-3)] {
+        for (eta, k) in [
+            (0.1556, 3.6024),
+            (3.1071, 3.3314),
+            (1.5, 0.0),
+            (0.05, 4.4),
+            (1.0, 1e-3),
+        ] {
             for i in 0..=90 {
                 let cos = f64::from(i as f32).to_radians().cos();
                 let got = fresnel_conductor(cos as f32, eta as f32, k as f32);
@@ -258,7 +264,8 @@ mod tests {
         }
         // k = 0 is a dielectric seen from outside: glass at normal incidence reflects 4%.
         assert!((fresnel_conductor(1.0, 1.5, 0.0) - 0.04).abs() < 1e-6);
-        let glass_45 = crate::shading::optics::fresnel_dielectric(45f32.to_radians().cos(), 1.0 / 1.5);
+        let glass_45 =
+            crate::shading::optics::fresnel_dielectric(45f32.to_radians().cos(), 1.0 / 1.5);
         assert!((fresnel_conductor(45f32.to_radians().cos(), 1.5, 0.0) - glass_45).abs() < 1e-5);
     }
 
@@ -271,13 +278,22 @@ mod tests {
         let gold = f0(ConductorPreset::Gold);
         let copper = f0(ConductorPreset::Copper);
         assert!(gold.x > gold.y && gold.y > gold.z, "gold is yellow: {gold}");
-        assert!(copper.x > copper.y && copper.x > copper.z, "copper is red: {copper}");
+        assert!(
+            copper.x > copper.y && copper.x > copper.z,
+            "copper is red: {copper}"
+        );
         let silver = f0(ConductorPreset::Silver);
-        assert!(silver.min_element() > 0.97, "silver is the brightest: {silver}");
+        assert!(
+            silver.min_element() > 0.97,
+            "silver is the brightest: {silver}"
+        );
         let al = f0(ConductorPreset::Aluminium);
         assert!(al.min_element() > 0.9 && al.max_element() < 0.93, "{al}");
         let cr = f0(ConductorPreset::Chrome);
-        assert!((cr.max_element() - cr.min_element()) < 0.01 && cr.x > 0.5, "chrome is grey: {cr}");
+        assert!(
+            (cr.max_element() - cr.min_element()) < 0.01 && cr.x > 0.5,
+            "chrome is grey: {cr}"
+        );
         for (p, n) in ConductorPreset::ALL.into_iter().zip(ConductorPreset::NAMES) {
             assert_eq!(ConductorPreset::from_name(n), Some(p));
             assert_eq!(p.name(), n);
@@ -307,11 +323,19 @@ mod tests {
             let exact = ConductorFresnel::Complex { eta, k };
             let fit = ConductorFresnel::f82_fit(eta, k);
             assert!(fit.eval(1.0).distance(exact.eval(1.0)) < 1e-5, "{p:?}");
-            assert!(fit.eval(F82_COS).distance(exact.eval(F82_COS)) < 1e-5, "{p:?}");
+            assert!(
+                fit.eval(F82_COS).distance(exact.eval(F82_COS)) < 1e-5,
+                "{p:?}"
+            );
             for i in 0..=90 {
                 let c = (i as f32).to_radians().cos();
                 let d = (fit.eval(c) - exact.eval(c)).abs().max_element();
-                assert!(d < 0.03, "{p:?} at {i}°: {} vs {}", fit.eval(c), exact.eval(c));
+                assert!(
+                    d < 0.03,
+                    "{p:?} at {i}°: {} vs {}",
+                    fit.eval(c),
+                    exact.eval(c)
+                );
             }
         }
     }

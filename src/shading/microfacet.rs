@@ -157,7 +157,13 @@ mod tests {
         Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
     }
 
-    const DISTRIBUTIONS: [(f32, f32); 5] = [(0.05, 0.05), (0.3, 0.3), (1.0, 1.0), (0.1, 0.5), (0.6, 0.15)];
+    const DISTRIBUTIONS: [(f32, f32); 5] = [
+        (0.05, 0.05),
+        (0.3, 0.3),
+        (1.0, 1.0),
+        (0.1, 0.5),
+        (0.6, 0.15),
+    ];
 
     #[test]
     fn closed_forms_by_hand() {
@@ -190,7 +196,10 @@ mod tests {
         for (ax, ay) in DISTRIBUTIONS {
             let g = Ggx::new(ax, ay);
             let proj = integrate(&bins, |h| g.d(h) * h.z);
-            assert!((proj - 1.0).abs() < 2e-3, "α ({ax}, {ay}): ∫ D cos = {proj}");
+            assert!(
+                (proj - 1.0).abs() < 2e-3,
+                "α ({ax}, {ay}): ∫ D cos = {proj}"
+            );
             for (theta, phi) in [(0.0, 0.0), (45.0, 30.0), (80.0, 0.0), (80.0, 120.0)] {
                 let wo = dir(theta, phi);
                 let vis = integrate(&bins, |h| g.visible_pdf(wo, h));

@@ -155,7 +155,8 @@ impl RoughDielectric {
     #[inline]
     #[must_use]
     pub fn pdf_local(&self, wo: Vec3, wi: Vec3, entering: bool, tint: Vec3) -> f32 {
-        self.eval_local(wo, wi, entering, TransportMode::Radiance, tint).1
+        self.eval_local(wo, wi, entering, TransportMode::Radiance, tint)
+            .1
     }
 
     /// A direction from a visible normal drawn with `u ∈ [0, 1)²`, reflected or refracted as
