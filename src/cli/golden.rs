@@ -102,7 +102,7 @@ pub fn run(args: &GoldenArgs) -> Result<(), Error> {
 }
 
 fn usage(text: String) -> Error {
-    Error::Usage(format!("{text}"))
+    Error::Usage(text)
 }
 
 /// The scene files named: files as given, folders replaced by their `.ron` and `.toml` files

@@ -84,7 +84,7 @@ pub struct Settings {
 impl Settings {
     /// Checks the flags as `render` does before any work.
     fn new(args: &RenderArgs) -> Result<Self, Error> {
-        let usage = |m: String| Error::Usage(format!("{m}"));
+        let usage = |m: String| Error::Usage(m);
         let output = args
             .output
             .clone()
