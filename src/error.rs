@@ -16,15 +16,17 @@ pub enum Error {
     /// The image could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),
-    /// A command-line value is malformed.
-    #[error("{0}")]
+    /// A command-line value (or a file it names) is unusable. The message is bare: its
+    /// `error: ` prefix is added here, in one place, by the error's text.
+    #[error("error: {0}")]
     Usage(String),
     /// The run was interrupted (Ctrl-C); the message says what, if anything, was kept.
     #[error("{0}")]
     Interrupted(String),
     /// A golden-image check failed: the image is further from its reference than allowed
-    /// (`render --compare REF --max-rmse X`); the image was still written.
-    #[error("{0}")]
+    /// (`render --compare REF --max-rmse X`); the image was still written. The message is bare,
+    /// as [`Error::Usage`]'s.
+    #[error("error: {0}")]
     Mismatch(String),
 }
 

@@ -34,6 +34,7 @@ pub mod render;
 pub mod render_scene;
 pub mod sampling;
 pub mod scene;
+pub mod settings;
 pub mod shading;
 pub mod spatial;
 pub mod texture;

@@ -18,8 +18,10 @@ fn main() -> ExitCode {
     }
 }
 
-/// The message of a failed command, every error line starting with `error:` (scene diagnostics
-/// already carry their own `error:` lines; an interruption is reported as `interrupted:`).
+/// The message of a failed command, every error line starting with `error:`. Usage and
+/// golden-check errors carry the prefix in their own text, as do scene diagnostics (their own
+/// `error:` lines) and image-output errors; an interruption is reported as `interrupted:`; the
+/// rest get it here.
 fn error_text(e: &caustic::Error) -> String {
     let text = e.to_string();
     match e {

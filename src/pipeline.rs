@@ -11,6 +11,7 @@ use crate::scene::overrides::apply_overrides;
 use crate::scene::schema::LightSpec;
 use crate::scene::validate::validate;
 use crate::scene::{Diagnostic, SceneError, SceneFile};
+use crate::settings::{IntegratorKind, SamplerKind};
 
 /// Command-line changes to a scene: `--set` assignments and the dedicated render flags.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -27,6 +28,10 @@ pub struct SceneOverrides {
     pub max_depth: Option<u32>,
     /// `render.seed`.
     pub seed: Option<u64>,
+    /// `render.integrator`.
+    pub integrator: Option<IntegratorKind>,
+    /// `render.sampler`.
+    pub sampler: Option<SamplerKind>,
     /// `photons.caustic`, shared by power among all lights (their own `caustic_photons` are
     /// dropped).
     pub caustic_photons: Option<u32>,
@@ -42,6 +47,8 @@ impl SceneOverrides {
         r.samples_per_pixel = self.samples_per_pixel.unwrap_or(r.samples_per_pixel);
         r.max_depth = self.max_depth.unwrap_or(r.max_depth);
         r.seed = self.seed.unwrap_or(r.seed);
+        r.integrator = self.integrator.unwrap_or(r.integrator);
+        r.sampler = self.sampler.unwrap_or(r.sampler);
         if let Some(n) = self.caustic_photons {
             s.photons.caustic = n;
             for l in &mut s.lights {
@@ -73,6 +80,8 @@ impl SceneOverrides {
             ("render.samples_per_pixel", self.samples_per_pixel.is_some()),
             ("render.max_depth", self.max_depth.is_some()),
             ("render.seed", self.seed.is_some()),
+            ("render.integrator", self.integrator.is_some()),
+            ("render.sampler", self.sampler.is_some()),
             ("photons.caustic", self.caustic_photons.is_some()),
         ] {
             if set {

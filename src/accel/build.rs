@@ -2,9 +2,45 @@
 
 use glam::Vec3;
 
-use super::bvh::{BvhNode, LEAF_BLOCK};
 use crate::geometry::Aabb;
 use crate::geometry::float::{next_down, next_up};
+
+/// Build-time binary node. A leaf (`count > 0`) covers primitive slots `index .. index + count`;
+/// an interior node (`count == 0`) has its children at nodes `index` and `index + 1`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BvhNode {
+    /// Lower corner of the node's bounds (padded outward by one ulp).
+    pub min: [f32; 3],
+    /// First child node or first primitive slot.
+    pub index: u32,
+    /// Upper corner of the node's bounds (padded outward by one ulp).
+    pub max: [f32; 3],
+    /// Number of primitives in a leaf, 0 for an interior node.
+    pub count: u32,
+}
+
+/// Leaves start at a multiple of this many slots, so a leaf's primitives fill whole SIMD packs
+/// (slot `s` is lane `s % LEAF_BLOCK` of pack `s / LEAF_BLOCK`).
+pub const LEAF_BLOCK: usize = 4;
+
+impl BvhNode {
+    /// The node's bounds as an [`Aabb`].
+    #[inline]
+    #[must_use]
+    pub fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.min.into(),
+            max: self.max.into(),
+        }
+    }
+
+    /// True for leaves.
+    #[inline]
+    #[must_use]
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+}
 
 const BINS: usize = 16;
 /// Leaves never hold more primitives than this unless they are all coincident-and-unsplittable.

@@ -5,21 +5,9 @@
 
 use wide::f32x8;
 
+use super::build::BvhNode;
+pub use super::build::LEAF_BLOCK;
 use crate::geometry::Aabb;
-
-/// Build-time binary node. A leaf (`count > 0`) covers primitive slots `index .. index + count`;
-/// an interior node (`count == 0`) has its children at nodes `index` and `index + 1`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BvhNode {
-    /// Lower corner of the node's bounds (padded outward by one ulp).
-    pub min: [f32; 3],
-    /// First child node or first primitive slot.
-    pub index: u32,
-    /// Upper corner of the node's bounds (padded outward by one ulp).
-    pub max: [f32; 3],
-    /// Number of primitives in a leaf, 0 for an interior node.
-    pub count: u32,
-}
 
 /// Children per traversal node.
 pub const WIDTH: usize = 8;
@@ -40,10 +28,6 @@ pub struct Node8 {
     /// Leaf size per child (0 = interior or absent).
     pub count: [u32; WIDTH],
 }
-
-/// Leaves start at a multiple of this many slots, so a leaf's primitives fill whole SIMD packs
-/// (slot `s` is lane `s % LEAF_BLOCK` of pack `s / LEAF_BLOCK`).
-pub const LEAF_BLOCK: usize = 4;
 
 /// The `order` entry of a padding slot (after a leaf's last primitive, up to the next block).
 pub const PAD: u32 = u32::MAX;
@@ -76,25 +60,6 @@ pub struct BvhStats {
     pub max_leaf_size: usize,
     /// SAH cost (traversal 1, intersection 1 per primitive) relative to the root's area.
     pub sah_cost: f64,
-}
-
-impl BvhNode {
-    /// The node's bounds as an [`Aabb`].
-    #[inline]
-    #[must_use]
-    pub fn bounds(&self) -> Aabb {
-        Aabb {
-            min: self.min.into(),
-            max: self.max.into(),
-        }
-    }
-
-    /// True for leaves.
-    #[inline]
-    #[must_use]
-    pub fn is_leaf(&self) -> bool {
-        self.count > 0
-    }
 }
 
 /// Slab planes of an absent child: the empty box.

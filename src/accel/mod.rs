@@ -4,5 +4,6 @@ pub(crate) mod build;
 pub mod bvh;
 mod traverse;
 
-pub use bvh::{Bvh, BvhNode, BvhStats, Node8};
+pub use build::BvhNode;
+pub use bvh::{Bvh, BvhStats, Node8};
 pub use traverse::RayBoxTest;

@@ -420,7 +420,7 @@ impl Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::bvh::BvhNode;
+    use crate::accel::BvhNode;
     use crate::geometry::Aabb;
 
     /// A node whose first child is `b` (padded like the builder does) and whose others are absent.

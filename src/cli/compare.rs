@@ -56,7 +56,7 @@ pub fn run(args: &CompareArgs) -> Result<(), Error> {
             .is_some_and(|e| e.eq_ignore_ascii_case("png"));
         if !png {
             return Err(Error::Usage(format!(
-                "error: --error-image `{}`: the error image must end in `.png`",
+                "--error-image `{}`: the error image must end in `.png`",
                 path.display()
             )));
         }
@@ -73,7 +73,7 @@ pub fn run(args: &CompareArgs) -> Result<(), Error> {
     });
     let outside = || {
         Error::Usage(format!(
-            "error: --region {},{},{},{} does not fit in the {w}×{h} images (X + W ≤ {w}, \
+            "--region {},{},{},{} does not fit in the {w}×{h} images (X + W ≤ {w}, \
              Y + H ≤ {h}, W and H at least 1)",
             region.x, region.y, region.width, region.height
         ))

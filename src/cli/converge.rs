@@ -24,7 +24,9 @@ use caustic::render::{RenderJob, RenderOptions};
 use super::compare::figures_json;
 use super::plot::{Curve, Plot};
 use super::render::parse_duration;
-use super::{IntegratorArg, SceneArgs, print_warnings};
+use caustic::settings::IntegratorKind;
+
+use super::{SceneArgs, print_warnings};
 
 /// Samples per pixel a series may reach when `--spp` is not given.
 const SPP_CAP: u32 = 1 << 20;
@@ -39,7 +41,7 @@ pub struct ConvergeArgs {
     reference: PathBuf,
     /// Integrators to measure, comma-separated (the names `--integrator` takes).
     #[arg(long, value_enum, value_delimiter = ',', required = true)]
-    integrators: Vec<IntegratorArg>,
+    integrators: Vec<IntegratorKind>,
     /// Total time, shared equally between the integrators (e.g. `120s`, `2m`).
     #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
     time: Duration,
@@ -66,7 +68,7 @@ struct Point {
 /// One integrator's series.
 #[derive(Debug, Clone)]
 struct Series {
-    integrator: IntegratorArg,
+    integrator: IntegratorKind,
     points: Vec<Point>,
     rays: u64,
     prepare_seconds: f64,
@@ -95,7 +97,7 @@ fn log_log_slope(points: impl Iterator<Item = (f64, f64)>) -> Option<f64> {
 
 impl Series {
     fn name(&self) -> String {
-        self.integrator.cli_name()
+        self.integrator.cli_name().to_string()
     }
 
     /// Slope of RMSE against wall time (log-log).
@@ -155,16 +157,14 @@ fn progress_bar(show: bool, name: &str, share: Duration) -> ProgressBar {
 /// Renders the series of one integrator.
 fn measure(
     args: &ConvergeArgs,
-    integrator: IntegratorArg,
+    integrator: IntegratorKind,
     reference: &Reference,
     share: Duration,
     show: bool,
 ) -> Result<(Series, caustic::render::Film, f32), Error> {
     let t = Instant::now();
     let mut overrides = args.scene.overrides();
-    overrides
-        .sets
-        .push(format!("render.integrator={}", integrator.scene_name()));
+    overrides.integrator = Some(integrator);
     overrides.samples_per_pixel = Some(args.scene.spp.unwrap_or(SPP_CAP));
     let prepared = prepare(&args.scene.scene, &overrides)?;
     if !args.quiet {
@@ -173,7 +173,7 @@ fn measure(
     let params = &prepared.render_scene.params;
     if (params.width, params.height) != (reference.film.width, reference.film.height) {
         return Err(Error::Usage(format!(
-            "error: the reference `{}` is {}×{} but the scene renders {}×{}; give --width {} \
+            "the reference `{}` is {}×{} but the scene renders {}×{}; give --width {} \
              --height {} or a reference of the scene's size",
             reference.path.display(),
             reference.film.width,
@@ -192,7 +192,7 @@ fn measure(
     let mut job = RenderJob::new(&prepared.render_scene, &options)?;
     let prepare_seconds = t.elapsed().as_secs_f64();
     let name = integrator.cli_name();
-    let bar = progress_bar(show, &name, share);
+    let bar = progress_bar(show, name, share);
     let cap = job.samples_per_pixel();
     let mut points = Vec::new();
     let mut render_time = Duration::ZERO;
@@ -204,7 +204,7 @@ fn measure(
         let film = job.snapshot();
         let c = reference
             .compare(&film, Path::new(&name), exposure, None)
-            .map_err(|e| Error::Usage(format!("error: {e}")))?;
+            .map_err(|e| Error::Usage(e.to_string()))?;
         points.push(Point {
             spp: target,
             seconds: render_time.as_secs_f64(),
@@ -268,16 +268,16 @@ fn csv(series: &[Series]) -> String {
 pub fn run(args: &ConvergeArgs) -> Result<(), Error> {
     if args.scene.integrator.is_some() {
         return Err(Error::Usage(
-            "error: converge measures the integrators of --integrators (e.g. `--integrators \
+            "converge measures the integrators of --integrators (e.g. `--integrators \
              path,whitted`); --integrator is for `render`"
                 .into(),
         ));
     }
     if args.threads == Some(0) {
-        return Err(Error::Usage("error: --threads must be at least 1".into()));
+        return Err(Error::Usage("--threads must be at least 1".into()));
     }
     // Each integrator once, in the order given.
-    let mut integrators: Vec<IntegratorArg> = Vec::new();
+    let mut integrators: Vec<IntegratorKind> = Vec::new();
     for &i in &args.integrators {
         if !integrators.contains(&i) {
             integrators.push(i);
@@ -285,7 +285,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), Error> {
     }
     std::fs::create_dir_all(&args.output).map_err(|e| {
         Error::Usage(format!(
-            "error: cannot create the output folder `{}`: {e}",
+            "cannot create the output folder `{}`: {e}",
             args.output.display()
         ))
     })?;
@@ -293,8 +293,8 @@ pub fn run(args: &ConvergeArgs) -> Result<(), Error> {
     for name in ["convergence.csv", "convergence.json", "convergence.png"] {
         caustic::render::output::check_writable(&path(name))?;
     }
-    let reference = Reference::read(&args.reference)
-        .map_err(|e| Error::Usage(format!("error: --reference: {e}")))?;
+    let reference =
+        Reference::read(&args.reference).map_err(|e| Error::Usage(format!("--reference: {e}")))?;
     let load_before = load_average();
     let share = args.time / u32::try_from(integrators.len()).unwrap_or(u32::MAX).max(1);
     let show = !args.quiet && std::io::stderr().is_terminal();

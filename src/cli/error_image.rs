@@ -84,6 +84,18 @@ pub fn zoom(width: u32) -> u32 {
 /// quantity named.
 #[must_use]
 pub fn render(errors: &[f32], width: u32, height: u32, scale: ErrorScale) -> RgbImage {
+    render_named(errors, width, height, scale, "RMS error (linear)")
+}
+
+/// [`render`] with the quantity under the colour bar named `name`.
+#[must_use]
+pub fn render_named(
+    errors: &[f32],
+    width: u32,
+    height: u32,
+    scale: ErrorScale,
+    name: &str,
+) -> RgbImage {
     let z = zoom(width);
     let canvas_w = (width * z).max(MIN_WIDTH);
     let bar_top = height * z + PAD;
@@ -117,7 +129,6 @@ pub fn render(errors: &[f32], width: u32, height: u32, scale: ErrorScale) -> Rgb
     let max = format!(">={}", label(scale.max));
     let right = i64::from(canvas_w - PAD) - i64::from(text_width(&max, 1));
     draw_text(&mut img, right, top, &max, 1, INK);
-    let name = "RMS error (linear)";
     let centre = (i64::from(canvas_w) - i64::from(text_width(name, 1))) / 2;
     draw_text(&mut img, centre, top + i64::from(GLYPH + PAD), name, 1, INK);
     img

@@ -53,10 +53,13 @@ struct PlanArgs {
     /// Number of shards (Slurm array tasks); at most the samples per pixel.
     #[arg(long, value_name = "N")]
     shards: u32,
-    /// Time limit of each shard (and of the photon-cache job), e.g. `2h`, `90m`. A shard
-    /// renders for at most this less a tenth and 30 s, then writes the samples it took.
-    #[arg(long, value_name = "DURATION", default_value = "1h", value_parser = parse_duration)]
-    time: Duration,
+    /// Time limit of each shard (and of the photon-cache job), e.g. `2h`, `90m`; default 1h.
+    /// A shard renders for at most this less a tenth and 30 s, then writes the samples it
+    /// took. Given without `--spp`, the plan is in time, not samples: every shard renders
+    /// passes of its own range of samples until its budget is spent (as `render --time`), so
+    /// any number of shards fits a scene of few samples per pixel.
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
+    time: Option<Duration>,
     /// The job folder to create (must not hold a job already).
     #[arg(short, long, value_name = "DIR")]
     output: PathBuf,
@@ -102,7 +105,7 @@ pub fn run(args: &FarmArgs) -> Result<(), Error> {
 }
 
 fn usage(text: String) -> Error {
-    Error::Usage(format!("error: {text}"))
+    Error::Usage(text)
 }
 
 fn io(path: &Path, e: &std::io::Error) -> Error {
@@ -136,6 +139,12 @@ fn override_record(o: &SceneOverrides) -> Vec<String> {
         if let Some(v) = v {
             out.push(format!("{path}={v}"));
         }
+    }
+    if let Some(i) = o.integrator {
+        out.push(format!("render.integrator={}", i.name()));
+    }
+    if let Some(s) = o.sampler {
+        out.push(format!("render.sampler={}", s.name()));
     }
     out
 }
@@ -177,8 +186,37 @@ fn resolved_scene(scene: &SceneFile, base: &Path, from: &Path) -> Result<String,
     ))
 }
 
+/// Samples per pixel each shard's range holds in a plan in time (`--time` without `--spp`):
+/// more than any shard renders within a Slurm time limit.
+const TIME_PLAN_SPP_PER_SHARD: u32 = 1 << 16;
+
+/// The default time limit of a shard.
+const DEFAULT_TIME: Duration = Duration::from_secs(3600);
+
 fn plan(a: &PlanArgs) -> Result<(), Error> {
-    let overrides = a.scene.overrides();
+    let mut overrides = a.scene.overrides();
+    let time = a.time.unwrap_or(DEFAULT_TIME);
+    // `--time` without `--spp`: a plan in time, every shard renders until its budget.
+    let in_time = a.time.is_some() && overrides.samples_per_pixel.is_none();
+    if in_time {
+        if shard_budget(time).is_none() {
+            return Err(usage(format!(
+                "--time {}s without --spp plans shards that render until their time is spent, which needs a limit of at least 2 minutes; give a longer --time or --spp",
+                time.as_secs()
+            )));
+        }
+        let total = a
+            .shards
+            .checked_mul(TIME_PLAN_SPP_PER_SHARD)
+            .ok_or_else(|| {
+                usage(format!(
+                    "--shards {}: at most {} shards in a plan in time",
+                    a.shards,
+                    u32::MAX / TIME_PLAN_SPP_PER_SHARD
+                ))
+            })?;
+        overrides.samples_per_pixel = Some(total);
+    }
     let source_path = &a.scene.scene;
     let prepared = prepare(source_path, &overrides)?;
     print_warnings(&prepared.warnings);
@@ -198,7 +236,11 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
             count: a.shards,
         }
         .samples(spp)
-        .map_err(|e| usage(e.to_string()))?;
+        .map_err(|e| {
+            usage(format!(
+                "{e}; or give --time without --spp, for shards that render until their time is spent"
+            ))
+        })?;
         ranges.push([r.start, r.end]);
     }
     let dir = &a.output;
@@ -261,8 +303,8 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
         height: p.height,
         integrator: format!("{:?}", p.integrator),
         caustic,
-        time_limit: slurm_time(a.time),
-        shard_budget_seconds: shard_budget(a.time).map(|d| d.as_secs()),
+        time_limit: slurm_time(time),
+        shard_budget_seconds: shard_budget(time).map(|d| d.as_secs()),
         cpus_per_task: a.cpus,
         outputs: vec![format!("{stem}.exr"), format!("{stem}.png")],
     };
@@ -277,8 +319,16 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
     }
     let json = serde_json::to_string_pretty(&m).map_err(|e| usage(e.to_string()))?;
     caustic::render::output::write_atomic(&dir.join(manifest::FILE), json.as_bytes())?;
+    let samples = if in_time {
+        format!(
+            "each rendering its own range of samples per pixel until its budget of {} s is spent",
+            m.shard_budget_seconds.unwrap_or(0)
+        )
+    } else {
+        format!("at {spp} spp")
+    };
     println!(
-        "{}: {} shards of {}×{} at {spp} spp ({}), hash {}; submit with: sbatch {}/render.sbatch",
+        "{}: {} shards of {}×{} {samples} ({}), hash {}; submit with: sbatch {}/render.sbatch",
         dir.display(),
         a.shards,
         p.width,

@@ -1,85 +1,382 @@
-//! `caustic render --compare REF --max-rmse X`: a golden-image check for continuous
-//! integration. The reference is read before rendering (a bad path fails at once, exit code 2);
-//! after the image is written the render is compared with it, the figures are printed, and the
-//! command fails with exit code 3 ([`Error::Mismatch`]) when the RMSE is above the limit.
+//! `caustic golden`: noise-aware snapshot tests. `update` renders each scene and stores its
+//! per-pixel means with the variance of each mean and the settings hash
+//! ([`caustic::render::golden`]); `check` renders again with a fresh seed and decides "same
+//! scene within noise" or "changed" with the block z-test of
+//! [`caustic::render::golden::block_test`] (exit code 3 when a scene changed), writing an
+//! error image and listing the blocks that moved.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+use clap::{Args, Subcommand};
 
 use caustic::Error;
-use caustic::analysis::metrics::Reference;
-use caustic::render::{Film, Region};
+use caustic::farm::part_meta::settings_hash;
+use caustic::pipeline::{SceneOverrides, prepare};
+use caustic::render::golden::{BlockTest, GoldenImage, GoldenMeta, PixelEstimates};
+use caustic::render::{RenderOptions, render};
 
-/// Reads the reference of `--compare`, if given.
-pub fn load(path: Option<&Path>) -> Result<Option<Reference>, Error> {
-    path.map(|p| Reference::read(p).map_err(|e| Error::Usage(format!("error: --compare: {e}"))))
-        .transpose()
+use super::golden_report::{self as report, Outcome};
+use super::{SceneArgs, print_warnings};
+
+/// Arguments of `caustic golden`.
+#[derive(Args)]
+pub struct GoldenArgs {
+    #[command(subcommand)]
+    command: GoldenCommand,
 }
 
-/// Refuses, before rendering, a reference whose size matches neither the image (`width`×
-/// `height`) nor the crop `region` of it.
-pub fn check_size(
-    reference: &Reference,
-    width: u32,
-    height: u32,
-    region: Option<Region>,
-) -> Result<(), Error> {
-    let size = (reference.film.width, reference.film.height);
-    if size == (width, height) || region.is_some_and(|r| size == (r.width, r.height)) {
-        return Ok(());
-    }
-    let crop = region.map_or_else(String::new, |r| {
-        format!(" or the {}×{} of --region", r.width, r.height)
-    });
-    Err(Error::Usage(format!(
-        "error: --compare: the reference `{}` is {}×{} but the image is {width}×{height}{crop}; \
-         give --width/--height to match it",
-        reference.path.display(),
-        size.0,
-        size.1
-    )))
+#[derive(Subcommand)]
+enum GoldenCommand {
+    /// Render each scene (its settings plus the flags given) and store DIR/<file>.golden: the
+    /// image, each pixel's variance of the mean, the settings hash and the flags.
+    Update(UpdateArgs),
+    /// Render each scene again (with the golden's flags, a fresh seed, then the flags given)
+    /// and decide "same within noise" (exit 0) or "changed" (exit 3, with an error image and
+    /// the blocks that moved); see docs/golden.md for the statistic.
+    Check(CheckArgs),
 }
 
-/// Compares the rendered `film` (written to `output`; a crop at `region` if given) with the
-/// reference, prints the figures on one line, and fails when the RMSE exceeds `max_rmse`.
-pub fn check(
-    reference: &Reference,
-    film: &Film,
-    output: &Path,
-    exposure: f32,
-    region: Option<Region>,
-    max_rmse: Option<f64>,
-) -> Result<(), Error> {
-    let c = reference
-        .compare(film, output, exposure, region)
-        .map_err(|e| Error::Usage(format!("error: --compare: {e}")))?;
-    if let Some(note) = &c.note {
-        eprintln!("{note}");
+/// Arguments of `caustic golden update`.
+#[derive(Args)]
+struct UpdateArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// More scene files, or folders whose .ron and .toml files are all taken.
+    #[arg(value_name = "MORE")]
+    more: Vec<PathBuf>,
+    /// The folder of golden images (created if missing).
+    #[arg(short, long, value_name = "DIR")]
+    output: PathBuf,
+    /// Worker threads (default: all cores); never changes the pixels.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No warnings.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Arguments of `caustic golden check`.
+#[derive(Args)]
+struct CheckArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// More scene files, or folders whose .ron and .toml files are all taken.
+    #[arg(value_name = "MORE")]
+    more: Vec<PathBuf>,
+    /// The folder of golden images written by `caustic golden update`.
+    #[arg(long, value_name = "DIR")]
+    golden: PathBuf,
+    /// False-alarm rate per scene: the largest chance that a render of an unchanged scene is
+    /// called changed.
+    #[arg(long, default_value = "0.01", value_parser = parse_alpha)]
+    alpha: f64,
+    /// Block side in pixels.
+    #[arg(long, default_value = "8", value_name = "PIXELS")]
+    block: u32,
+    /// Where error images of changed scenes go (default: the golden folder), as
+    /// <file>.error.png.
+    #[arg(long, value_name = "DIR")]
+    error_dir: Option<PathBuf>,
+    /// Worker threads (default: all cores); never changes the pixels.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No warnings.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn parse_alpha(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|a| *a > 0.0 && *a < 1.0)
+        .ok_or_else(|| format!("expected a probability between 0 and 1, e.g. 0.01, found `{text}`"))
+}
+
+/// Runs `golden update` or `golden check`.
+pub fn run(args: &GoldenArgs) -> Result<(), Error> {
+    match &args.command {
+        GoldenCommand::Update(a) => update(a),
+        GoldenCommand::Check(a) => check(a),
     }
-    let e = c.error;
-    // NaN figures (an image of NaNs) fail too.
-    let fails = max_rmse.is_some_and(|max| e.rmse > max || e.rmse.is_nan());
-    let verdict = match max_rmse {
-        Some(_) if fails => " > --max-rmse: FAIL",
-        Some(_) => " <= --max-rmse: pass",
-        None => "",
+}
+
+fn usage(text: String) -> Error {
+    Error::Usage(text)
+}
+
+/// The scene files named: files as given, folders replaced by their `.ron` and `.toml` files
+/// (sorted); refuses two scenes whose golden files would have the same name.
+fn scene_list(first: &Path, more: &[PathBuf]) -> Result<Vec<PathBuf>, Error> {
+    let mut out = Vec::new();
+    for path in std::iter::once(first).chain(more.iter().map(PathBuf::as_path)) {
+        if path.is_dir() {
+            let entries = std::fs::read_dir(path)
+                .map_err(|e| usage(format!("cannot read the folder `{}`: {e}", path.display())))?;
+            let mut found: Vec<PathBuf> = entries
+                .filter_map(Result::ok)
+                .map(|e| e.path())
+                .filter(|p| {
+                    p.is_file()
+                        && matches!(p.extension().and_then(|e| e.to_str()), Some("ron" | "toml"))
+                })
+                .collect();
+            if found.is_empty() {
+                return Err(usage(format!(
+                    "the folder `{}` holds no scene (.ron or .toml) files",
+                    path.display()
+                )));
+            }
+            found.sort();
+            out.extend(found);
+        } else {
+            out.push(path.to_path_buf());
+        }
+    }
+    let mut names: Vec<(String, &PathBuf)> = out.iter().map(|p| (golden_name(p), p)).collect();
+    names.sort();
+    for w in names.windows(2) {
+        if w[0].0 == w[1].0 {
+            return Err(usage(format!(
+                "`{}` and `{}` would share the golden file `{}`; check them with separate --golden folders",
+                w[0].1.display(),
+                w[1].1.display(),
+                w[0].0
+            )));
+        }
+    }
+    Ok(out)
+}
+
+/// The golden file's name for a scene: its file name and `.golden` (`cornell.ron.golden`).
+fn golden_name(scene: &Path) -> String {
+    let name = scene
+        .file_name()
+        .map_or_else(|| "scene".into(), |n| n.to_string_lossy().into_owned());
+    format!("{name}.golden")
+}
+
+/// The overrides that `update` records for `check` to apply again (all but the seed).
+fn record(o: &SceneOverrides) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = o.sets.iter().map(|s| ("set".into(), s.clone())).collect();
+    for (key, v) in [
+        ("width", o.width),
+        ("height", o.height),
+        ("spp", o.samples_per_pixel),
+        ("max_depth", o.max_depth),
+        ("caustic_photons", o.caustic_photons),
+    ] {
+        if let Some(v) = v {
+            out.push((key.into(), v.to_string()));
+        }
+    }
+    out
+}
+
+/// The golden's recorded overrides, then the check's own on top (its `--set`s after the
+/// golden's, its flags instead of the golden's); the seed is the check's, or the golden's + 1
+/// so that the two renders' noise is independent.
+fn combined(
+    golden: &GoldenMeta,
+    own: &SceneOverrides,
+    path: &Path,
+) -> Result<SceneOverrides, Error> {
+    let mut o = SceneOverrides::default();
+    for (key, value) in &golden.overrides {
+        let num = || {
+            value.parse::<u32>().map_err(|_| {
+                usage(format!(
+                    "`{}`: its recorded flag `{key}={value}` is malformed; run `caustic golden update` again",
+                    path.display()
+                ))
+            })
+        };
+        match key.as_str() {
+            "set" => o.sets.push(value.clone()),
+            "width" => o.width = Some(num()?),
+            "height" => o.height = Some(num()?),
+            "spp" => o.samples_per_pixel = Some(num()?),
+            "max_depth" => o.max_depth = Some(num()?),
+            "caustic_photons" => o.caustic_photons = Some(num()?),
+            _ => {
+                return Err(usage(format!(
+                    "`{}`: unknown recorded flag `{key}` (written by a newer caustic?); run `caustic golden update` again",
+                    path.display()
+                )));
+            }
+        }
+    }
+    o.sets.extend(own.sets.iter().cloned());
+    o.width = own.width.or(o.width);
+    o.height = own.height.or(o.height);
+    o.samples_per_pixel = own.samples_per_pixel.or(o.samples_per_pixel);
+    o.max_depth = own.max_depth.or(o.max_depth);
+    o.caustic_photons = own.caustic_photons.or(o.caustic_photons);
+    o.seed = Some(own.seed.unwrap_or(golden.seed.wrapping_add(1)));
+    Ok(o)
+}
+
+/// A scene rendered for the golden test.
+struct Rendered {
+    estimates: PixelEstimates,
+    meta: GoldenMeta,
+    /// The settings hash as if rendered with `hash_seed` instead of its own seed.
+    hash_at_seed: u64,
+}
+
+/// Prepares and renders `path`; refuses fewer than 2 samples per pixel (no variance).
+fn render_scene(
+    path: &Path,
+    overrides: &SceneOverrides,
+    threads: Option<usize>,
+    quiet: bool,
+    hash_seed: Option<u64>,
+) -> Result<Rendered, Error> {
+    let mut prepared = prepare(path, overrides)?;
+    if !quiet {
+        print_warnings(&prepared.warnings);
+    }
+    let p = &prepared.render_scene.params;
+    if p.samples_per_pixel < 2 {
+        return Err(usage(format!(
+            "`{}`: a golden test needs at least 2 samples per pixel to measure the noise, found {}; give --spp",
+            path.display(),
+            p.samples_per_pixel
+        )));
+    }
+    let hash = settings_hash(&prepared.render_scene);
+    let seed = prepared.render_scene.params.seed;
+    let hash_at_seed = match hash_seed {
+        Some(s) if s != seed => {
+            prepared.render_scene.params.seed = s;
+            let h = settings_hash(&prepared.render_scene);
+            prepared.render_scene.params.seed = seed;
+            h
+        }
+        _ => hash,
     };
-    println!(
-        "against `{}`: rmse {:.6}{verdict}  relMSE {:.6}  mae {:.6}  mean bias {:+.6}  max |diff| {:.6}",
-        reference.path.display(),
-        e.rmse,
-        e.rel_mse,
-        e.mae,
-        e.mean_bias,
-        e.max_abs
-    );
-    match max_rmse {
-        Some(max) if fails => Err(Error::Mismatch(format!(
-            "error: `{}` is further from the reference `{}` than allowed: RMSE {:.6} > \
-             --max-rmse {max} (the image was written; exit code 3)",
-            output.display(),
-            reference.path.display(),
-            e.rmse
-        ))),
-        _ => Ok(()),
+    let options = RenderOptions {
+        threads,
+        ..RenderOptions::default()
+    };
+    let out = render(&prepared.render_scene, &options)?;
+    if out.stats.nan_samples > 0 && !quiet {
+        eprintln!(
+            "warning: `{}`: {} samples were NaN or infinite and were dropped",
+            path.display(),
+            out.stats.nan_samples
+        );
     }
+    let p = &prepared.render_scene.params;
+    let meta = GoldenMeta {
+        hash,
+        seed,
+        spp: p.samples_per_pixel,
+        integrator: format!("{:?}", p.integrator),
+        sampler: format!("{:?}", p.sampler),
+        exposure: p.exposure,
+        scene: path.display().to_string(),
+        overrides: record(overrides),
+        settings: report::settings(&prepared.scene),
+    };
+    Ok(Rendered {
+        estimates: PixelEstimates::from_sums(&out.sums),
+        meta,
+        hash_at_seed,
+    })
+}
+
+fn update(a: &UpdateArgs) -> Result<(), Error> {
+    let scenes = scene_list(&a.scene.scene, &a.more)?;
+    std::fs::create_dir_all(&a.output)
+        .map_err(|e| usage(format!("cannot create `{}`: {e}", a.output.display())))?;
+    let overrides = a.scene.overrides();
+    for path in &scenes {
+        let r = render_scene(path, &overrides, a.threads, a.quiet, None)?;
+        let target = a.output.join(golden_name(path));
+        let (w, h) = (r.estimates.width, r.estimates.height);
+        let (spp, integrator) = (r.meta.spp, r.meta.integrator.clone());
+        GoldenImage {
+            estimates: r.estimates,
+            meta: r.meta,
+        }
+        .write(&target)?;
+        println!(
+            "{}: {w}×{h}, {spp} spp, {integrator}: golden written to `{}`",
+            path.display(),
+            target.display()
+        );
+    }
+    Ok(())
+}
+
+fn check(a: &CheckArgs) -> Result<(), Error> {
+    let scenes = scene_list(&a.scene.scene, &a.more)?;
+    let test = BlockTest {
+        block: a.block,
+        alpha: a.alpha,
+    };
+    if a.block == 0 {
+        return Err(usage("--block must be at least 1 pixel".into()));
+    }
+    let own = a.scene.overrides();
+    let error_dir = a.error_dir.clone().unwrap_or_else(|| a.golden.clone());
+    let (mut changed, mut failed) = (0usize, 0usize);
+    for path in &scenes {
+        match check_one(path, a, &own, &test, &error_dir) {
+            Ok(Outcome::Same) => {}
+            Ok(Outcome::Changed) => changed += 1,
+            Err(e) => {
+                failed += 1;
+                let text = e.to_string();
+                if text.starts_with("error:") || text.contains("\nerror:") {
+                    eprintln!("{text}");
+                } else {
+                    eprintln!("error: {text}");
+                }
+            }
+        }
+    }
+    let n = scenes.len();
+    if failed > 0 {
+        return Err(usage(format!(
+            "{failed} of {n} scenes could not be checked (see above); {changed} changed"
+        )));
+    }
+    if changed > 0 {
+        return Err(Error::Mismatch(format!(
+            "{changed} of {n} scenes changed beyond their noise (exit code 3)"
+        )));
+    }
+    println!("{n} of {n} scenes the same as their golden images within noise");
+    Ok(())
+}
+
+fn check_one(
+    path: &Path,
+    a: &CheckArgs,
+    own: &SceneOverrides,
+    test: &BlockTest,
+    error_dir: &Path,
+) -> Result<Outcome, Error> {
+    let golden_path = a.golden.join(golden_name(path));
+    let golden = GoldenImage::read(&golden_path).map_err(|e| {
+        usage(format!(
+            "{}: {e}; write it with `caustic golden update {} -o {}`",
+            path.display(),
+            path.display(),
+            a.golden.display()
+        ))
+    })?;
+    let overrides = combined(&golden.meta, own, &golden_path)?;
+    let r = render_scene(path, &overrides, a.threads, a.quiet, Some(golden.meta.seed))?;
+    report::report(
+        path,
+        &golden,
+        &r.estimates,
+        &r.meta,
+        r.hash_at_seed,
+        test,
+        error_dir,
+    )
 }

@@ -47,7 +47,7 @@ pub struct Merged {
 }
 
 fn usage(text: String) -> Error {
-    Error::Usage(format!("error: {text}"))
+    Error::Usage(text)
 }
 
 /// Reads one part with its metadata.

@@ -7,20 +7,24 @@ mod debug_pixel;
 mod error_image;
 mod farm;
 mod golden;
+mod golden_report;
+mod max_rmse;
 mod merge;
 mod photons;
 mod pixel_font;
 mod plot;
 mod plot_backend;
+mod preview;
 mod render;
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 
 use caustic::Error;
 use caustic::pipeline::SceneOverrides;
 use caustic::scene::Diagnostic;
+use caustic::settings::{IntegratorKind, SamplerKind};
 
 /// caustic: a ray tracer driven by RON/TOML scene files.
 #[derive(Parser)]
@@ -62,6 +66,13 @@ enum Command {
     /// Render on a Slurm cluster: `farm plan` writes a job folder, `sbatch DIR/render.sbatch`
     /// runs it, `farm status DIR` reports progress (docs/farm.md).
     Farm(farm::FarmArgs),
+    /// Serve a live preview on 127.0.0.1: the render refining pass by pass, restarted whenever
+    /// the scene or an asset it uses changes; takes every `render` flag (docs/preview.md).
+    Preview(preview::PreviewArgs),
+    /// Noise-aware snapshot tests: `golden update SCENES… -o DIR` stores each render with its
+    /// per-pixel variance; `golden check SCENES… --golden DIR` renders again and says "same
+    /// within noise" or "changed" (exit code 3) by a block z-test (docs/golden.md).
+    Golden(golden::GoldenArgs),
 }
 
 /// Runs one command.
@@ -79,52 +90,9 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Photons(args) => photons::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::Farm(args) => farm::run(&args),
+        Command::Preview(args) => preview::run(&args),
+        Command::Golden(args) => golden::run(&args),
     }
-}
-
-/// Light-transport algorithms, as named on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum IntegratorArg {
-    /// Recursive ray tracing: direct light, mirrors and refraction.
-    Whitted,
-    /// Path tracing with next-event estimation and MIS (unbiased global illumination).
-    Path,
-    /// Photon mapping: caustic and global photon maps, final gathering.
-    Photon,
-    /// Progressive photon mapping: fresh maps every pass, shrinking radius (consistent).
-    Ppm,
-    /// Path tracing with caustics from progressive photon maps (consistent).
-    PathPpm,
-}
-
-impl IntegratorArg {
-    /// The scene file's name of the integrator (`render.integrator`).
-    fn scene_name(self) -> &'static str {
-        match self {
-            IntegratorArg::Whitted => "Whitted",
-            IntegratorArg::Path => "Path",
-            IntegratorArg::Photon => "Photon",
-            IntegratorArg::Ppm => "Ppm",
-            IntegratorArg::PathPpm => "PathPpm",
-        }
-    }
-
-    /// The command line's name (`--integrator NAME`).
-    fn cli_name(self) -> String {
-        self.to_possible_value().map_or_else(
-            || self.scene_name().to_lowercase(),
-            |v| v.get_name().to_string(),
-        )
-    }
-}
-
-/// Samplers, as named on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum SamplerArg {
-    /// Independent uniform random numbers.
-    Independent,
-    /// Owen-scrambled Sobol points.
-    Sobol,
 }
 
 /// The scene and the overrides every command that loads one takes.
@@ -152,10 +120,10 @@ pub struct SceneArgs {
     seed: Option<u64>,
     /// Light-transport algorithm (the scene's `render.integrator`).
     #[arg(long, value_enum)]
-    integrator: Option<IntegratorArg>,
+    integrator: Option<IntegratorKind>,
     /// Random-number sampler (the scene's `render.sampler`).
     #[arg(long, value_enum)]
-    sampler: Option<SamplerArg>,
+    sampler: Option<SamplerKind>,
     /// Photons emitted for the global map (`photons.global`; 0: no global map).
     #[arg(long, value_name = "N")]
     photons: Option<u32>,
@@ -177,16 +145,6 @@ pub struct SceneArgs {
 impl SceneArgs {
     fn overrides(&self) -> SceneOverrides {
         let mut sets = self.sets.clone();
-        if let Some(i) = self.integrator {
-            sets.push(format!("render.integrator={}", i.scene_name()));
-        }
-        if let Some(s) = self.sampler {
-            let name = match s {
-                SamplerArg::Independent => "Independent",
-                SamplerArg::Sobol => "Sobol",
-            };
-            sets.push(format!("render.sampler={name}"));
-        }
         for (field, v) in [
             ("photons.global", self.photons),
             ("photons.gather", self.gather),
@@ -207,6 +165,8 @@ impl SceneArgs {
             samples_per_pixel: self.spp,
             max_depth: self.max_depth,
             seed: self.seed,
+            integrator: self.integrator,
+            sampler: self.sampler,
         }
     }
 }

@@ -3,7 +3,8 @@
 //! pixel. The first tool to reach for when a caustic looks wrong.
 //!
 //! Every photon is projected through the pinhole camera to the pixel it falls in (a one-pixel
-//! splat) if the camera sees it: it lies in front of the camera and inside the image, on the side
+//! splat into a [`SplatBuffer`], so the sums do not depend on thread count or order) if the
+//! camera sees it: it lies in front of the camera and inside the image, on the side
 //! of its surface the camera is on (its stored normal faces the eye), and nothing opaque blocks
 //! the segment from the eye to it (a shadow ray that passes through objects with a transmitting
 //! part: caustics under water or behind glass are drawn where they lie, as if the water did not
@@ -22,6 +23,7 @@ use caustic::Error;
 use caustic::geometry::Ray;
 use caustic::integrators::photon::PhotonMap;
 use caustic::integrators::photon::cache::build_or_load;
+use caustic::integrators::splat::SplatBuffer;
 use caustic::pipeline::prepare;
 use caustic::render::output::{OutputFormat, check_writable, srgb_encode, write_image};
 use caustic::render::{Film, RenderOptions, render};
@@ -63,7 +65,7 @@ pub fn run(args: &PhotonsArgs) -> Result<(), Error> {
     if !args.quiet {
         print_warnings(&prepared.warnings);
     }
-    let maps = build_or_load(&prepared.render_scene, args.photon_cache.as_deref());
+    let maps = build_or_load(&prepared.render_scene, args.photon_cache.as_deref(), None);
     if !args.quiet {
         eprintln!("{}", maps.summary);
     }
@@ -123,9 +125,9 @@ pub fn run(args: &PhotonsArgs) -> Result<(), Error> {
     Ok(())
 }
 
-/// The pixel the camera sees `p` in (row-major index), if it sees it: in front, inside the
-/// image, on the side of `normal` the eye is on, and not blocked.
-fn visible_pixel(scene: &RenderScene, p: Vec3, normal: Vec3) -> Option<usize> {
+/// The pixel `(x, y)` the camera sees `p` in, if it sees it: in front, inside the image, on the
+/// side of `normal` the eye is on, and not blocked.
+fn visible_pixel(scene: &RenderScene, p: Vec3, normal: Vec3) -> Option<(u32, u32)> {
     let cam = &scene.camera;
     let (w, h) = (scene.params.width, scene.params.height);
     let d = p - cam.eye;
@@ -154,28 +156,30 @@ fn visible_pixel(scene: &RenderScene, p: Vec3, normal: Vec3) -> Option<usize> {
     {
         return None;
     }
-    Some(fy as usize * w as usize + fx as usize)
+    Some((fx as u32, fy as u32))
 }
 
-/// Per pixel, the summed mean power (W) of the map's visible photons, and how many were visible.
-/// Deterministic: visibility is computed in parallel, summed in photon order.
+/// Per pixel (row-major), the summed mean power (W) of the map's visible photons, and how many
+/// were visible. Each visible photon splats its mean power (as grey) into a [`SplatBuffer`]
+/// from the worker that found it visible: the buffer's exact fixed-point sums make the result
+/// the same for any thread count and order.
 fn splat(scene: &RenderScene, map: &PhotonMap) -> (Vec<f32>, usize) {
-    let n = scene.params.width as usize * scene.params.height as usize;
-    let hits: Vec<Option<(usize, f32)>> = map
+    let (w, h) = (scene.params.width, scene.params.height);
+    let mut splats = SplatBuffer::new(w, h);
+    let drawn = map
         .photons()
         .par_iter()
-        .map(|ph| {
+        .filter(|ph| {
             let power = ph.power();
             visible_pixel(scene, ph.position(), ph.normal())
-                .map(|i| (i, (power.x + power.y + power.z) / 3.0))
+                .map(|(x, y)| splats.add(x, y, Vec3::splat((power.x + power.y + power.z) / 3.0)))
+                .is_some()
         })
+        .count();
+    let sums = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| splats.sum(x, y).x)
         .collect();
-    let mut sums = vec![0.0f32; n];
-    let mut drawn = 0;
-    for (i, w) in hits.into_iter().flatten() {
-        sums[i] += w;
-        drawn += 1;
-    }
     (sums, drawn)
 }
 

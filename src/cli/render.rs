@@ -21,50 +21,50 @@ use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, writ
 use super::{SceneArgs, count, print_warnings};
 
 /// Samples per pixel a `--time` render may reach when `--spp` is not given.
-const BUDGET_SPP_CAP: u32 = 1 << 20;
+pub(super) const BUDGET_SPP_CAP: u32 = 1 << 20;
 
 /// Arguments of `caustic render`.
 #[derive(Args)]
 pub struct RenderArgs {
     #[command(flatten)]
-    scene: SceneArgs,
+    pub(super) scene: SceneArgs,
     /// Output image (.png, .exr, or .part for the mergeable film of per-pixel sums); default:
     /// the scene's name with .png in the current directory.
     #[arg(short, long)]
-    output: Option<PathBuf>,
+    pub(super) output: Option<PathBuf>,
     /// Worker threads (default: all cores).
     #[arg(long)]
-    threads: Option<usize>,
+    pub(super) threads: Option<usize>,
     /// Render only the crop X,Y,W,H (pixels from the top-left); its pixels equal the full render's.
     #[arg(long, value_name = "X,Y,W,H")]
-    region: Option<String>,
+    pub(super) region: Option<String>,
     /// No progress bar and no warnings.
     #[arg(short, long)]
-    quiet: bool,
+    pub(super) quiet: bool,
     /// Print scene and BVH statistics.
     #[arg(long)]
-    stats: bool,
+    pub(super) stats: bool,
     /// Render for this long (e.g. `30s`, `2m`, `1.5h`, or seconds), in passes of samples per
     /// pixel, then write the image; the summary says how many samples per pixel it reached.
     /// `--spp`, if given, still caps the samples.
     #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
-    time: Option<Duration>,
+    pub(super) time: Option<Duration>,
     /// Render in passes of samples per pixel and save the image so far to FILE (.png or .exr,
     /// not the output) after a pass once `--checkpoint-every` seconds have passed since the last
     /// save. Ctrl-C
     /// leaves the last complete checkpoint there; it is removed once the final image is written.
     /// The final image is the same, bit for bit, as without checkpoints.
     #[arg(long, value_name = "FILE")]
-    checkpoint: Option<PathBuf>,
+    pub(super) checkpoint: Option<PathBuf>,
     /// After writing the image, compare it with this reference (PNG or EXR; for a `--region`
     /// render the reference may be the whole image or the crop) and print RMSE, relMSE, mean
     /// absolute error and bias.
     #[arg(long, value_name = "REF")]
-    compare: Option<PathBuf>,
+    pub(super) compare: Option<PathBuf>,
     /// With `--compare`: a golden-image check: exit with code 3 (the image is still written)
     /// when the RMSE against the reference is above this.
     #[arg(long, value_name = "RMSE", requires = "compare", value_parser = parse_max_rmse)]
-    max_rmse: Option<f64>,
+    pub(super) max_rmse: Option<f64>,
     /// Time between checkpoints: seconds, or with a unit (`90s`, `5m`); 0: after every pass.
     #[arg(
         long,
@@ -73,28 +73,28 @@ pub struct RenderArgs {
         requires = "checkpoint",
         value_parser = parse_seconds
     )]
-    checkpoint_every: Duration,
+    pub(super) checkpoint_every: Duration,
     /// Keep the photon maps in this folder and reuse them while only the camera, the image
     /// size or the samples change (photon integrator; a corrupt file is rebuilt).
     #[arg(long, value_name = "DIR")]
-    photon_cache: Option<PathBuf>,
+    pub(super) photon_cache: Option<PathBuf>,
     /// Render only shard I of N (numbered from 1): the sample indices ⌊(I−1)·S/N⌋ to
     /// ⌊I·S/N⌋ − 1 of every pixel (S: samples per pixel), into the mergeable film (the output
     /// must end in `.part`). `caustic merge` joins the shards into the image of one render.
     #[arg(long, value_name = "I/N", conflicts_with = "compare")]
-    shard: Option<String>,
+    pub(super) shard: Option<String>,
     /// Render only the sample indices START to END − 1 of every pixel (of the render's
     /// samples per pixel): with a `.part` output, a shard of your own choosing; as an image,
     /// what merging such parts gives.
     #[arg(long, value_name = "START..END", conflicts_with_all = ["compare", "shard"], value_parser = parse_samples)]
-    samples: Option<Range<u32>>,
+    pub(super) samples: Option<Range<u32>>,
     /// Also write these layers into the `.exr` output beside the image, comma-separated:
     /// specular (emitters and background seen directly or through mirrors and glass), direct
     /// (light after one diffuse or glossy bounce), caustic (light through mirrors or glass onto
     /// a diffuse surface), indirect (two or more bounces), variance (of each pixel's mean),
     /// samples (per pixel); `all` for every one. The four light kinds add up to the image.
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_layers)]
-    layers: Vec<Vec<Layer>>,
+    pub(super) layers: Vec<Vec<Layer>>,
 }
 
 fn parse_layers(text: &str) -> Result<Vec<Layer>, String> {
@@ -173,12 +173,12 @@ pub(super) fn parse_region(text: &str) -> Result<Region, Error> {
             height: *h,
         }),
         _ => Err(Error::Usage(format!(
-            "error: --region `{text}`: expected four non-negative integers X,Y,W,H, e.g. `--region 64,64,128,128`"
+            "--region `{text}`: expected four non-negative integers X,Y,W,H, e.g. `--region 64,64,128,128`"
         ))),
     }
 }
 
-fn default_output(scene: &Path) -> PathBuf {
+pub(super) fn default_output(scene: &Path) -> PathBuf {
     let stem = scene
         .file_stem()
         .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
@@ -234,7 +234,7 @@ impl Interrupt {
 
 /// Whether two paths name the same file (lexically after making them absolute, or the same
 /// existing file).
-fn same_file(a: &Path, b: &Path) -> bool {
+pub(super) fn same_file(a: &Path, b: &Path) -> bool {
     if let (Ok(x), Ok(y)) = (a.canonicalize(), b.canonicalize()) {
         return x == y;
     }
@@ -252,7 +252,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if !is_part(&output) {
         if args.shard.is_some() {
             return Err(Error::Usage(format!(
-                "error: --shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
+                "--shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
                 output.display()
             )));
         }
@@ -261,7 +261,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if !args.layers.is_empty() && !matches!(OutputFormat::for_path(&output), Ok(OutputFormat::Exr))
     {
         return Err(Error::Usage(format!(
-            "error: --layers are written into an EXR file: the output `{}` must end in `.exr`",
+            "--layers are written into an EXR file: the output `{}` must end in `.exr`",
             output.display()
         )));
     }
@@ -270,17 +270,17 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         .as_deref()
         .map(Shard::parse)
         .transpose()
-        .map_err(|e| Error::Usage(format!("error: {e}")))?;
+        .map_err(|e| Error::Usage(e.to_string()))?;
     if let Some(cp) = &args.checkpoint {
         if OutputFormat::for_path(cp).is_err() {
             return Err(Error::Usage(format!(
-                "error: --checkpoint `{}`: the checkpoint must end in `.png` or `.exr`",
+                "--checkpoint `{}`: the checkpoint must end in `.png` or `.exr`",
                 cp.display()
             )));
         }
         if same_file(cp, &output) {
             return Err(Error::Usage(format!(
-                "error: --checkpoint `{}` is the output file; give it a name of its own",
+                "--checkpoint `{}` is the output file; give it a name of its own",
                 cp.display()
             )));
         }
@@ -290,9 +290,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         caustic::render::output::check_writable(path)?;
     }
     let region = args.region.as_deref().map(parse_region).transpose()?;
-    let reference = super::golden::load(args.compare.as_deref())?;
+    let reference = super::max_rmse::load(args.compare.as_deref())?;
     if args.threads == Some(0) {
-        return Err(Error::Usage("error: --threads must be at least 1".into()));
+        return Err(Error::Usage("--threads must be at least 1".into()));
     }
     let mut overrides = args.scene.overrides();
     if args.time.is_some() && overrides.samples_per_pixel.is_none() {
@@ -307,14 +307,14 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     }
     if let Some(reference) = &reference {
         let p = &prepared.render_scene.params;
-        super::golden::check_size(reference, p.width, p.height, region)?;
+        super::max_rmse::check_size(reference, p.width, p.height, region)?;
     }
     let exposure = prepared.render_scene.params.exposure;
     let spp = prepared.render_scene.params.samples_per_pixel;
     let samples = match &args.samples {
         Some(r) if r.end > spp => {
             return Err(Error::Usage(format!(
-                "error: --samples {}..{}: the render has {spp} samples per pixel, so END must be at most {spp}",
+                "--samples {}..{}: the render has {spp} samples per pixel, so END must be at most {spp}",
                 r.start, r.end
             )));
         }
@@ -322,9 +322,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         None => shard
             .map(|s| s.samples(spp))
             .transpose()
-            .map_err(|e| Error::Usage(format!("error: {e}")))?,
+            .map_err(|e| Error::Usage(e.to_string()))?,
     };
     let first_sample = samples.as_ref().map_or(0, |r| r.start);
+    let samples_taken = samples.clone();
     let hash = is_part(&output).then(|| settings_hash(&prepared.render_scene));
     let terminal = !args.quiet && std::io::stderr().is_terminal();
     let mut layers: Vec<Layer> = args.layers.iter().flatten().copied().collect();
@@ -335,14 +336,31 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         progress: terminal && args.time.is_none(),
         cancel: Some(interrupt.start_rendering()),
         photon_cache: args.photon_cache.clone(),
-        samples,
+        samples: samples_taken,
         light_paths: layers.iter().any(|l| matches!(l, Layer::Part(_))),
     };
-    let job = RenderJob::new(&prepared.render_scene, &options)?;
+    let job = match RenderJob::new(&prepared.render_scene, &options) {
+        // Ctrl-C during photon tracing.
+        Err(RenderError::Cancelled) => {
+            return Err(Error::Interrupted("interrupted: no image written".into()));
+        }
+        other => other?,
+    };
+    let maps = job.integrator().photon_maps();
     if !args.quiet
-        && let Some(maps) = job.integrator().photon_maps()
+        && let Some(maps) = maps
     {
         eprintln!("{}", maps.summary);
+    }
+    if !args.quiet
+        && maps.is_none()
+        && let Some(dir) = &args.photon_cache
+    {
+        eprintln!(
+            "warning: --photon-cache `{}` is ignored: the {:?} integrator keeps no photon maps to cache (only `--integrator photon` does; ppm and path-ppm trace fresh maps every pass)",
+            dir.display(),
+            prepared.render_scene.params.integrator
+        );
     }
     let plan = PassPlan {
         checkpoint: args.checkpoint.as_deref().map(|path| CheckpointPlan {
@@ -414,12 +432,25 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let st = &out.stats;
     let secs = st.elapsed.as_secs_f64();
     let reached = st.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1);
+    // A shard or `--samples` range says which samples of the render's it took.
+    let range = match &samples {
+        Some(r) if reached > 0 => format!(
+            " (samples {}..{} of {spp})",
+            r.start,
+            r.start + reached as u32
+        ),
+        Some(r) => format!(" (none of samples {}..{} of {spp})", r.start, r.end),
+        None => String::new(),
+    };
+    let p = &prepared.render_scene.params;
     println!(
-        "{}: {}×{}, {} spp, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
+        "{}: {}×{}, {} spp{range}, {:?} integrator, {:?} sampler, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
         output.display(),
         out.film.width,
         out.film.height,
         reached,
+        p.integrator,
+        p.sampler,
         st.rays,
         secs,
         st.rays as f64 / secs.max(1e-9) / 1e6,
@@ -441,7 +472,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         );
     } else if st.photon_estimates > 0 && !args.quiet {
         eprintln!(
-            "photons: {} estimates, {:.1}% cut short by the largest radius",
+            "photons: {} estimates, {:.1}% cut short by the largest radius (photons.max_radius): those found fewer than the photons they ask for (photons.gather) within it, so they average fewer photons and are noisier; if the image looks blotchy, trace more photons (--photons, --caustic-photons) or raise --max-radius (which blurs more)",
             st.photon_estimates,
             100.0 * st.photon_radius_cut as f64 / st.photon_estimates as f64
         );
@@ -453,7 +484,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         );
     }
     if let Some(reference) = &reference {
-        super::golden::check(
+        super::max_rmse::check(
             reference,
             &out.film,
             &output,
@@ -465,7 +496,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     Ok(())
 }
 
-fn print_stats(s: &caustic::compile::CompileStats) {
+pub(super) fn print_stats(s: &caustic::compile::CompileStats) {
     eprintln!(
         "scene: {} ({} dropped), {}, {}, {}, {}, {}",
         count(s.triangles, "triangle"),

@@ -256,6 +256,17 @@ fn cached<K: Eq + Hash, T>(
     Ok(m)
 }
 
+/// For an asset `file` that does not exist: the did-you-mean against the files beside it.
+pub(super) fn missing_file_help(base_dir: &Path, file: &str) -> Option<String> {
+    if base_dir.join(file).exists() {
+        return None;
+    }
+    let near = crate::scene::diagnostic::did_you_mean_file(base_dir, file)?;
+    Some(format!(
+        "did you mean `{near}`? (a file beside it; paths are relative to the scene file)"
+    ))
+}
+
 /// The diagnostic for an image file of texture `at` that cannot be loaded.
 fn file_error(at: &str, base_dir: &Path, file: &str, e: &TextureError) -> Box<Diagnostic> {
     Box::new(
@@ -267,9 +278,10 @@ fn file_error(at: &str, base_dir: &Path, file: &str, e: &TextureError) -> Box<Di
                 image_error_text(e)
             ),
         )
-        .with_help(match e {
-            TextureError::NonFinite { .. } => "NaN and infinite values mean nothing as a colour or a height; fix or re-export the image",
-            _ => "textures must be PNG, JPEG or EXR files; paths are relative to the scene file",
+        .with_help(match (e, missing_file_help(base_dir, file)) {
+            (_, Some(help)) => help,
+            (TextureError::NonFinite { .. }, None) => "NaN and infinite values mean nothing as a colour or a height; fix or re-export the image".into(),
+            (_, None) => "textures must be PNG, JPEG or EXR files; paths are relative to the scene file".into(),
         }),
     )
 }

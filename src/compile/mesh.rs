@@ -9,6 +9,115 @@ use glam::{Vec2, Vec3};
 
 use super::polygon::triangulate;
 
+/// Why an OBJ file could not be loaded. Each message names the file (and the line, where the
+/// fault is on one) and is a user-facing sentence.
+#[derive(Debug, thiserror::Error)]
+pub enum ObjError {
+    /// The file could not be read.
+    #[error("cannot read OBJ file `{}`: {source}", path.display())]
+    Read {
+        /// The OBJ file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The file is not UTF-8 text.
+    #[error("`{}` is not a text OBJ file (invalid UTF-8 at byte {at})", path.display())]
+    NotText {
+        /// The OBJ file.
+        path: PathBuf,
+        /// Offset of the first byte that is not UTF-8.
+        at: usize,
+    },
+    /// A statement is malformed.
+    #[error("`{}` line {line}: `{text}`: {problem}", path.display())]
+    Line {
+        /// The OBJ file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// The line as written (trimmed).
+        text: String,
+        /// What is wrong with it.
+        problem: LineProblem,
+    },
+    /// `tobj` refused the file.
+    #[error("`{}` is not a valid OBJ file: {source}", path.display())]
+    Invalid {
+        /// The OBJ file.
+        path: PathBuf,
+        /// The parser's error.
+        source: tobj::LoadError,
+    },
+    /// A triangle refers to a record that does not exist.
+    #[error(
+        "`{}` is not a valid OBJ file: face {face} refers to a vertex, normal or texture coordinate that does not exist",
+        path.display()
+    )]
+    MissingRecord {
+        /// The OBJ file.
+        path: PathBuf,
+        /// 1-based triangle (after triangulation).
+        face: usize,
+    },
+    /// The file has no faces.
+    #[error("`{}` contains no faces", path.display())]
+    NoFaces {
+        /// The OBJ file.
+        path: PathBuf,
+    },
+    /// A vertex position is NaN or infinite.
+    #[error("`{}`: vertex {vertex} has a non-finite coordinate", path.display())]
+    NonFinite {
+        /// The OBJ file.
+        path: PathBuf,
+        /// 1-based vertex.
+        vertex: usize,
+    },
+}
+
+/// What is wrong with one OBJ statement ([`ObjError::Line`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum LineProblem {
+    /// A `v`, `vn` or `vt` record with too few numbers (or a word that is not one).
+    #[error("{what} needs {need} or more numbers")]
+    Numbers {
+        /// `a vertex or normal` or `a texture coordinate`.
+        what: &'static str,
+        /// Numbers needed.
+        need: usize,
+    },
+    /// A face with fewer than three corners.
+    #[error("a face needs at least three corners")]
+    FewCorners,
+    /// A face corner that is not `v`, `v/t`, `v//n` or `v/t/n` with integer indices.
+    #[error("`{0}` is not a face corner")]
+    NotACorner(String),
+    /// A face corner's index refers to a record not defined above the face.
+    #[error("the face uses {what} {index}, but only {count} {} defined above it", defined(what, *count))]
+    Undefined {
+        /// `vertex`, `texture coordinate` or `normal`.
+        what: &'static str,
+        /// The index as written (negative: relative to the end).
+        index: i64,
+        /// Records of that kind defined above the face.
+        count: i64,
+    },
+}
+
+/// `vertex is` / `vertices are` (etc.) for `count` records of kind `what`.
+fn defined(what: &str, count: i64) -> String {
+    if count == 1 {
+        return format!("{what} is");
+    }
+    let plural = match what {
+        "vertex" => "vertices",
+        "normal" => "normals",
+        _ => "texture coordinates",
+    };
+    format!("{plural} are")
+}
+
 /// One triangle corner: indices into positions, normals and texture coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Corner {
@@ -79,7 +188,7 @@ impl MeshCache {
 
     /// Loads `path` (or returns the cached copy); the error is a user-facing sentence. The flag
     /// is true on the first load only, so a file's warnings are reported once.
-    pub fn load(&mut self, path: &Path) -> Result<(Rc<ObjMesh>, bool), String> {
+    pub fn load(&mut self, path: &Path) -> Result<(Rc<ObjMesh>, bool), ObjError> {
         if let Some(m) = self.meshes.get(path) {
             return Ok((Rc::clone(m), false));
         }
@@ -89,36 +198,42 @@ impl MeshCache {
     }
 }
 
-fn read_obj(path: &Path) -> Result<ObjMesh, String> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| format!("cannot read OBJ file `{}`: {e}", path.display()))?;
+/// Reads and parses the OBJ file at `path`.
+fn read_obj(path: &Path) -> Result<ObjMesh, ObjError> {
+    let bytes = std::fs::read(path).map_err(|source| ObjError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
     parse_obj(&bytes, path)
 }
 
-/// Parses OBJ bytes (`path` only names the file in messages); the error is a user-facing sentence.
-pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        format!(
-            "`{}` is not a text OBJ file (invalid UTF-8 at byte {})",
-            path.display(),
-            e.valid_up_to()
-        )
+/// Parses OBJ bytes (`path` only names the file in messages).
+///
+/// # Errors
+/// An [`ObjError`] naming the file (and line) when the bytes are not a valid OBJ file.
+pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, ObjError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| ObjError::NotText {
+        path: path.to_path_buf(),
+        at: e.valid_up_to(),
     })?;
+    let text = normalise_line_endings(text);
     let mut mesh = ObjMesh::default();
-    let faces =
-        check_obj_text(text, &mut mesh.names).map_err(|e| format!("`{}` {e}", path.display()))?;
+    let faces = check_obj_text(&text, &mut mesh.names, path)?;
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
         ignore_points: true,
         ignore_lines: true,
     };
-    let mut reader = std::io::BufReader::new(bytes);
+    let mut reader = std::io::BufReader::new(text.as_bytes());
     // Materials come from the scene file, so .mtl files are never opened.
     let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
-    .map_err(|e| format!("`{}` is not a valid OBJ file: {e}", path.display()))?;
+    .map_err(|source| ObjError::Invalid {
+        path: path.to_path_buf(),
+        source,
+    })?;
     let mut faces_seen = 0;
     for model in &models {
         let m = &model.mesh;
@@ -201,26 +316,46 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, String> {
             mesh.triangle_names.resize(mesh.triangles.len(), names);
         }
     }
-    check_indices(&mesh)
-        .map_err(|e| format!("`{}` is not a valid OBJ file: {e}", path.display()))?;
+    if let Some(face) = missing_record(&mesh) {
+        return Err(ObjError::MissingRecord {
+            path: path.to_path_buf(),
+            face,
+        });
+    }
     if mesh.triangles.is_empty() {
-        return Err(format!("`{}` contains no faces", path.display()));
+        return Err(ObjError::NoFaces {
+            path: path.to_path_buf(),
+        });
     }
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
-        return Err(format!(
-            "`{}`: vertex {} has a non-finite coordinate",
-            path.display(),
-            i + 1
-        ));
+        return Err(ObjError::NonFinite {
+            path: path.to_path_buf(),
+            vertex: i + 1,
+        });
     }
     Ok(mesh)
+}
+
+/// `text` with every line ending made `\n`: CRLF (Windows) and a lone CR (classic Mac OS) each
+/// end one line, as LF does, so line numbers stay those an editor shows. tobj splits lines on LF
+/// only, so a CR-only file would otherwise read as one long comment or statement.
+fn normalise_line_endings(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.contains('\r') {
+        std::borrow::Cow::Owned(text.replace("\r\n", "\n").replace('\r', "\n"))
+    } else {
+        std::borrow::Cow::Borrowed(text)
+    }
 }
 
 /// Checks the statements tobj relies on, so errors name the OBJ line: vertex records need
 /// numbers, faces need at least three corners whose indices refer to records defined so far.
 /// Returns each face's 1-based line and names, in file order (tobj keeps that order); the
 /// group and `usemtl` names are added to `names`.
-fn check_obj_text(text: &str, names: &mut Vec<String>) -> Result<Vec<FaceRecord>, String> {
+fn check_obj_text(
+    text: &str,
+    names: &mut Vec<String>,
+    path: &Path,
+) -> Result<Vec<FaceRecord>, ObjError> {
     let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
     let mut faces = Vec::new();
     let mut current = FaceNames::default();
@@ -237,7 +372,12 @@ fn check_obj_text(text: &str, names: &mut Vec<String>) -> Result<Vec<FaceRecord>
     for (n, raw) in text.lines().enumerate() {
         let line = raw.split('#').next().unwrap_or("").trim();
         let mut words = line.split_whitespace();
-        let at = |msg: String| format!("line {}: `{}`: {msg}", n + 1, raw.trim());
+        let at = |problem: LineProblem| ObjError::Line {
+            path: path.to_path_buf(),
+            line: n + 1,
+            text: raw.trim().to_string(),
+            problem,
+        };
         // The name is the rest of the line, as tobj reads it.
         let rest = || {
             line.split_once(char::is_whitespace)
@@ -255,7 +395,7 @@ fn check_obj_text(text: &str, names: &mut Vec<String>) -> Result<Vec<FaceRecord>
                     } else {
                         "a vertex or normal"
                     };
-                    return Err(at(format!("{what} needs {need} or more numbers")));
+                    return Err(at(LineProblem::Numbers { what, need }));
                 }
                 match kind {
                     "v" => v += 1,
@@ -266,7 +406,7 @@ fn check_obj_text(text: &str, names: &mut Vec<String>) -> Result<Vec<FaceRecord>
             Some("f") => {
                 let corners: Vec<&str> = words.collect();
                 if corners.len() < 3 {
-                    return Err(at("a face needs at least three corners".into()));
+                    return Err(at(LineProblem::FewCorners));
                 }
                 faces.push(FaceRecord {
                     line: n + 1,
@@ -284,22 +424,10 @@ fn check_obj_text(text: &str, names: &mut Vec<String>) -> Result<Vec<FaceRecord>
                         }
                         let index: i64 = part
                             .parse()
-                            .map_err(|_| at(format!("`{corner}` is not a face corner")))?;
+                            .map_err(|_| at(LineProblem::NotACorner(corner.to_string())))?;
                         let resolved = if index < 0 { count + index + 1 } else { index };
                         if resolved < 1 || resolved > count {
-                            let plural = match what {
-                                "vertex" => "vertices",
-                                "normal" => "normals",
-                                _ => "texture coordinates",
-                            };
-                            return Err(at(format!(
-                                "the face uses {what} {index}, but only {count} {} defined above it",
-                                if count == 1 {
-                                    format!("{what} is")
-                                } else {
-                                    format!("{plural} are")
-                                }
-                            )));
+                            return Err(at(LineProblem::Undefined { what, index, count }));
                         }
                     }
                 }
@@ -310,20 +438,18 @@ fn check_obj_text(text: &str, names: &mut Vec<String>) -> Result<Vec<FaceRecord>
     Ok(faces)
 }
 
-fn check_indices(mesh: &ObjMesh) -> Result<(), String> {
+/// The first (1-based) triangle with a corner that refers to a position, normal or texture
+/// coordinate that does not exist.
+fn missing_record(mesh: &ObjMesh) -> Option<usize> {
     let (np, nn, nt) = (mesh.positions.len(), mesh.normals.len(), mesh.uvs.len());
-    for (f, tri) in mesh.triangles.iter().enumerate() {
-        for c in tri {
-            let bad = c.p as usize >= np
-                || c.n.is_some_and(|n| n as usize >= nn)
-                || c.t.is_some_and(|t| t as usize >= nt);
-            if bad {
-                return Err(format!(
-                    "face {} refers to a vertex, normal or texture coordinate that does not exist",
-                    f + 1
-                ));
-            }
-        }
-    }
-    Ok(())
+    mesh.triangles
+        .iter()
+        .position(|tri| {
+            tri.iter().any(|c| {
+                c.p as usize >= np
+                    || c.n.is_some_and(|n| n as usize >= nn)
+                    || c.t.is_some_and(|t| t as usize >= nt)
+            })
+        })
+        .map(|f| f + 1)
 }

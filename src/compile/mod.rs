@@ -12,10 +12,9 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use crate::accel::BvhStats;
+use crate::render_scene::PhotonParams;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::render_scene::{Camera, Light, ObjectInfo, RenderParams, RenderScene};
-use crate::render_scene::{IntegratorKind, PhotonParams, TextureFilter};
-use crate::sampling::SamplerKind;
 use crate::scene::Diagnostic;
 use crate::scene::schema::{self, CameraSpec, LightSpec, SceneFile};
 
@@ -171,23 +170,10 @@ pub fn compile(
         seed: r.seed,
         background: r.background.into(),
         exposure: r.exposure,
-        integrator: match r.integrator {
-            schema::IntegratorKind::Whitted => IntegratorKind::Whitted,
-            schema::IntegratorKind::Path => IntegratorKind::Path,
-            schema::IntegratorKind::Photon => IntegratorKind::Photon,
-            schema::IntegratorKind::Ppm => IntegratorKind::Ppm,
-            schema::IntegratorKind::PathPpm => IntegratorKind::PathPpm,
-        },
-        sampler: match r.sampler {
-            schema::SamplerKind::Independent => SamplerKind::Independent,
-            schema::SamplerKind::Sobol => SamplerKind::Sobol,
-        },
+        integrator: r.integrator,
+        sampler: r.sampler,
         diffuse_depth: r.diffuse_depth.unwrap_or(u32::MAX),
-        texture_filter: match r.texture_filter {
-            schema::TextureFilter::Anisotropic => TextureFilter::Anisotropic,
-            schema::TextureFilter::Trilinear => TextureFilter::Trilinear,
-            schema::TextureFilter::Bilinear => TextureFilter::Bilinear,
-        },
+        texture_filter: r.texture_filter,
         photons: photon_params(&scene.photons, &scene.lights),
     };
     let CameraSpec::Pinhole {

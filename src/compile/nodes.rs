@@ -124,9 +124,15 @@ impl Flattener<'_> {
                             self.mesh(&xf, &mesh, *smooth, |_| object);
                         }
                     }
-                    Err(msg) => self
-                        .errors
-                        .push(Diagnostic::error(format!("{path}.file"), msg)),
+                    Err(e) => {
+                        let d = Diagnostic::error(format!("{path}.file"), e.to_string());
+                        self.errors.push(
+                            match super::materials::missing_file_help(self.base_dir, file) {
+                                Some(help) => d.with_help(help),
+                                None => d,
+                            },
+                        );
+                    }
                 }
             }
         }

@@ -6,6 +6,7 @@ pub mod path;
 pub mod photon;
 pub mod progressive;
 pub mod shadow;
+pub mod splat;
 pub mod trace_log;
 pub mod whitted;
 
@@ -148,15 +149,33 @@ impl<'a> Integrator<'a> {
     /// `photon_cache` (`--photon-cache`; see [`photon::cache`]).
     #[must_use]
     pub fn prepare_with(scene: &'a RenderScene, photon_cache: Option<&std::path::Path>) -> Self {
+        Self::prepare_cancellable(scene, photon_cache, None)
+    }
+
+    /// [`Integrator::prepare_with`], whose photon tracing (the photon integrator's maps here,
+    /// a progressive one's in every [`Integrator::begin_pass`]) stops soon after `cancel` is
+    /// raised; check the flag before rendering with the result.
+    #[must_use]
+    pub fn prepare_cancellable(
+        scene: &'a RenderScene,
+        photon_cache: Option<&std::path::Path>,
+        cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    ) -> Self {
         match scene.params.integrator {
             IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(scene)),
             IntegratorKind::Path => Integrator::Path(PathTracer::new(scene)),
             IntegratorKind::Photon => {
-                Integrator::Photon(Box::new(PhotonMapper::new(scene, photon_cache)))
+                Integrator::Photon(Box::new(PhotonMapper::new(scene, photon_cache, cancel)))
             }
-            IntegratorKind::Ppm => Integrator::Ppm(Box::new(ProgressivePath::ppm(scene))),
+            IntegratorKind::Ppm => {
+                let mut p = ProgressivePath::ppm(scene);
+                p.set_cancel(cancel);
+                Integrator::Ppm(Box::new(p))
+            }
             IntegratorKind::PathPpm => {
-                Integrator::PathPpm(Box::new(ProgressivePath::path_ppm(scene)))
+                let mut p = ProgressivePath::path_ppm(scene);
+                p.set_cancel(cancel);
+                Integrator::PathPpm(Box::new(p))
             }
         }
     }

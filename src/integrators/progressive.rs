@@ -77,6 +77,11 @@ impl<'a> ProgressivePath<'a> {
         &self.photons
     }
 
+    /// Makes every later pass's photon tracing stop soon after `cancel` (Ctrl-C) is raised.
+    pub fn set_cancel(&mut self, cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
+        self.photons.set_cancel(cancel);
+    }
+
     /// Makes the maps those of pass `pass` (the sample index about to be taken).
     pub fn begin_pass(&mut self, pass: u32) {
         self.photons.begin_pass(pass);

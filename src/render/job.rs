@@ -94,10 +94,22 @@ impl<'a> RenderJob<'a> {
         // Shared state (photon maps; a progressive integrator's first pass) is built on the
         // job's own workers.
         let integrator = pool.install(|| {
-            let mut i = Integrator::prepare_with(scene, options.photon_cache.as_deref());
+            let mut i = Integrator::prepare_cancellable(
+                scene,
+                options.photon_cache.as_deref(),
+                options.cancel.clone(),
+            );
             i.begin_pass(range.start);
             i
         });
+        // A signal during photon tracing left the maps incomplete.
+        if options
+            .cancel
+            .as_deref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+        {
+            return Err(RenderError::Cancelled);
+        }
         if range.end > scene.params.samples_per_pixel || range.start > range.end {
             return Err(RenderError::SampleRange(
                 range.start,
@@ -223,6 +235,19 @@ impl<'a> RenderJob<'a> {
     #[must_use]
     pub fn sums(&self) -> &PixelSums {
         &self.sums
+    }
+
+    /// The per-kind-of-light-path statistics so far, in `LightPath::ALL` order, when the job
+    /// keeps them ([`RenderOptions::light_paths`]).
+    #[must_use]
+    pub fn parts(&self) -> Option<&[PixelSums]> {
+        self.parts.as_deref()
+    }
+
+    /// Rays traced so far (by complete passes), for a live rays-per-second figure.
+    #[must_use]
+    pub fn rays_traced(&self) -> u64 {
+        self.stats.rays
     }
 
     /// Renders every sample of another `region` of the same image with this job's prepared

@@ -5,15 +5,12 @@
 //! `R, G, B` (the combined image, what viewers show first) and `<layer>.R/G/B` (or
 //! `samples.Y`), the OpenEXR convention for layers in one part.
 
-use std::io::Cursor;
 use std::path::Path;
 
-use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer as ExrLayer, LayerAttributes,
-    SmallVec, Vec2, WritableImage,
-};
+use exr::prelude::{AnyChannel, FlatSamples};
 
 use super::PixelSums;
+use super::exr::{encode_channels, rgb_channels};
 use super::output::{OutputError, write_atomic};
 use crate::integrators::LightPath;
 
@@ -110,78 +107,7 @@ pub fn encode_layers(
             )),
         }
     }
-    encode_channels(w, h, channels, path)
-}
-
-/// Encodes a `width` × `height` RGB image (`value(i)` for pixel `i`, row-major) as EXR bytes:
-/// 32-bit float channels `R, G, B`, lossless compression, written on one thread so that the
-/// same image always gives the same bytes (parallel compression writes its blocks in whatever
-/// order they finish).
-///
-/// # Errors
-/// [`OutputError::Layers`] when the encoder fails.
-pub fn encode_rgb_exr(
-    width: usize,
-    height: usize,
-    value: &dyn Fn(usize) -> glam::Vec3,
-    path: &Path,
-) -> Result<Vec<u8>, OutputError> {
-    let channels = rgb_channels(width * height, "", value).into();
-    encode_channels(width, height, channels, path)
-}
-
-/// Three float channels `<name>.R/G/B` (`R, G, B` for an empty name) of `n` pixels.
-fn rgb_channels(
-    n: usize,
-    name: &str,
-    value: &dyn Fn(usize) -> glam::Vec3,
-) -> [AnyChannel<FlatSamples>; 3] {
-    let mut c = [
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-    ];
-    for v in (0..n).map(value) {
-        c[0].push(v.x);
-        c[1].push(v.y);
-        c[2].push(v.z);
-    }
-    let prefix = if name.is_empty() {
-        String::new()
-    } else {
-        format!("{name}.")
-    };
-    let [r, g, b] = c;
-    [
-        AnyChannel::new(format!("{prefix}R").as_str(), FlatSamples::F32(r)),
-        AnyChannel::new(format!("{prefix}G").as_str(), FlatSamples::F32(g)),
-        AnyChannel::new(format!("{prefix}B").as_str(), FlatSamples::F32(b)),
-    ]
-}
-
-/// One EXR part holding `channels`, encoded on one thread (deterministic bytes).
-fn encode_channels(
-    width: usize,
-    height: usize,
-    channels: Vec<AnyChannel<FlatSamples>>,
-    path: &Path,
-) -> Result<Vec<u8>, OutputError> {
-    let layer = ExrLayer::new(
-        Vec2(width, height),
-        LayerAttributes::default(),
-        Encoding::FAST_LOSSLESS,
-        AnyChannels::sort(SmallVec::from_vec(channels)),
-    );
-    let mut bytes = Cursor::new(Vec::new());
-    Image::from_layer(layer)
-        .write()
-        .non_parallel()
-        .to_buffered(&mut bytes)
-        .map_err(|e| OutputError::Layers {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
-    Ok(bytes.into_inner())
+    encode_channels(w, h, channels).map_err(|e| fail(e.to_string()))
 }
 
 /// [`encode_layers`], written to `path` atomically.
@@ -196,29 +122,4 @@ pub fn write_layers(
 ) -> Result<(), OutputError> {
     let bytes = encode_layers(sums, parts, layers, path)?;
     write_atomic(path, &bytes)
-}
-
-#[cfg(test)]
-mod tests {
-    use std::path::Path;
-
-    use glam::Vec3;
-
-    use super::encode_rgb_exr;
-
-    #[test]
-    fn the_same_image_always_encodes_to_the_same_bytes() {
-        // Large enough for many compressed blocks: a parallel encoder wrote them in whatever
-        // order they finished, so repeated encodings differed.
-        let value = |i: usize| Vec3::new(i as f32 * 1e-3, (i % 97) as f32, (i % 13) as f32 * 0.5);
-        let first = encode_rgb_exr(320, 200, &value, Path::new("x.exr")).expect("encodes");
-        for _ in 0..8 {
-            let again = encode_rgb_exr(320, 200, &value, Path::new("x.exr")).expect("encodes");
-            assert!(again == first, "EXR bytes differ between two encodings");
-        }
-        let image = image::load_from_memory(&first)
-            .expect("decodes")
-            .into_rgb32f();
-        assert_eq!(image.get_pixel(5, 1).0, value(325).to_array());
-    }
 }

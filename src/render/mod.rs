@@ -1,6 +1,8 @@
 //! Rendering: the render job and its tile loop, the film and its mergeable sums, image output.
 
+pub mod exr;
 pub mod film;
+pub mod golden;
 pub mod job;
 pub mod layers;
 pub mod options;

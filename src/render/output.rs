@@ -124,12 +124,13 @@ pub fn encode(film: &Film, path: &Path, exposure: f32) -> Result<Vec<u8>, Output
     let result = match format {
         OutputFormat::Png => to_srgb8(film, exposure).write_to(&mut bytes, ImageFormat::Png),
         OutputFormat::Exr => {
-            return super::layers::encode_rgb_exr(
-                film.width as usize,
-                film.height as usize,
-                &|i| film.pixels[i],
-                path,
-            );
+            return super::exr::encode_rgb_exr(film.width as usize, film.height as usize, &|i| {
+                film.pixels[i]
+            })
+            .map_err(|e| OutputError::Layers {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+            });
         }
     };
     result.map_err(|source| OutputError::Encode {

@@ -10,11 +10,11 @@ use glam::{DVec3, Vec3};
 
 use super::Film;
 use crate::binfile::{Reader, fnv1a};
+use crate::integrators::splat::{SUM_SCALE as SCALE, SplatBuffer, to_fixed as fixed};
 
-/// Fixed-point scale of the sums: samples are rounded to multiples of 2⁻⁶⁴ (about 5.4e-20) before
-/// summing, so even a light of a microwatt keeps 11 significant digits; sums saturate at
-/// 2⁶³ ≈ 9.2e18.
-const SCALE: f64 = 18_446_744_073_709_551_616.0;
+// The fixed-point scale of the sums (`SCALE`, shared with the splat buffer): samples are rounded
+// to multiples of 2⁻⁶⁴ (about 5.4e-20) before summing, so even a light of a microwatt keeps 11
+// significant digits; sums saturate at 2⁶³ ≈ 9.2e18.
 /// Fixed-point scale of the sums of squares: 2⁻³² resolution, saturating at 4e28.
 const SCALE_SQ: f64 = 4_294_967_296.0;
 /// File signature of a `.part` film.
@@ -57,19 +57,6 @@ pub struct PixelSums {
     squares: Vec<[i128; 3]>,
     /// Samples added per pixel (finite samples only; NaN/Inf are counted by the renderer).
     counts: Vec<u32>,
-}
-
-#[inline]
-fn fixed(v: f64, scale: f64) -> i128 {
-    // `as` saturates; inputs are finite (the renderer drops NaN/Inf before they get here).
-    let x = (v * scale).round();
-    // Most samples fit an i64, whose conversion is one instruction; the i128 conversion is a
-    // library call. Both are exact for an integral `x` in range, so the result is the same.
-    if x.abs() < 9.0e18 {
-        x as i64 as i128
-    } else {
-        x as i128
-    }
 }
 
 impl PixelSums {
@@ -124,6 +111,31 @@ impl PixelSums {
         }
         for i in 0..self.counts.len() {
             self.add_pixel(i, other, i);
+        }
+        Ok(())
+    }
+
+    /// Adds the splats of `splats` (same size) into the pixels' sums: each splat counts as a
+    /// sample's value of its pixel, divided by the pixel's sample count like the samples (the
+    /// contract in [`crate::integrators::splat`]); counts and sums of squares are unchanged.
+    /// Exact, so films with splats merge as films without.
+    ///
+    /// # Errors
+    /// [`FilmError::Size`] when the sizes differ.
+    pub fn add_splats(&mut self, splats: &mut SplatBuffer) -> Result<(), FilmError> {
+        if (self.width, self.height) != (splats.width(), splats.height()) {
+            return Err(FilmError::Size(
+                self.width,
+                self.height,
+                splats.width(),
+                splats.height(),
+            ));
+        }
+        for (i, s) in self.sums.iter_mut().enumerate() {
+            let add = splats.fixed_sum(i);
+            for c in 0..3 {
+                s[c] = s[c].saturating_add(add[c]);
+            }
         }
         Ok(())
     }

@@ -20,6 +20,7 @@ pub use texture::Texture;
 use glam::Vec3;
 
 use crate::sampling::SamplerKind;
+pub use crate::settings::{IntegratorKind, TextureFilter};
 
 /// Rendering parameters after command-line overrides.
 #[derive(Debug, Clone, PartialEq)]
@@ -80,32 +81,6 @@ pub struct PhotonParams {
     pub final_gather: u32,
     /// Most bounces of a photon path.
     pub max_bounces: u32,
-}
-
-/// Which light-transport algorithm renders the image (see the scene schema's `integrator`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum IntegratorKind {
-    /// Recursive ray tracing (`integrators::Whitted`).
-    Whitted,
-    /// Path tracing (`integrators::PathTracer`).
-    Path,
-    /// Photon mapping (`integrators::PhotonMapper`).
-    Photon,
-    /// Progressive photon mapping (`integrators::ProgressivePath::ppm`).
-    Ppm,
-    /// Path tracing with progressive photon maps (`integrators::ProgressivePath::path_ppm`).
-    PathPpm,
-}
-
-/// How image textures are filtered (see the scene schema's `texture_filter`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TextureFilter {
-    /// Several trilinear lookups along the footprint's long axis.
-    Anisotropic,
-    /// One trilinear lookup covering the whole footprint.
-    Trilinear,
-    /// Level 0 only, bilinear (aliases; for comparison).
-    Bilinear,
 }
 
 /// A named scene object, for diagnostics and ray-tree dumps.

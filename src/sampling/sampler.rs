@@ -6,40 +6,7 @@
 use super::rng::{Rng, mix64};
 use super::sobol::{shuffled_scrambled_1d_reversed, shuffled_scrambled_2d_reversed, to_unit_f32};
 
-/// Which sequence a [`Sampler`] draws from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum SamplerKind {
-    /// Independent uniform numbers: the PCG32 streams of [`Rng::for_pixel_sample`] (the same
-    /// numbers, in the same order, as the renderer drew before samplers existed).
-    Independent,
-    /// Owen-scrambled Sobol points with Burley's (2020) hash-based shuffling and padding: each
-    /// 1-D or 2-D draw is stratified over a pixel's samples (a (0, 2)-net for 2ᵏ samples).
-    Sobol,
-}
-
-impl SamplerKind {
-    /// The names accepted by [`SamplerKind::from_name`], for messages listing valid values.
-    pub const NAMES: [&'static str; 2] = ["independent", "sobol"];
-
-    /// Parses a sampler name (case-insensitive); `None` for anything else.
-    #[must_use]
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name.to_ascii_lowercase().as_str() {
-            "independent" => Some(Self::Independent),
-            "sobol" => Some(Self::Sobol),
-            _ => None,
-        }
-    }
-
-    /// The lower-case name of this kind.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Independent => "independent",
-            Self::Sobol => "sobol",
-        }
-    }
-}
+pub use crate::settings::SamplerKind;
 
 /// Dimension at which integrator draws start after `start_pixel_sample`: 0 and 1 are the pixel
 /// position (`pixel_2d`).

@@ -4,6 +4,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use super::lexer::{SourceFormat, lex};
 use super::locate::{Location, SourceIndex};
 
 /// How serious a diagnostic is.
@@ -28,6 +29,9 @@ pub struct Diagnostic {
     pub help: Option<String>,
     /// Where in the file, when known.
     pub location: Option<SourcePoint>,
+    /// How `path` is shown when it passes through named nodes (`nodes[2] "ball".radius`);
+    /// `None`: as `path`.
+    pub path_label: Option<String>,
 }
 
 /// A located excerpt of a source file.
@@ -55,6 +59,7 @@ impl Diagnostic {
             message: message.into(),
             help: None,
             location: None,
+            path_label: None,
         }
     }
 
@@ -123,18 +128,10 @@ pub(crate) fn token_width(rest: &str) -> usize {
     let mut chars = rest.chars();
     match chars.next() {
         None => 1,
-        Some('"') => {
-            let mut n = 1;
-            let mut escaped = false;
-            for c in chars {
-                n += 1;
-                if c == '"' && !escaped {
-                    return n;
-                }
-                escaped = c == '\\' && !escaped;
-            }
-            n
-        }
+        // A string, its escapes read by the lexer (the whole rest if it is never closed).
+        Some('"') => lex(rest, SourceFormat::Ron)
+            .first()
+            .map_or(1, |t| rest[..t.end].chars().count()),
         Some(open @ ('(' | '[' | '{')) => {
             let close = match open {
                 '(' => ')',
@@ -174,7 +171,8 @@ impl fmt::Display for Diagnostic {
         if self.path.is_empty() {
             writeln!(f, "{label}: {}", self.message)?;
         } else {
-            writeln!(f, "{label}: {}: {}", short_path(&self.path), self.message)?;
+            let path = self.path_label.as_deref().unwrap_or(&self.path);
+            writeln!(f, "{label}: {}: {}", short_path(path), self.message)?;
         }
         if let Some(p) = &self.location {
             let num = p.line.to_string();
@@ -253,6 +251,27 @@ pub fn did_you_mean<'a>(
         .map(|(_, c)| c)
 }
 
+/// A file beside the missing `file` (in the folder it names, relative to `base_dir`) whose name
+/// is close to its name by edit distance, written the way `file` is (its folder kept), if any.
+#[must_use]
+pub fn did_you_mean_file(base_dir: &Path, file: &str) -> Option<String> {
+    let path = Path::new(file);
+    let name = path.file_name()?.to_str()?;
+    let folder = base_dir.join(path.parent().unwrap_or(Path::new("")));
+    let mut names: Vec<String> = std::fs::read_dir(folder)
+        .ok()?
+        .filter_map(Result::ok)
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .filter_map(|e| e.file_name().into_string().ok())
+        .collect();
+    names.sort();
+    let best = did_you_mean(name, names.iter().map(String::as_str))?;
+    Some(match file.rfind(['/', '\\']) {
+        Some(i) => format!("{}{best}", &file[..=i]),
+        None => best.to_string(),
+    })
+}
+
 /// Rewrites serde's Rust-flavoured wording (`expected f32`, `u32`, `a sequence`) for scene authors.
 #[must_use]
 pub fn humanize(msg: &str) -> String {
@@ -293,6 +312,23 @@ mod tests {
         );
         assert_eq!(did_you_mean("glas", ["glass", "mirror"]), Some("glass"));
         assert_eq!(did_you_mean("zzz", ["glass", "mirror"]), None);
+    }
+
+    #[test]
+    fn missing_files_are_matched_against_their_folder() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        std::fs::create_dir(dir.path().join("assets")).expect("folder");
+        for name in ["wood.png", "water.png", "boat.obj"] {
+            std::fs::write(dir.path().join("assets").join(name), b"").expect("file");
+        }
+        std::fs::write(dir.path().join("wod.png"), b"").expect("file");
+        let near = |f: &str| did_you_mean_file(dir.path(), f);
+        assert_eq!(near("assets/wodo.png").as_deref(), Some("assets/wood.png"));
+        assert_eq!(near("assets/bot.obj").as_deref(), Some("assets/boat.obj"));
+        // Only the folder the path names counts, and a far name gets nothing.
+        assert_eq!(near("wood.png").as_deref(), Some("wod.png"));
+        assert_eq!(near("assets/zzzzzz.tga"), None);
+        assert_eq!(near("nowhere/wood.png"), None);
     }
 
     #[test]

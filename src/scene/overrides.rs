@@ -3,7 +3,7 @@
 use serde_json::Value;
 
 use super::diagnostic::{Diagnostic, did_you_mean, humanize, quoted_list};
-use super::load::SceneError;
+use super::error::SceneError;
 use super::schema::SceneFile;
 
 /// Applies `path=value` assignments in order (e.g. `camera.fov_y=35`, `materials.glass.ior=1.7`,

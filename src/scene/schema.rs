@@ -9,6 +9,8 @@ use std::collections::BTreeMap;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+pub use crate::settings::{IntegratorKind, SamplerKind, TextureFilter};
+
 /// A point or direction `(x, y, z)` in the scene's units.
 pub type Vec3Spec = [f32; 3];
 /// A linear RGB triple.
@@ -94,29 +96,6 @@ impl Default for RenderSettings {
     }
 }
 
-/// Which light-transport algorithm renders the image.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-pub enum IntegratorKind {
-    /// Recursive (Whitted) ray tracing: direct light with shadow rays, mirror and refraction.
-    Whitted,
-    /// Path tracing with next-event estimation and multiple importance sampling: unbiased
-    /// global illumination, the reference the other integrators are checked against.
-    Path,
-    /// Photon mapping (Jensen 2001): direct light by shadow rays, caustics from a caustic photon
-    /// map, indirect light from a global map read directly or by final gathering (`photons`).
-    Photon,
-    /// Progressive photon mapping (Knaus & Zwicker 2011): every sample per pixel is a pass with
-    /// fresh caustic and global maps (`photons.caustic`, `photons.global` photons per pass)
-    /// read directly at the first diffuse hit within a radius that shrinks from pass to pass
-    /// (`photons.alpha`); the image is the mean of the passes and converges to the exact one.
-    Ppm,
-    /// Path tracing with next-event estimation and MIS, with caustics (light → mirror or
-    /// glass → diffuse paths) taken from a progressive caustic photon map at every diffuse
-    /// vertex instead of from emitters hit by chance: consistent, and the default choice for
-    /// scenes with small lights seen through glass or water.
-    PathPpm,
-}
-
 /// Photon-map settings: the report's Settings.hpp photon constants, made explicit. Counts are
 /// photons *emitted*; each light gets a share in proportion to its power (equal-flux photons).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -185,31 +164,6 @@ pub enum PhotonFilter {
         /// Cone slope constant (≥ 1).
         k: f32,
     },
-}
-
-/// Which sequence the integrators draw their random numbers from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-pub enum SamplerKind {
-    /// Independent uniform random numbers per pixel sample.
-    Independent,
-    /// Owen-scrambled Sobol points (Burley 2020): stratified in every pair of dimensions, lower
-    /// error at the same sample count.
-    Sobol,
-}
-
-/// How image textures (bitmaps and height maps) are filtered.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-pub enum TextureFilter {
-    /// Mipmapped over the pixel's footprint on the surface (tracked through mirrors and
-    /// refraction): up to 16 trilinear lookups along the footprint's long axis, each at the
-    /// level of its width. No shimmer or moiré, and sharp at grazing angles.
-    Anisotropic,
-    /// Mipmapped: one trilinear lookup at the level of the footprint's longest extent. No
-    /// shimmer or moiré, but blurry at grazing angles.
-    Trilinear,
-    /// Bilinear lookups in the full-resolution image only: sharp, but distant or grazing
-    /// textures alias (for comparison and debugging).
-    Bilinear,
 }
 
 /// Camera models.

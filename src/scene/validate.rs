@@ -83,6 +83,7 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
             v.photon_count(&format!("lights[{i}].caustic_photons"), n);
         }
     }
+    v.caustic_map_total(scene);
     if scene.nodes.is_empty() {
         v.out.push(Diagnostic::error(
             "nodes",
@@ -531,6 +532,34 @@ impl<'a> Validator<'a> {
                 .with_help("photon maps store up to a few photons per emitted photon at 24 bytes each; use `--time` or `ppm` passes for more"),
             );
         }
+    }
+
+    /// The caustic map's total (every light's own `caustic_photons`, plus `photons.caustic` when
+    /// a light shares it) is bounded as each field is: refused up front, not capped, so no
+    /// light's share changes silently (issue 29: three lights at 4e7 failed to allocate).
+    fn caustic_map_total(&mut self, scene: &SceneFile) {
+        let own: Vec<(usize, u32)> = (scene.lights.iter().enumerate())
+            .filter_map(|(i, l)| l.caustic_photons().map(|n| (i, n)))
+            .collect();
+        let mut parts: Vec<(String, u32)> = (own.iter())
+            .map(|&(i, n)| (format!("lights[{i}].caustic_photons"), n))
+            .collect();
+        if own.len() < scene.lights.len() {
+            parts.push(("photons.caustic".into(), scene.photons.caustic));
+        }
+        let total: u64 = parts.iter().map(|p| u64::from(p.1)).sum();
+        // One field over the limit is reported by `photon_count`.
+        if own.is_empty()
+            || total <= u64::from(MAX_PHOTONS)
+            || parts.iter().any(|p| p.1 > MAX_PHOTONS)
+        {
+            return;
+        }
+        let list: Vec<String> = parts.iter().map(|(f, n)| format!("{f} {n}")).collect();
+        let path = parts[own.len() - 1].0.clone();
+        self.out.push(Diagnostic::error(path, format!(
+            "the caustic map would hold {total} photons ({}), more than the {MAX_PHOTONS} one map may have (a map that size could need {:.1} GB)",
+            list.join(" + "), total as f64 * 24.0 * 4.0 / 1e9)).with_help("every light's caustic photons go into one map: lower the counts, or use `ppm` passes for more"));
     }
 
     fn photons(&mut self, p: &PhotonSettings) {

@@ -22,12 +22,12 @@ pub enum TextureError {
         got: usize,
     },
     /// The image's header claims a size over the texture limits
-    /// ([`MAX_IMAGE_SIDE`](super::mipmap::MAX_IMAGE_SIDE) per side,
-    /// [`MAX_IMAGE_BYTES`](super::mipmap::MAX_IMAGE_BYTES) to load); nothing was allocated for it.
+    /// ([`MAX_IMAGE_SIDE`](super::limits::MAX_IMAGE_SIDE) per side,
+    /// [`MAX_IMAGE_BYTES`](super::limits::MAX_IMAGE_BYTES) to load); nothing was allocated for it.
     #[error(
         "image is {width}x{height} pixels: too large for a texture (at most {max_side} pixels per side and {limit_mib} MiB to load; this one needs {needed_mib} MiB)",
-        max_side = super::mipmap::MAX_IMAGE_SIDE,
-        limit_mib = super::mipmap::MAX_IMAGE_BYTES >> 20,
+        max_side = super::limits::MAX_IMAGE_SIDE,
+        limit_mib = super::limits::MAX_IMAGE_BYTES >> 20,
         needed_mib = needed.div_ceil(1 << 20),
     )]
     TooLarge {

@@ -14,6 +14,7 @@ use glam::{Vec2, Vec3};
 use image::{DynamicImage, ImageDecoder, ImageReader, Limits};
 
 use super::error::TextureError;
+pub use super::limits::{MAX_IMAGE_BYTES, MAX_IMAGE_SIDE};
 
 /// What a pyramid can store: anything that can be weighted and summed (`Vec3` colours, `f32`
 /// heights).
@@ -40,19 +41,6 @@ pub struct MipMap<T = Vec3> {
 
 /// A single-channel pyramid, for height maps.
 pub type GreyMipMap = MipMap<f32>;
-
-/// Largest image side, in pixels, that [`MipMap::open`], [`MipMap::from_bytes`] and their grey
-/// twins accept.
-pub const MAX_IMAGE_SIDE: u32 = 16_384;
-
-/// Most memory, in bytes, that decoding one image file into a pyramid may take: the decoded image
-/// plus, per pixel, twice the texel size (the float conversion and then the pyramid, which is at
-/// most 4/3 of level 0 plus a half-level of scratch). It is checked against the file's header
-/// before any pixel buffer is allocated, and is also the `image` decoders' own allocation limit.
-///
-/// 4 GiB admits 8-bit colour images up to about 12600 × 12600 (27 bytes per pixel, so 8K
-/// textures load) and grey ones up to the side limit (9 bytes per pixel).
-pub const MAX_IMAGE_BYTES: u64 = 4 << 30;
 
 /// Magnitude to which decoded float texels (EXR) are clamped, the largest half-float: values
 /// beyond it mean nothing as a reflectance or a height, and keeping texels well inside `f32`

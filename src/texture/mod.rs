@@ -14,6 +14,7 @@ pub mod bitmap;
 pub mod bump;
 pub mod error;
 pub mod footprint;
+pub mod limits;
 pub mod marble;
 pub mod mipmap;
 pub mod noise;

@@ -420,3 +420,67 @@ fn a_closed_output_pipe_ends_the_program_quietly() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_ne!(out.status.code(), Some(101), "a panic's exit code");
 }
+
+/// One spelling per integrator is not enough (#28): `PathPpm` and `path-ppm` are both accepted
+/// by `--integrator`, `--set` and scene files (RON and TOML), and mean the same integrator.
+#[test]
+fn integrator_names_are_accepted_in_both_spellings_everywhere() {
+    use caustic::pipeline::{SceneOverrides, prepare};
+    use caustic::settings::IntegratorKind;
+    let cornell = root().join("scenes/cornell.ron");
+    for kind in IntegratorKind::ALL {
+        for name in [kind.name(), kind.cli_name()] {
+            let set = SceneOverrides {
+                sets: vec![format!("render.integrator={name}")],
+                ..SceneOverrides::default()
+            };
+            let got = prepare(&cornell, &set).expect("--set takes either spelling");
+            assert_eq!(got.render_scene.params.integrator, *kind, "--set {name}");
+            let cornell = cornell.to_str().expect("utf-8 path");
+            for args in [
+                vec!["check", cornell, "--integrator", name],
+                vec![
+                    "check",
+                    cornell,
+                    "--set",
+                    &format!("render.integrator={name}"),
+                ],
+            ] {
+                let out = caustic(&args);
+                assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+            }
+        }
+    }
+    let dir = tempfile::tempdir().expect("tmp");
+    let ron = std::fs::read_to_string(&cornell).expect("cornell");
+    let toml = std::fs::read_to_string(root().join("scenes/cornell.toml")).expect("cornell.toml");
+    assert!(toml.contains("[render]") && ron.contains("render: ("));
+    for (file, text) in [
+        (
+            "a.ron",
+            ron.replacen("render: (", "render: (integrator: \"path-ppm\", ", 1),
+        ),
+        (
+            "b.ron",
+            ron.replacen("render: (", "render: (integrator: PathPpm, ", 1),
+        ),
+        (
+            "c.toml",
+            toml.replacen("[render]", "[render]\nintegrator = \"path-ppm\"", 1),
+        ),
+        (
+            "d.toml",
+            toml.replacen("[render]", "[render]\nintegrator = \"PathPpm\"", 1),
+        ),
+    ] {
+        let path = dir.path().join(file);
+        std::fs::write(&path, text).expect("write");
+        // Relative asset paths: cornell uses none.
+        let got = prepare(&path, &SceneOverrides::default()).expect(file);
+        assert_eq!(
+            got.render_scene.params.integrator,
+            IntegratorKind::PathPpm,
+            "{file}"
+        );
+    }
+}

@@ -44,7 +44,13 @@ fn direct_photons(scene: &RenderScene, n: u64) -> (Vec<Photon>, TraceCounts) {
         max_bounces: 0,
         pass: None,
     };
-    let (photons, counts) = trace_map(scene, &[emitter], &CausticTargets::default(), settings);
+    let (photons, counts) = trace_map(
+        scene,
+        &[emitter],
+        &CausticTargets::default(),
+        settings,
+        None,
+    );
     (photons, counts[0])
 }
 

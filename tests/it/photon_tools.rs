@@ -102,7 +102,7 @@ fn a_cache_hit_renders_the_same_bytes_as_a_fresh_build() {
     assert_eq!(bits(&hit), bits(&fresh));
     // The loaded maps are the built maps: photons in the same slots, the same radii, counts.
     let built = build_maps(&scene);
-    let loaded = build_or_load(&scene, Some(&dir));
+    let loaded = build_or_load(&scene, Some(&dir), None);
     assert_same_maps(built.caustic.as_ref(), loaded.caustic.as_ref());
     assert_same_maps(built.global.as_ref(), loaded.global.as_ref());
     assert!(built.caustic.as_ref().is_some_and(|m| m.len() > 1000));
@@ -228,7 +228,7 @@ fn a_hit_with_other_gather_settings_equals_a_fresh_build_with_them() {
     let (hit, line) = render_cached(&other, Some(&dir));
     assert!(line.is_some_and(|l| l.starts_with("photon cache: hit")));
     assert_eq!(bits(&hit), bits(&fresh));
-    let loaded = build_or_load(&other, Some(&dir));
+    let loaded = build_or_load(&other, Some(&dir), None);
     assert!(loaded.summary.irradiance_points > 0);
     assert_eq!(
         loaded.summary.irradiance_points,
@@ -242,7 +242,7 @@ fn renders_racing_on_one_cache_leave_a_whole_file() {
     let scene = scene_from_text(&ball_scene());
     let lines: Vec<Option<String>> = std::thread::scope(|s| {
         let handles: Vec<_> = (0..4)
-            .map(|_| s.spawn(|| build_or_load(&scene, Some(&dir)).summary.cache))
+            .map(|_| s.spawn(|| build_or_load(&scene, Some(&dir), None).summary.cache))
             .collect();
         handles
             .into_iter()

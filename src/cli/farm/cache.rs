@@ -19,7 +19,7 @@ pub fn run(dir: &Path, threads: Option<usize>) -> Result<(), Error> {
     let hash = settings_hash(&prepared.render_scene);
     if hash != m.hash_value()? {
         return Err(Error::Usage(format!(
-            "error: `{}` now has settings hash {hash:016x}, not the planned {}: the scene or its assets changed since `caustic farm plan`; plan the job again",
+            "`{}` now has settings hash {hash:016x}, not the planned {}: the scene or its assets changed since `caustic farm plan`; plan the job again",
             dir.join(SCENE).display(),
             m.hash
         )));

@@ -74,20 +74,20 @@ impl Manifest {
         let path = dir.join(FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| {
             Error::Usage(format!(
-                "error: cannot read `{}`: {e} (is `{}` a folder written by `caustic farm plan`?)",
+                "cannot read `{}`: {e} (is `{}` a folder written by `caustic farm plan`?)",
                 path.display(),
                 dir.display()
             ))
         })?;
         let m: Self = serde_json::from_str(&text).map_err(|e| {
             Error::Usage(format!(
-                "error: `{}`: not a caustic farm manifest: {e}",
+                "`{}`: not a caustic farm manifest: {e}",
                 path.display()
             ))
         })?;
         if m.format != FORMAT {
             return Err(Error::Usage(format!(
-                "error: `{}`: format `{}`, expected `{FORMAT}`; plan the job again with this caustic",
+                "`{}`: format `{}`, expected `{FORMAT}`; plan the job again with this caustic",
                 path.display(),
                 m.format
             )));

@@ -21,13 +21,16 @@
 //! `docs/photon_map.md`.)
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
 use super::estimate::{Kernel, PhotonMap};
 use super::maps::{
-    PhotonMaps, PhotonSummary, auto_radius, build_maps, diffuse_area, precompute_irradiance,
+    PhotonMaps, PhotonSummary, auto_radius, build_maps_cancellable, diffuse_area,
+    precompute_irradiance,
 };
 use super::trace::{MapKind, TraceCounts};
 use crate::binfile::{AtomicWrite, Reader, Truncated, fnv1a};
@@ -72,12 +75,17 @@ pub fn cache_file(dir: &Path, key: u64) -> PathBuf {
 }
 
 /// The maps `scene` asks for: read from `cache` (a folder) when it holds them for this scene,
-/// else built with [`build_maps`] and saved there. Never fails: a cache that cannot be read is
-/// rebuilt, one that cannot be written is skipped; `summary.cache` says which happened.
+/// else built with [`build_maps_cancellable`] and saved there. Never fails: a cache that cannot be read is
+/// rebuilt, one that cannot be written is skipped; `summary.cache` says which happened. A
+/// raised `cancel` stops the build ([`PhotonSummary::cancelled`]) and nothing is saved.
 #[must_use]
-pub fn build_or_load(scene: &RenderScene, cache: Option<&Path>) -> PhotonMaps {
+pub fn build_or_load(
+    scene: &RenderScene,
+    cache: Option<&Path>,
+    cancel: Option<Arc<AtomicBool>>,
+) -> PhotonMaps {
     let Some(dir) = cache else {
-        return build_maps(scene);
+        return build_maps_cancellable(scene, cancel);
     };
     let key = cache_key(scene);
     let path = cache_file(dir, key);
@@ -92,7 +100,10 @@ pub fn build_or_load(scene: &RenderScene, cache: Option<&Path>) -> PhotonMaps {
     } else {
         None
     };
-    let mut maps = build_maps(scene);
+    let mut maps = build_maps_cancellable(scene, cancel);
+    if maps.summary.cancelled {
+        return maps;
+    }
     let saved = std::fs::create_dir_all(dir)
         .map_err(|source| CacheError::Io {
             path: dir.to_path_buf(),
@@ -383,7 +394,7 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
     summary.memory = memory;
     summary.trace_time = Duration::ZERO;
     summary.build_time = t0.elapsed();
-    let irradiance = precompute_irradiance(scene, &caustic, &global, &mut summary);
+    let irradiance = precompute_irradiance(scene, &caustic, &global, &mut summary, None);
     Ok(PhotonMaps {
         caustic,
         global,

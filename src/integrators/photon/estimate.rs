@@ -1,7 +1,7 @@
 //! The radiance estimate from a photon map (Jensen 2001, §7.1): the `k` nearest photons within
 //! the map's largest radius, each weighted by the BSDF, over the area of their disc.
 //!
-//! `L(x, ωo) ≈ Σₚ w(dₚ) f(ωo, ωₚ) Φₚ · |ns·ωₚ|/|ng·ωₚ| / (π r² c)` where
+//! `L(x, ωo) ≈ Σₚ w(dₚ) f(ωo, ωₚ) Φₚ · |ns·ωₚ|/|nₚ·ωₚ| / (π r² c)` where
 //! - `r` is the distance of the k-th nearest photon, which itself is left out of the sum: the
 //!   k − 1 photons strictly inside the disc make the estimate unbiased for a uniform density
 //!   (π r_k² λ is Gamma(k)-distributed, so E[(k − 1)/(π r_k²)] = λ; García et al., CGF 2012);
@@ -9,11 +9,17 @@
 //!   every photon counts;
 //! - `w` is the kernel and `c` its normalisation (box: 1, 1; Jensen's cone `1 − d/(k r)`:
 //!   `c = 1 − 2/(3k)`), so a uniform density reads its true value whichever kernel is used;
-//! - `|ns·ωₚ|/|ng·ωₚ|` turns the flux that crossed the geometric surface into the cosine the
-//!   shading normal implies (the camera side of Veach's adjoint rule, §5.3);
+//! - `|ns·ωₚ|/|nₚ·ωₚ|` turns the flux that crossed the geometric surface into the cosine the
+//!   shading normal implies (the camera side of Veach's adjoint rule, §5.3). `nₚ` is the
+//!   geometric normal where the photon *landed* (stored with it), not the query's: on a
+//!   smooth-shaded low-poly mesh a disc near a facet edge holds photons of the neighbouring
+//!   facet, whose flux per area went with their own facet's cosine; dividing by the query
+//!   facet's (near a terminator, ~0) multiplied them 10-25× (issue 29, smooth-normal-photons).
+//!   The divisor is floored at [`MIN_LANDING_COSINE`] against octahedral rounding of grazing
+//!   photons;
 //! - photons from the other side of the surface or from another surface are rejected: their
 //!   stored normal must face the query's normal (`nₚ·ng > 0.1`) and their direction must arrive
-//!   from the side of `ωo` (`ωₚ·ng > 10⁻²`), the tests of Mitsuba 0.6's photon map (hard case 12).
+//!   from the side of `ωo` (`ωₚ·ng > 0`), the tests of Mitsuba 0.6's photon map (hard case 12).
 //!
 //! Progressive passes ([`PhotonMap::set_shrink`], `integrators::photon::progressive`) read
 //! only the photons strictly inside `s·r`, `s` ∈ (0, 1], over the area `π (s r)² c`. Given
@@ -25,17 +31,24 @@
 //! crowd, wide where they are sparse), which a single radius per pass cannot do.
 //!
 //! A radius of 0 (all k photons at one point) is raised to [`MIN_RADIUS_FRACTION`] of the
-//! largest radius, so coincident photons give a finite estimate.
+//! largest radius, so coincident photons give a finite estimate. Any other radius is used as
+//! found: the largest radius only caps a search and never widens a disc, so once it no longer
+//! cuts searches short the estimate does not depend on it (issue 29, estimate-radius-floor).
 
 use std::cell::RefCell;
 
 use glam::Vec3;
 
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
-use crate::spatial::{KdTree, KnnHeap, Photon};
+use crate::spatial::{HasPosition, KdTree, KnnHeap, Photon};
 
-/// The smallest estimate radius as a fraction of the map's largest radius.
+/// The radius given to an estimate whose k nearest photons all lie at one point (a zero radius),
+/// as a fraction of the map's largest radius.
 pub const MIN_RADIUS_FRACTION: f32 = 1e-3;
+
+/// Smallest landing cosine `|nₚ·ωₚ|` an estimate divides by (the stored directions are rounded
+/// to 6.5e-5 rad, so a grazing photon's could read 0 or below).
+pub const MIN_LANDING_COSINE: f32 = 1e-3;
 
 /// The kernel weighing photons by distance within the estimate's disc.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -156,9 +169,9 @@ impl PhotonMap {
     /// the camera side sees it), estimated from the nearest photons. See the module docs.
     #[must_use]
     pub fn estimate(&self, p: Vec3, wo: Vec3, fr: &ShadingFrame, bsdf: &Bsdf) -> Estimate {
-        self.gather(p, fr.ng, |ph, wi, cos_g| {
+        self.gather(p, fr.ng, |ph, wi, cos_p| {
             let cos_s = wi.dot(fr.ns).max(0.0);
-            bsdf.eval(wo, wi, fr, TransportMode::Radiance) * ph.power() * (cos_s / cos_g)
+            bsdf.eval(wo, wi, fr, TransportMode::Radiance) * ph.power() * (cos_s / cos_p)
         })
     }
 
@@ -170,8 +183,8 @@ impl PhotonMap {
     }
 
     /// The density estimate at `p` (surface normal `ng`, on the query's side): the kernel-
-    /// weighted sum of `value(photon, wi, cos θg)` over the accepted photons, over the disc's
-    /// normalised area.
+    /// weighted sum of `value(photon, wi, cos θₚ)` over the accepted photons (`cos θₚ` the
+    /// landing cosine, [`accept`]), over the disc's normalised area.
     fn gather(&self, p: Vec3, ng: Vec3, value: impl Fn(&Photon, Vec3, f32) -> Vec3) -> Estimate {
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
@@ -192,8 +205,13 @@ impl PhotonMap {
                 let far = heap.iter().max_by(|a, b| a.dist2.total_cmp(&b.dist2));
                 (heap.max_dist2().unwrap_or(max2), far.map(|n| n.index))
             };
-            let min_r = self.max_radius * MIN_RADIUS_FRACTION;
-            let r2 = r2.max(min_r * min_r) * self.shrink * self.shrink;
+            let r2 = if r2 > 0.0 {
+                r2
+            } else {
+                let min_r = self.max_radius * MIN_RADIUS_FRACTION;
+                min_r * min_r
+            };
+            let r2 = r2 * self.shrink * self.shrink;
             let r = r2.sqrt();
             let photons = self.tree.items();
             let mut sum = Vec3::ZERO;
@@ -218,31 +236,50 @@ impl PhotonMap {
 }
 
 /// The side tests of an estimate at a point of geometric normal `ng`: the photon's incoming
-/// direction `ωₚ` and `cos θg = ωₚ·ng`, or `None` when it landed on another surface (stored
-/// normal `nₚ·ng ≤ 0.1`) or arrived from the other side (`ωₚ·ng ≤ 10⁻²`).
+/// direction `ωₚ` and its landing cosine `cos θₚ = ωₚ·nₚ` with its own stored geometric normal
+/// (at least [`MIN_LANDING_COSINE`]), or `None` when it landed on another surface (stored
+/// normal `nₚ·ng ≤ 0.1`) or arrived from the other side (`ωₚ·ng ≤ 0`, as the BSDF and the
+/// shadow ray see it: a facet lit at a grazing angle keeps its own photons).
 #[inline]
 fn accept(ph: &Photon, ng: Vec3) -> Option<(Vec3, f32)> {
-    if ph.normal().dot(ng) <= 0.1 {
+    let np = ph.normal();
+    if np.dot(ng) <= 0.1 {
         return None;
     }
     let wi = -ph.direction();
-    let cos_g = wi.dot(ng);
-    (cos_g > 1e-2).then_some((wi, cos_g))
+    (wi.dot(ng) > 0.0).then(|| (wi, wi.dot(np).max(MIN_LANDING_COSINE)))
 }
 
 /// Precomputed irradiance for final gathering (Christensen, "Faster Photon Map Global
 /// Illumination", JGT 4(1), 1999): the irradiance of both maps estimated once at every
 /// [`IRRADIANCE_STRIDE`]-th photon's position, so a final-gather ray that lands on a diffuse
 /// surface costs one nearest-point lookup instead of two k-nearest estimates. The radiance
-/// there is taken as `f(ωo, n) · E`: exact for Lambert surfaces, which is what indirect light
-/// at gather points mostly sees; a glossy lobe is evaluated as if the light came along the
-/// normal.
+/// there is `f(ωo, n) · E`, exact for Lambert surfaces only: the photon integrator reads the
+/// maps themselves where a surface has a Phong lobe. Each point also keeps the radius of the
+/// estimate it came from, which tells final gathering when a gather ray is too short for the
+/// estimate at its end (`integrators::photon`'s short-gather rule).
 #[derive(Debug)]
 pub struct IrradianceCache {
-    /// Points (photon records whose `power` field holds the irradiance E in W/m²).
-    tree: KdTree<Photon>,
+    /// Points (photon records whose `power` field holds the irradiance E in W/m²) with their
+    /// estimate's radius.
+    tree: KdTree<IrradiancePoint>,
     /// Largest lookup distance.
     max_radius: f32,
+}
+
+/// One point of an [`IrradianceCache`]: a photon record (position, normal, and the irradiance
+/// in its `power` field) and the radius of the sites map's estimate there (scene units).
+#[derive(Debug, Clone, Copy)]
+struct IrradiancePoint {
+    photon: Photon,
+    radius: f32,
+}
+
+impl HasPosition for IrradiancePoint {
+    #[inline]
+    fn position(&self) -> [f32; 3] {
+        HasPosition::position(&self.photon)
+    }
 }
 
 /// One irradiance point per this many photons of the map it is built on.
@@ -253,23 +290,48 @@ const LOOKUP_K: usize = 4;
 
 impl IrradianceCache {
     /// Estimates the irradiance of `maps` (summed) at every [`IRRADIANCE_STRIDE`]-th photon of
-    /// `sites` (in parallel, deterministic). `None` when there are no maps or sites.
+    /// `sites` (in parallel, deterministic). `None` when there are no maps or sites, or when
+    /// `cancel` is raised before the points are done (the rest are skipped at once).
     #[must_use]
-    pub fn build(sites: &PhotonMap, maps: &[&PhotonMap]) -> Option<Self> {
+    pub fn build(
+        sites: &PhotonMap,
+        maps: &[&PhotonMap],
+        cancel: Option<&std::sync::atomic::AtomicBool>,
+    ) -> Option<Self> {
         use rayon::prelude::*;
         if maps.is_empty() || sites.is_empty() {
             return None;
         }
-        let points: Vec<Photon> = sites
+        let points: Vec<IrradiancePoint> = sites
             .photons()
             .par_iter()
             .step_by(IRRADIANCE_STRIDE)
             .map(|ph| {
+                if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+                    return IrradiancePoint {
+                        photon: Photon::default(),
+                        radius: 0.0,
+                    };
+                }
                 let (p, n) = (ph.position(), ph.normal());
-                let e: Vec3 = maps.iter().map(|m| m.irradiance(p, n).radiance).sum();
-                Photon::new(p, -n, n, e)
+                let (e, radius) = maps.iter().fold((Vec3::ZERO, 0.0), |(e, r), m| {
+                    let est = m.irradiance(p, n);
+                    let r = if std::ptr::eq(*m, sites) {
+                        est.radius
+                    } else {
+                        r
+                    };
+                    (e + est.radiance, r)
+                });
+                IrradiancePoint {
+                    photon: Photon::new(p, -n, n, e),
+                    radius,
+                }
             })
             .collect();
+        if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+            return None;
+        }
         let max_radius = maps.iter().map(|m| m.max_radius).fold(0.0, f32::max);
         let tree = KdTree::build(points).ok()?;
         Some(Self { tree, max_radius })
@@ -297,6 +359,13 @@ impl IrradianceCache {
     /// ~25°), or `None` when no such point lies within the largest radius.
     #[must_use]
     pub fn lookup(&self, p: Vec3, ng: Vec3) -> Option<Vec3> {
+        self.lookup_with_radius(p, ng).map(|(e, _)| e)
+    }
+
+    /// [`IrradianceCache::lookup`], with the radius (scene units) of the estimate the point's
+    /// irradiance came from.
+    #[must_use]
+    pub fn lookup_with_radius(&self, p: Vec3, ng: Vec3) -> Option<(Vec3, f32)> {
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
             heap.set_k(LOOKUP_K);
@@ -306,8 +375,8 @@ impl IrradianceCache {
             let points = self.tree.items();
             heap.iter()
                 .map(|n| &points[n.index as usize])
-                .find(|q| q.normal().dot(ng) > 0.9)
-                .map(Photon::power)
+                .find(|q| q.photon.normal().dot(ng) > 0.9)
+                .map(|q| (q.photon.power(), q.radius))
         })
     }
 }
@@ -405,6 +474,42 @@ mod tests {
         let e = map.estimate(Vec3::ZERO, Vec3::Z, &up_frame(), &white_lambert());
         assert!(e.radiance.is_finite() && e.radiance.x > 0.0);
         assert_eq!(e.radius, MIN_RADIUS_FRACTION);
+    }
+
+    #[test]
+    fn the_largest_radius_only_caps_the_disc() {
+        // Issue 29 (estimate-radius-floor): photons 1e-5 apart (a 1 mm part) read the same
+        // density whether the largest radius is 1 cm or 100 m, as long as it does not cut the
+        // search; the exact irradiance of a uniform density λ is λ.
+        let mut rng = Rng::new(4, 3);
+        let side = 2e-3f32;
+        let n = 40_000;
+        let photons: Vec<Photon> = (0..n)
+            .map(|_| {
+                let (a, b) = rng.next_2d();
+                let p = Vec3::new(side * (a - 0.5), side * (b - 0.5), 0.0);
+                Photon::new(p, -Vec3::Z, Vec3::Z, Vec3::ONE)
+            })
+            .collect();
+        let lambda = n as f32 / (side * side);
+        for max_radius in [1e-2, 1.0, 100.0] {
+            let tree = KdTree::build(photons.clone()).expect("tree");
+            let map = PhotonMap::new(tree, 50, max_radius, Kernel::Box);
+            let mut sum = 0.0f64;
+            let mut queries = Rng::new(5, 9);
+            for _ in 0..200 {
+                let (a, b) = queries.next_2d();
+                let p = Vec3::new(side * 0.5 * (a - 0.5), side * 0.5 * (b - 0.5), 0.0);
+                let e = map.irradiance(p, Vec3::Z);
+                assert!(!e.cut && e.radius < 1e-4, "{e:?}");
+                sum += f64::from(e.radiance.x / lambda);
+            }
+            let ratio = sum / 200.0;
+            assert!(
+                (ratio - 1.0).abs() < 0.03,
+                "max radius {max_radius}: {ratio}"
+            );
+        }
     }
 
     #[test]

@@ -1,8 +1,12 @@
 //! Building the caustic and global photon maps: emission budgets per light, photon paths traced
 //! in parallel batches with rayon, and the kd-trees. Deterministic: every photon draws from the
 //! sampler stream keyed by (seed, map, light, photon index), and batches are concatenated in
-//! index order, so the maps are the same for any thread count.
+//! index order, so the maps are the same for any thread count. A raised cancel flag
+//! ([`MapScene::cancel`], the render's Ctrl-C flag) stops tracing within a photon and skips
+//! the kd-trees and the irradiance; the maps are then marked [`PhotonSummary::cancelled`].
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
@@ -51,6 +55,9 @@ pub struct PhotonSummary {
     pub memory: usize,
     /// What the photon-map cache did (`--photon-cache`), as the summary's last line.
     pub cache: Option<String>,
+    /// The cancel flag stopped the build: the maps are incomplete and must not be used or
+    /// saved.
+    pub cancelled: bool,
 }
 
 impl PhotonSummary {
@@ -81,13 +88,18 @@ impl std::fmt::Display for PhotonSummary {
             let t = PhotonSummary::total(per_light);
             writeln!(
                 f,
-                "photons: {name} map: {} stored of {} emitted, max radius {radius:.4}{}",
+                "photons: {name} map: {} stored of {} emitted, max radius {radius:.4}{}; {}",
                 t.stored,
                 t.emitted,
                 if self.auto_radius {
                     " (from the scene's size)"
                 } else {
                     ""
+                },
+                if name == "caustic" {
+                    "only photons that reach a diffuse surface through mirrors or glass are stored, and they alone draw the caustics: few stored means blotchy caustics (raise --caustic-photons)"
+                } else {
+                    "stored photons carry the indirect light: few stored means blotchy indirect light (raise --photons)"
                 }
             )?;
             for (i, c) in per_light.iter().enumerate() {
@@ -104,7 +116,13 @@ impl std::fmt::Display for PhotonSummary {
                     c.stored,
                     mean_flux(c.stored_flux),
                     if c.lost_at_depth > 0 {
-                        format!(", {} cut by max_bounces", c.lost_at_depth)
+                        format!(
+                            ", {} cut by max_bounces carrying {:.4} W, {:.2} % of the flux stored",
+                            c.lost_at_depth,
+                            mean_flux(c.lost_flux),
+                            100.0 * mean_flux(c.lost_flux)
+                                / mean_flux(c.stored_flux).max(f32::MIN_POSITIVE)
+                        )
                     } else {
                         String::new()
                     }
@@ -170,12 +188,14 @@ fn rotation_stream(kind: MapKind, light: usize, pass: Option<u32>) -> u64 {
 
 /// Traces `emitters`' photons (light `l`'s from stream (settings' map, `l`), caustic ones aimed
 /// at `targets`) into one flat list in (light, index) order, with per-light counts. Parallel
-/// batches; the same result for any thread count.
+/// batches; the same result for any thread count. When `cancel` is raised, every batch stops
+/// before its next photon and the list is incomplete (the caller checks the flag).
 pub fn trace_map(
     scene: &RenderScene,
     emitters: &[LightEmitter],
     targets: &CausticTargets,
     settings: TraceSettings,
+    cancel: Option<&AtomicBool>,
 ) -> (Vec<Photon>, Vec<TraceCounts>) {
     let jobs: Vec<(usize, u64, u64)> = emitters
         .iter()
@@ -195,6 +215,9 @@ pub fn trace_map(
             let mut cones = Vec::new();
             let e = &emitters[l];
             for i in start..end {
+                if is_raised(cancel) {
+                    break;
+                }
                 sampler.start_stream(stream(settings.kind, l, settings.pass), i);
                 counts.emitted += 1;
                 let emitted = match settings.kind {
@@ -224,6 +247,12 @@ pub fn trace_map(
         photons.extend_from_slice(&out);
     }
     (photons, per_light)
+}
+
+/// Whether the cancel flag `cancel` is raised.
+#[inline]
+pub(super) fn is_raised(cancel: Option<&AtomicBool>) -> bool {
+    cancel.is_some_and(|c| c.load(Ordering::Relaxed))
 }
 
 /// The diffuse surface area (m²) photons can land on: triangles and spheres of objects whose
@@ -295,12 +324,21 @@ pub struct PhotonMaps {
 /// Traces and builds the maps the scene's `photons` settings ask for.
 #[must_use]
 pub fn build_maps(scene: &RenderScene) -> PhotonMaps {
+    build_maps_cancellable(scene, None)
+}
+
+/// [`build_maps`], stopping soon after `cancel` is raised (the maps are then
+/// [`PhotonSummary::cancelled`]).
+#[must_use]
+pub fn build_maps_cancellable(scene: &RenderScene, cancel: Option<Arc<AtomicBool>>) -> PhotonMaps {
     let all = MapSet {
         caustic: true,
         global: true,
         global_any_bounce: false,
     };
-    build_maps_with(scene, &MapScene::new(scene), None, all)
+    let mut prepared = MapScene::new(scene);
+    prepared.cancel = cancel;
+    build_maps_with(scene, &prepared, None, all)
 }
 
 /// What every build of a scene's maps needs and no pass changes: where caustic photons are
@@ -312,6 +350,8 @@ pub struct MapScene {
     pub targets: CausticTargets,
     /// Diffuse surface area, m² ([`diffuse_area`]).
     pub area: f64,
+    /// The render's cancel flag (Ctrl-C): raised, it stops photon tracing within a photon.
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 impl MapScene {
@@ -321,6 +361,7 @@ impl MapScene {
         Self {
             targets: CausticTargets::new(scene),
             area: diffuse_area(scene),
+            cancel: None,
         }
     }
 }
@@ -360,6 +401,7 @@ pub fn build_maps_with(
         })
         .collect();
     let targets = &prepared.targets;
+    let cancel = prepared.cancel.as_deref();
     summary.targets = targets.len();
     let mut sampler = Sampler::new(scene.params.sampler, scene.params.seed, 1);
 
@@ -411,8 +453,11 @@ pub fn build_maps_with(
             max_bounces: p.max_bounces,
             pass,
         };
-        let (photons, counts) = trace_map(scene, &e, targets, settings);
+        let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
         summary.caustic = counts;
+        if is_raised(cancel) {
+            return cancelled(summary);
+        }
         finish_map(
             photons,
             MapKind::Caustic,
@@ -445,8 +490,11 @@ pub fn build_maps_with(
             max_bounces: p.max_bounces,
             pass,
         };
-        let (photons, counts) = trace_map(scene, &e, targets, settings);
+        let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
         summary.global = counts;
+        if is_raised(cancel) {
+            return cancelled(summary);
+        }
         finish_map(
             photons,
             MapKind::Global,
@@ -464,10 +512,13 @@ pub fn build_maps_with(
     summary.build_time = build_time;
     summary.memory = memory;
     let irradiance = if pass.is_none() {
-        precompute_irradiance(scene, &caustic, &global, &mut summary)
+        precompute_irradiance(scene, &caustic, &global, &mut summary, cancel)
     } else {
         None
     };
+    if is_raised(cancel) {
+        return cancelled(summary);
+    }
     PhotonMaps {
         caustic,
         global,
@@ -476,14 +527,25 @@ pub fn build_maps_with(
     }
 }
 
+/// No maps, marked cancelled (what a build stopped by its cancel flag returns).
+fn cancelled(mut summary: PhotonSummary) -> PhotonMaps {
+    summary.cancelled = true;
+    PhotonMaps {
+        summary,
+        ..PhotonMaps::default()
+    }
+}
+
 /// The irradiance final gathering reads, precomputed from the built (or cached) maps: `None`
-/// when `final_gather` is 0 or no map was built. Adds its time, points and memory to `summary`.
-/// Used by [`build_maps`] and by the photon-map cache after loading the maps.
+/// when `final_gather` is 0, no map was built, or `cancel` was raised. Adds its time, points
+/// and memory to `summary`. Used by [`build_maps`] and by the photon-map cache after loading
+/// the maps.
 pub(super) fn precompute_irradiance(
     scene: &RenderScene,
     caustic: &Option<PhotonMap>,
     global: &Option<PhotonMap>,
     summary: &mut PhotonSummary,
+    cancel: Option<&AtomicBool>,
 ) -> Option<IrradianceCache> {
     let t1 = Instant::now();
     let irradiance = if scene.params.photons.final_gather > 0 {
@@ -491,7 +553,7 @@ pub(super) fn precompute_irradiance(
         global
             .as_ref()
             .or(caustic.as_ref())
-            .and_then(|sites| IrradianceCache::build(sites, &maps))
+            .and_then(|sites| IrradianceCache::build(sites, &maps, cancel))
     } else {
         None
     };

@@ -89,6 +89,18 @@ fn set_radiance(log: Option<&mut TraceLog>, node: Option<usize>, gathered: Vec3)
 /// Most mirror or glass bounces a final-gather ray follows before reading the maps.
 const GATHER_SPECULAR_DEPTH: u32 = 4;
 
+/// A final-gather ray shorter than this many times the radius of the estimate where it lands
+/// is "short": its end is so near the gathering point that the estimate's disc there reaches
+/// past the corner between them, where the other surface's photons are rejected and the disc
+/// is partly empty (−5 % 1 cm from a wall; issue 29, corner-final-gather). A short ray does
+/// not read that estimate: it gathers one more diffuse bounce instead (Jensen 2001, §9.3's
+/// path-traced step for short gather rays), whose own landing is usually far.
+const SHORT_GATHER: f32 = 2.0;
+
+/// Most short-ray bounces one final-gather ray takes (deep in a corner, each may land near the
+/// corner again); after them the estimate is read as it is.
+const SHORT_GATHER_BOUNCES: u32 = 3;
+
 /// The photon-mapping integrator: the maps, built once, and the camera-side estimator.
 #[derive(Debug)]
 pub struct PhotonMapper<'a> {
@@ -102,15 +114,21 @@ pub struct PhotonMapper<'a> {
 
 impl<'a> PhotonMapper<'a> {
     /// Traces the photons and builds the maps (`scene.params.photons`), or reads them from the
-    /// photon-map cache folder `cache` ([`cache::build_or_load`]).
+    /// photon-map cache folder `cache` ([`cache::build_or_load`]). A raised `cancel` (the
+    /// render's Ctrl-C flag) stops the build soon: the maps are then empty and
+    /// [`PhotonSummary::cancelled`], and the render must not go on.
     #[must_use]
-    pub fn new(scene: &'a RenderScene, cache: Option<&std::path::Path>) -> Self {
+    pub fn new(
+        scene: &'a RenderScene,
+        cache: Option<&std::path::Path>,
+        cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    ) -> Self {
         Self {
             scene,
             lights: LightSampler::new(&scene.lights),
             pixel_spread: scene.pixel_spread(),
             final_gather: scene.params.photons.final_gather,
-            maps: cache::build_or_load(scene, cache),
+            maps: cache::build_or_load(scene, cache, cancel),
         }
     }
 
@@ -312,11 +330,21 @@ impl<'a> PhotonMapper<'a> {
     ) -> (Radiance, Option<String>) {
         let fr = frame(sh);
         let direct = self.direct(sp, &fr, sh, wo, sampler, counters);
-        if !full && let Some(l) = cached_radiance(maps, sp, &fr, sh, wo) {
+        if !full && let Some(l) = cached_radiance(maps, sp, &fr, sh, wo, counters) {
             let note = describe.then(|| {
                 format!(
-                    "direct ({:.4}, {:.4}, {:.4}); caustic + indirect from precomputed irradiance ({:.4}, {:.4}, {:.4}) (dim branch)",
-                    direct.x, direct.y, direct.z, l.x, l.y, l.z
+                    "direct ({:.4}, {:.4}, {:.4}); caustic + indirect {} ({:.4}, {:.4}, {:.4}) (dim branch)",
+                    direct.x,
+                    direct.y,
+                    direct.z,
+                    if lambertian(&sh.bsdf) {
+                        "from precomputed irradiance"
+                    } else {
+                        "from both maps (glossy)"
+                    },
+                    l.x,
+                    l.y,
+                    l.z
                 )
             });
             let mut r = Radiance::default();
@@ -402,7 +430,8 @@ impl<'a> PhotonMapper<'a> {
 
     /// Indirect light at a vertex by `n` final-gather rays sampled from the BSDF's diffuse part:
     /// where each lands, its direct light, caustics and global-map radiance (following up to
-    /// four mirror or glass bounces first).
+    /// four mirror or glass bounces first; a ray shorter than [`SHORT_GATHER`] times the
+    /// landing estimate's radius takes one more BSDF-sampled bounce instead of reading it).
     #[allow(clippy::too_many_arguments)]
     fn final_gather(
         &self,
@@ -432,7 +461,8 @@ impl<'a> PhotonMapper<'a> {
             }
             let mut beta = s.weight;
             let mut ray = Ray::new(offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi), s.wi);
-            for bounce in 0..=GATHER_SPECULAR_DEPTH {
+            let (mut specular, mut shortcuts) = (0u32, 0u32);
+            loop {
                 counters.rays += 1;
                 let Some(hit) = scene.geometry.intersect(&ray) else {
                     sum += beta * scene.params.background;
@@ -445,10 +475,23 @@ impl<'a> PhotonMapper<'a> {
                 };
                 let gsh = scene.shading_point(&scene.materials[m as usize], &gp, gwo, 0.0);
                 let gfr = frame(&gsh);
+                let mut short = false;
                 if gsh.bsdf.has_local() {
                     let mut lo = self.direct(&gp, &gfr, &gsh, gwo, sampler, counters);
-                    if let Some(l) = cached_radiance(maps, &gp, &gfr, &gsh, gwo) {
-                        lo += l;
+                    let near = maps
+                        .irradiance
+                        .as_ref()
+                        .and_then(|c| c.lookup_with_radius(gp.p, gfr.ng));
+                    short = shortcuts < SHORT_GATHER_BOUNCES
+                        && near.is_some_and(|(_, r)| hit.t < SHORT_GATHER * r);
+                    if short {
+                        // The caustics here still come from their map; the rest of the light
+                        // arriving here is gathered by the bounce below.
+                        if let Some(map) = &maps.caustic {
+                            lo += counted(map, gp.p, gwo, &gfr, &gsh, counters).radiance;
+                        }
+                    } else if let Some((e, _)) = near.filter(|_| lambertian(&gsh.bsdf)) {
+                        lo += gsh.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e;
                     } else {
                         for map in [&maps.caustic, &maps.global].into_iter().flatten() {
                             lo += counted(map, gp.p, gwo, &gfr, &gsh, counters).radiance;
@@ -456,7 +499,7 @@ impl<'a> PhotonMapper<'a> {
                     }
                     sum += beta * lo;
                 }
-                if bounce == GATHER_SPECULAR_DEPTH || !gsh.bsdf.has_delta() {
+                if !short && (specular == GATHER_SPECULAR_DEPTH || !gsh.bsdf.has_delta()) {
                     break;
                 }
                 let u_lobe = sampler.defer_1d();
@@ -468,7 +511,14 @@ impl<'a> PhotonMapper<'a> {
                 else {
                     break;
                 };
-                if !g.delta {
+                if g.delta {
+                    if specular == GATHER_SPECULAR_DEPTH {
+                        break;
+                    }
+                    specular += 1;
+                } else if short {
+                    shortcuts += 1;
+                } else {
                     break;
                 }
                 beta *= g.weight;
@@ -482,17 +532,40 @@ impl<'a> PhotonMapper<'a> {
     }
 }
 
-/// Caustic and indirect radiance towards `wo` from the precomputed irradiance (both maps),
-/// `f(ωo, n) · E`, when final gathering built it and a point lies near on the same surface.
+/// Caustic and indirect radiance towards `wo` read without gathering again, where final
+/// gathering built the precomputed irradiance (a gather ray's landing, a dim camera vertex):
+/// - on a Lambert surface, `f · E` with `E` the irradiance of both maps at the nearest point on
+///   the same surface (exact: `f` does not depend on the light's direction); `None` when no
+///   such point lies near;
+/// - on a surface with a Phong lobe, both maps read with the full BSDF, since the lobe weighs
+///   each photon by its direction: `f(ωo, n) · E` (the lobe evaluated as if all light came
+///   along the normal) made final gathering +8 / +22 / +45 % too bright on glossy walls of
+///   shininess 1 / 10 / 50 (issue 29, glossy-final-gather).
 fn cached_radiance(
     maps: &PhotonMaps,
     sp: &SurfacePoint,
     fr: &ShadingFrame,
     sh: &ShadingPoint,
     wo: Vec3,
+    counters: &mut Counters,
 ) -> Option<Vec3> {
-    let e = maps.irradiance.as_ref()?.lookup(sp.p, fr.ng)?;
-    Some(sh.bsdf.eval(wo, fr.ns, fr, TransportMode::Radiance) * e)
+    let cache = maps.irradiance.as_ref()?;
+    if lambertian(&sh.bsdf) {
+        let e = cache.lookup(sp.p, fr.ng)?;
+        return Some(sh.bsdf.eval(wo, fr.ns, fr, TransportMode::Radiance) * e);
+    }
+    let mut l = Vec3::ZERO;
+    for map in [&maps.caustic, &maps.global].into_iter().flatten() {
+        l += counted(map, sp.p, wo, fr, sh, counters).radiance;
+    }
+    Some(l)
+}
+
+/// True when the non-delta part of `bsdf` is Lambert alone (no Phong lobe), so its radiance
+/// is `f · E` whatever direction the light arrives from.
+#[inline]
+fn lambertian(bsdf: &crate::shading::Bsdf) -> bool {
+    bsdf.specular == Vec3::ZERO
 }
 
 /// `map`'s estimate at `p` towards `wo` through `sh`'s BSDF, counted in `counters` (estimates

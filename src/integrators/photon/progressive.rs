@@ -15,6 +15,8 @@
 //! pass, so any set of passes can be rendered anywhere, in any order, and the films merged
 //! (farm shards) into the bytes of one render.
 
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use super::maps::{MapScene, MapSet, PhotonMaps, build_maps_with};
@@ -85,14 +87,25 @@ impl<'a> ProgressivePhotons<'a> {
         }
     }
 
+    /// Makes every later pass's photon tracing stop soon after `cancel` (the render's Ctrl-C
+    /// flag) is raised.
+    pub fn set_cancel(&mut self, cancel: Option<Arc<AtomicBool>>) {
+        self.prepared.cancel = cancel;
+    }
+
     /// Makes the maps those of pass `pass` (building them unless they already are), reading
-    /// within the pass's share of the k-nearest radius.
+    /// within the pass's share of the k-nearest radius. A build stopped by the cancel flag
+    /// leaves no pass current (its maps are empty), so it is rebuilt if asked for again.
     pub fn begin_pass(&mut self, pass: u32) {
         if self.pass == Some(pass) {
             return;
         }
         let t = Instant::now();
         self.maps = build_maps_with(self.scene, &self.prepared, Some(pass), self.set);
+        if self.maps.summary.cancelled {
+            self.pass = None;
+            return;
+        }
         self.pass = Some(pass);
         let shrink = self.shrink(pass);
         for m in [self.maps.caustic.as_mut(), self.maps.global.as_mut()]

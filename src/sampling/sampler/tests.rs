@@ -249,18 +249,6 @@ fn sobol_integrates_a_smooth_function_much_better() {
 }
 
 #[test]
-fn names_round_trip() {
-    for name in SamplerKind::NAMES {
-        assert_eq!(
-            SamplerKind::from_name(name).map(SamplerKind::name),
-            Some(name)
-        );
-    }
-    assert_eq!(SamplerKind::from_name("Sobol"), Some(SamplerKind::Sobol));
-    assert_eq!(SamplerKind::from_name("halton"), None);
-}
-
-#[test]
 fn deferred_draws_equal_eager_ones_and_unused_ones_change_nothing() {
     for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
         let mut eager = Sampler::new(kind, 9, 64);

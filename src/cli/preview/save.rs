@@ -1,0 +1,79 @@
+//! The page's save (`s`): writes the image so far the way `caustic render -o` writes its
+//! output (PNG or EXR, EXR with `--layers`, or the mergeable `.part` film), atomically, and runs
+//! `--compare` on it. The bytes equal those of `caustic render` for the same samples
+//! (`--samples 0..N`, N the samples per pixel taken when saving), since passes add up exactly.
+
+use std::time::Instant;
+
+use caustic::farm::PartMeta;
+use caustic::farm::part_meta::settings_hash;
+use caustic::pipeline::Prepared;
+use caustic::render::output::write_image;
+use caustic::render::{RenderJob, write_layers};
+
+use super::Settings;
+
+/// Saves the samples `job` has taken so far; the message for the page, or why nothing (or not
+/// all) was saved. `first` is the render's first sample index (`--samples`, `--shard`; else 0)
+/// and `start` when its passes began.
+pub fn save(
+    settings: &Settings,
+    prepared: &Prepared,
+    job: &RenderJob<'_>,
+    first: u32,
+    start: Instant,
+) -> Result<String, String> {
+    let s = &settings.save;
+    let output = &s.output;
+    let sums = job.sums();
+    let end = job.samples_done();
+    if end == first {
+        return Err("not saved: no pass has finished yet".into());
+    }
+    let p = &prepared.render_scene.params;
+    let written = if s.part {
+        let meta = PartMeta {
+            hash: settings_hash(&prepared.render_scene),
+            samples: std::iter::once(first..end).collect(),
+            spp: p.samples_per_pixel,
+            width: p.width,
+            height: p.height,
+            region: settings.region,
+            integrator: format!("{:?}", p.integrator),
+            exposure: p.exposure,
+            scene: settings.scene.display().to_string(),
+            shard: settings.shard.map(|s| s.to_string()),
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        sums.write(output, &meta.to_text())
+    } else if !s.layers.is_empty() {
+        write_layers(sums, job.parts(), &s.layers, output)
+    } else {
+        write_image(&job.snapshot(), output, p.exposure)
+    };
+    written.map_err(|e| format!("not saved: {e}"))?;
+    let mut message = format!(
+        "saved `{}`: samples {first}..{end} ({} of {} per pixel)",
+        output.display(),
+        end - first,
+        p.samples_per_pixel
+    );
+    eprintln!("{message}");
+    if let Some(reference) = &s.reference {
+        let checked = super::super::max_rmse::check(
+            reference,
+            &job.snapshot(),
+            output,
+            p.exposure,
+            settings.region,
+            s.max_rmse,
+        );
+        if let Err(e) = checked {
+            let text = crate::error_text(&e);
+            eprintln!("{text}");
+            message.push('\n');
+            message.push_str(&text);
+        }
+    }
+    Ok(message)
+}

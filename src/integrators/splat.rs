@@ -1,0 +1,296 @@
+//! The splat buffer: a film-sized buffer that an estimator adds to at pixels other than the one
+//! it was called for (light tracing's camera connections, BDPT's t = 1 strategy, the photon
+//! viewer's projected photons), from many workers at once.
+//!
+//! **Contract.** A splat `add(x, y, v)` is a radiance contribution (W sr⁻¹ m⁻², linear RGB) of
+//! one camera sample — whichever pixel that sample was taken for — to pixel `(x, y)`. When the
+//! buffer is merged into the film (`PixelSums::add_splats`, in the renderer), the splats are
+//! added to the pixel's sum of samples and, like the film's own samples, divided by the pixel's
+//! sample count (the render's samples per pixel): a splat of `v` stands for a sample of value `v`
+//! taken for that pixel, and a pixel's value is `(Σ samples + Σ splats) / spp`. Splats carry no
+//! sample count and do not enter the sums of squares (the variance layer sees camera samples
+//! only). Non-finite values and pixels outside the film are dropped and counted
+//! ([`SplatBuffer::dropped`]), as the renderer drops non-finite samples.
+//!
+//! **Determinism.** Values are accumulated in the film's fixed-point representation
+//! ([`to_fixed`] at [`SUM_SCALE`]: multiples of 2⁻⁶⁴) as integer sums on atomics, so addition is
+//! exact and the order of splats never matters: the buffer holds the same bytes for any thread
+//! count and any order, and buffers (of tiles, passes or farm shards) merge exactly. Each
+//! channel's 128-bit sum is two `u64` atomics, the low word's carry added to the high word;
+//! sums wrap (two's complement) beyond ±2¹²⁷ · 2⁻⁶⁴ ≈ 9.2e18, far past any radiance.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use glam::{DVec3, Vec3};
+
+/// Fixed-point scale of the film's sums and of splats: values are rounded to multiples of
+/// 2⁻⁶⁴ (about 5.4e-20) before summing.
+pub const SUM_SCALE: f64 = 18_446_744_073_709_551_616.0;
+
+/// `v · scale` rounded to the nearest integer (ties away from zero), saturating at the `i128`
+/// range: the fixed-point value the film and the splat buffer sum. Inputs are finite.
+#[inline]
+#[must_use]
+pub fn to_fixed(v: f64, scale: f64) -> i128 {
+    // `as` saturates; inputs are finite (the renderer drops NaN/Inf before they get here).
+    let x = (v * scale).round();
+    // Most samples fit an i64, whose conversion is one instruction; the i128 conversion is a
+    // library call. Both are exact for an integral `x` in range, so the result is the same.
+    if x.abs() < 9.0e18 {
+        x as i64 as i128
+    } else {
+        x as i128
+    }
+}
+
+/// The two's-complement halves of a fixed-point value: (low word, high word).
+#[inline]
+fn halves(f: i128) -> (u64, u64) {
+    (f as u64, (f >> 64) as u64)
+}
+
+/// A film-sized buffer of splatted radiance, summed exactly in fixed point (module docs for the
+/// contract). `add` takes `&self`: share it among workers by reference.
+#[derive(Debug)]
+pub struct SplatBuffer {
+    width: u32,
+    height: u32,
+    /// Low words of the sums, three channels per pixel, row-major.
+    lo: Vec<AtomicU64>,
+    /// High words of the sums, likewise.
+    hi: Vec<AtomicU64>,
+    /// Splats dropped: non-finite, or outside the film.
+    dropped: AtomicU64,
+}
+
+impl SplatBuffer {
+    /// An empty buffer for a `width × height` film.
+    #[must_use]
+    pub fn new(width: u32, height: u32) -> Self {
+        let n = 3 * width as usize * height as usize;
+        let zeros = || (0..n).map(|_| AtomicU64::new(0)).collect();
+        Self {
+            width,
+            height,
+            lo: zeros(),
+            hi: zeros(),
+            dropped: AtomicU64::new(0),
+        }
+    }
+
+    /// Width in pixels.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Adds the radiance contribution `value` to pixel `(x, y)` (from the top-left). Safe from
+    /// any number of threads at once; the result does not depend on their order. A non-finite
+    /// `value` or a pixel outside the film is dropped and counted.
+    #[inline]
+    pub fn add(&self, x: u32, y: u32, value: Vec3) {
+        if x >= self.width || y >= self.height || !value.is_finite() {
+            self.dropped.fetch_add(1, Ordering::Relaxed);
+            return;
+        }
+        let at = 3 * (y as usize * self.width as usize + x as usize);
+        let v = value.as_dvec3();
+        for c in 0..3 {
+            let (lo, hi) = halves(to_fixed(v[c], SUM_SCALE));
+            let old = self.lo[at + c].fetch_add(lo, Ordering::Relaxed);
+            let carry = u64::from(old.overflowing_add(lo).1);
+            let hi = hi.wrapping_add(carry);
+            if hi != 0 {
+                self.hi[at + c].fetch_add(hi, Ordering::Relaxed);
+            }
+        }
+    }
+
+    /// Splats dropped so far (non-finite values, pixels outside the film).
+    #[must_use]
+    pub fn dropped(&self) -> u64 {
+        self.dropped.load(Ordering::Relaxed)
+    }
+
+    /// The fixed-point sums (value · [`SUM_SCALE`]) of pixel `index` (row-major), per channel.
+    /// Takes `&mut self`, so no worker is still adding.
+    #[must_use]
+    pub fn fixed_sum(&mut self, index: usize) -> [i128; 3] {
+        let at = 3 * index;
+        std::array::from_fn(|c| {
+            let lo = *self.lo[at + c].get_mut();
+            let hi = *self.hi[at + c].get_mut();
+            ((u128::from(hi) << 64) | u128::from(lo)) as i128
+        })
+    }
+
+    /// The summed splats of pixel `(x, y)` (black outside the film).
+    #[must_use]
+    pub fn sum(&mut self, x: u32, y: u32) -> Vec3 {
+        if x >= self.width || y >= self.height {
+            return Vec3::ZERO;
+        }
+        let s = self.fixed_sum(y as usize * self.width as usize + x as usize);
+        (DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64) / SUM_SCALE).as_vec3()
+    }
+
+    /// Adds every splat of `other` (same size) into `self`, exactly: merging buffers in any
+    /// order gives the bytes of one buffer that took all their splats.
+    ///
+    /// # Errors
+    /// [`SplatSizeMismatch`] when the sizes differ (nothing is added).
+    pub fn merge(&mut self, other: &mut SplatBuffer) -> Result<(), SplatSizeMismatch> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return Err(SplatSizeMismatch {
+                ours: (self.width, self.height),
+                theirs: (other.width, other.height),
+            });
+        }
+        let pixels = self.width as usize * self.height as usize;
+        for i in 0..pixels {
+            let (mine, theirs) = (self.fixed_sum(i), other.fixed_sum(i));
+            for c in 0..3 {
+                let (lo, hi) = halves(mine[c].wrapping_add(theirs[c]));
+                *self.lo[3 * i + c].get_mut() = lo;
+                *self.hi[3 * i + c].get_mut() = hi;
+            }
+        }
+        *self.dropped.get_mut() += *other.dropped.get_mut();
+        Ok(())
+    }
+}
+
+/// Two splat buffers (or a buffer and a film) of different sizes cannot be merged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("a {}×{} splat buffer cannot be merged with a {}×{} one", theirs.0, theirs.1, ours.0, ours.1)]
+pub struct SplatSizeMismatch {
+    /// Width and height of the buffer merged into.
+    pub ours: (u32, u32),
+    /// Width and height of the buffer merged.
+    pub theirs: (u32, u32),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::PixelSums;
+    use crate::sampling::Rng;
+    use rayon::prelude::*;
+
+    /// Random splats over a 7 × 5 film, many on the same pixels, of both signs and a wide range
+    /// of magnitudes (low-word carries and borrows happen).
+    fn splats(n: usize) -> Vec<(u32, u32, Vec3)> {
+        let mut r = Rng::new(23, 4);
+        (0..n)
+            .map(|_| {
+                let mut v = || (r.next_f32() - 0.3) * 10f32.powi(r.next_u32() as i32 % 10 - 5);
+                let value = Vec3::new(v(), v(), v());
+                (r.next_u32() % 7, r.next_u32() % 5, value)
+            })
+            .collect()
+    }
+
+    fn splat_all(threads: usize, items: &[(u32, u32, Vec3)]) -> SplatBuffer {
+        let buf = SplatBuffer::new(7, 5);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| {
+            items
+                .par_iter()
+                .with_max_len(1)
+                .for_each(|&(x, y, v)| buf.add(x, y, v));
+        });
+        buf
+    }
+
+    fn all_sums(buf: &mut SplatBuffer) -> Vec<[i128; 3]> {
+        (0..35).map(|i| buf.fixed_sum(i)).collect()
+    }
+
+    #[test]
+    fn one_and_eight_threads_in_any_order_give_the_same_bytes() {
+        let items = splats(20_000);
+        let mut reversed = items.clone();
+        reversed.reverse();
+        let mut shuffled = items.clone();
+        let mut r = Rng::new(5, 9);
+        for i in (1..shuffled.len()).rev() {
+            shuffled.swap(i, r.next_u32() as usize % (i + 1));
+        }
+        let mut one = splat_all(1, &items);
+        let expected = all_sums(&mut one);
+        for order in [&items, &reversed, &shuffled] {
+            let mut eight = splat_all(8, order);
+            assert_eq!(all_sums(&mut eight), expected);
+        }
+        // An independent sum: plain i128 addition of the same fixed-point values.
+        let mut direct = vec![[0i128; 3]; 35];
+        for &(x, y, v) in &items {
+            for c in 0..3 {
+                direct[(y * 7 + x) as usize][c] += to_fixed(f64::from(v[c]), SUM_SCALE);
+            }
+        }
+        assert_eq!(expected, direct);
+        // Merging two halves is the buffer of all the splats, and so are the films they make.
+        let (a, b) = items.split_at(7_000);
+        let mut merged = splat_all(3, b);
+        merged.merge(&mut splat_all(2, a)).expect("same size");
+        assert_eq!(all_sums(&mut merged), expected);
+        let film = |buf: &mut SplatBuffer| {
+            let mut f = PixelSums::new(7, 5);
+            for i in 0..35 {
+                f.add(i, Vec3::ZERO);
+            }
+            f.add_splats(buf).expect("same size");
+            f.to_bytes("")
+        };
+        assert_eq!(film(&mut merged), film(&mut one));
+        assert!(
+            merged
+                .merge(&mut SplatBuffer::new(3, 3))
+                .is_err_and(|e| e.theirs == (3, 3))
+        );
+    }
+
+    #[test]
+    fn a_splat_equals_the_film_sample_it_stands_for() {
+        let v = Vec3::new(0.3, 1e-7, 1234.5);
+        // Pixel 4 of a 3 × 2 film: one camera sample of `v` ...
+        let mut sampled = PixelSums::new(3, 2);
+        sampled.add(4, v);
+        // ... or a black camera sample plus a splat of `v` (e.g. from another pixel's path).
+        let mut splatted = PixelSums::new(3, 2);
+        splatted.add(4, Vec3::ZERO);
+        let mut buf = SplatBuffer::new(3, 2);
+        buf.add(1, 1, v);
+        assert_eq!(
+            buf.fixed_sum(4),
+            [0.3f32, 1e-7, 1234.5].map(|c| (f64::from(c) * 2f64.powi(64)).round() as i128)
+        );
+        splatted.add_splats(&mut buf).expect("same size");
+        assert_eq!(splatted.mean(4), sampled.mean(4));
+        assert_eq!(splatted.to_film().to_bytes(), sampled.to_film().to_bytes());
+        // With two samples per pixel the splat is divided by 2, as a sample is.
+        splatted.add(4, Vec3::ZERO);
+        assert_eq!(splatted.mean(4), v / 2.0);
+        // Splats on other pixels, outside the film or not finite are not in pixel 4.
+        let mut other = SplatBuffer::new(3, 2);
+        other.add(0, 1, v);
+        other.add(3, 0, v);
+        other.add(0, 2, v);
+        other.add(2, 1, Vec3::new(f32::NAN, 0.0, 0.0));
+        other.add(2, 1, Vec3::splat(f32::INFINITY));
+        assert_eq!(other.dropped(), 4);
+        assert_eq!(other.sum(1, 1), Vec3::ZERO);
+        assert_eq!(other.sum(0, 1), v);
+        assert_eq!(other.fixed_sum(5), [0; 3]);
+    }
+}

@@ -1,0 +1,371 @@
+//! Golden images for noise-aware snapshot tests (`caustic golden`): a render's per-pixel means
+//! **with the variance of each mean**, so that a later render (any seed, thread count or
+//! machine) can be judged "the same scene within noise" or "changed" by a statistical test
+//! ([`block_test`]) instead of a fixed RMSE threshold.
+//!
+//! A golden file stores, after a signature, the image size, a metadata text (the settings hash
+//! of [`super::part_meta::settings_hash`], the seed, samples per pixel, integrator, sampler,
+//! exposure, the command-line overrides of `golden update`, and the scene's settings as
+//! `path=value` lines so a check can say which settings changed) and, per pixel, the mean and
+//! the variance of the mean per channel as little-endian `f32`, then an FNV-1a checksum:
+//! 24 bytes a pixel. (The mergeable `.part` film carries the same information as exact
+//! fixed-point sums at 100 bytes a pixel; a golden is never merged, so it keeps only what the
+//! test needs.)
+
+pub mod block_test;
+pub mod quantile;
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::PixelSums;
+use super::output::{OutputError, write_atomic};
+use crate::binfile::fnv1a;
+
+pub use block_test::{BlockTest, BlockZ, Verdict};
+
+/// File signature of a golden image.
+const MAGIC: &[u8; 16] = b"caustic-golden1\n";
+/// First line of the metadata text.
+const HEADER: &str = "caustic-golden 1";
+
+/// Why a golden file could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum GoldenError {
+    /// Reading failed (a missing file included).
+    #[error("cannot read `{path}`: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Not a golden file, a truncated or corrupt one, or malformed metadata.
+    #[error("`{path}` is not a valid caustic golden image: {reason}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// Per-pixel estimates of an image: each pixel's mean radiance and the variance of that mean
+/// (the samples' unbiased variance over their count), row-major from the top-left.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PixelEstimates {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Mean linear radiance per pixel.
+    pub mean: Vec<Vec3>,
+    /// Variance of each pixel's mean per channel (squared radiance units); 0 where a pixel
+    /// has fewer than two samples.
+    pub variance: Vec<Vec3>,
+}
+
+impl PixelEstimates {
+    /// The estimates of a rendered film's sums.
+    #[must_use]
+    pub fn from_sums(sums: &PixelSums) -> Self {
+        let n = sums.width as usize * sums.height as usize;
+        let mut mean = Vec::with_capacity(n);
+        let mut variance = Vec::with_capacity(n);
+        for i in 0..n {
+            mean.push(sums.mean(i));
+            let count = sums.count(i);
+            variance.push(if count < 2 {
+                Vec3::ZERO
+            } else {
+                sums.variance(i) / count as f32
+            });
+        }
+        Self {
+            width: sums.width,
+            height: sums.height,
+            mean,
+            variance,
+        }
+    }
+}
+
+/// What a golden image records about the render it holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GoldenMeta {
+    /// [`super::part_meta::settings_hash`] of the compiled scene after overrides.
+    pub hash: u64,
+    /// The seed it was rendered with (a check renders with another one by default).
+    pub seed: u64,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// The integrator's name (`Path`, `PathPpm`, ...).
+    pub integrator: String,
+    /// The sampler's name (`Sobol`, `Independent`).
+    pub sampler: String,
+    /// The scene's exposure.
+    pub exposure: f32,
+    /// Informational: the scene file rendered.
+    pub scene: String,
+    /// The command-line overrides of `golden update` as `key=value` (`set=PATH=VALUE`,
+    /// `width=64`, ...), which `golden check` applies again.
+    pub overrides: Vec<(String, String)>,
+    /// The scene's settings after overrides as `(path, value)`, sorted by path, so a check
+    /// can name the ones that changed.
+    pub settings: Vec<(String, String)>,
+}
+
+impl GoldenMeta {
+    /// The metadata text stored in the file: one `key=value` per line.
+    #[must_use]
+    pub fn to_text(&self) -> String {
+        let clean = |s: &str| s.replace(['\n', '\r'], " ");
+        let mut t = format!(
+            "{HEADER}\nhash={:016x}\nseed={}\nspp={}\nintegrator={}\nsampler={}\nexposure={:?}\nscene={}\n",
+            self.hash,
+            self.seed,
+            self.spp,
+            clean(&self.integrator),
+            clean(&self.sampler),
+            self.exposure,
+            clean(&self.scene)
+        );
+        for (k, v) in &self.overrides {
+            t.push_str(&format!("override.{}={}\n", clean(k), clean(v)));
+        }
+        for (k, v) in &self.settings {
+            t.push_str(&format!("setting.{}={}\n", clean(k), clean(v)));
+        }
+        t
+    }
+
+    /// Reads [`GoldenMeta::to_text`]'s output; `path` names the file in errors.
+    ///
+    /// # Errors
+    /// [`GoldenError::Invalid`] when the header is not this format's or a field is missing or
+    /// malformed.
+    pub fn parse(text: &str, path: &str) -> Result<Self, GoldenError> {
+        let err = |reason: String| GoldenError::Invalid {
+            path: path.to_string(),
+            reason,
+        };
+        let mut lines = text.lines();
+        if lines.next() != Some(HEADER) {
+            return Err(err(format!("its metadata does not start with `{HEADER}`")));
+        }
+        let fields: Vec<(&str, &str)> = lines.filter_map(|l| l.split_once('=')).collect();
+        let get = |key: &str| {
+            fields
+                .iter()
+                .find(|(k, _)| *k == key)
+                .map(|(_, v)| *v)
+                .ok_or_else(|| err(format!("its metadata has no `{key}` field")))
+        };
+        let bad = |key: &str, v: &str| err(format!("its metadata field `{key}={v}` is malformed"));
+        let hash_text = get("hash")?;
+        let seed_text = get("seed")?;
+        let spp_text = get("spp")?;
+        let exposure_text = get("exposure")?;
+        let prefixed = |prefix: &str| -> Vec<(String, String)> {
+            fields
+                .iter()
+                .filter_map(|(k, v)| Some((k.strip_prefix(prefix)?.to_string(), v.to_string())))
+                .collect()
+        };
+        Ok(Self {
+            hash: u64::from_str_radix(hash_text, 16).map_err(|_| bad("hash", hash_text))?,
+            seed: seed_text.parse().map_err(|_| bad("seed", seed_text))?,
+            spp: spp_text.parse().map_err(|_| bad("spp", spp_text))?,
+            integrator: get("integrator")?.to_string(),
+            sampler: get("sampler")?.to_string(),
+            exposure: exposure_text
+                .parse()
+                .map_err(|_| bad("exposure", exposure_text))?,
+            scene: get("scene")?.to_string(),
+            overrides: prefixed("override."),
+            settings: prefixed("setting."),
+        })
+    }
+}
+
+/// A golden image: the estimates of a render and what it was rendered from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GoldenImage {
+    /// Means and variances of the means.
+    pub estimates: PixelEstimates,
+    /// Settings hash, seed, overrides and settings.
+    pub meta: GoldenMeta,
+}
+
+impl GoldenImage {
+    /// The file's bytes (see the module documentation).
+    #[must_use]
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let e = &self.estimates;
+        let meta = self.meta.to_text();
+        let mut out = Vec::with_capacity(48 + meta.len() + e.mean.len() * 24);
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&e.width.to_le_bytes());
+        out.extend_from_slice(&e.height.to_le_bytes());
+        out.extend_from_slice(&(meta.len() as u64).to_le_bytes());
+        out.extend_from_slice(meta.as_bytes());
+        for (m, v) in e.mean.iter().zip(&e.variance) {
+            for x in m.to_array().into_iter().chain(v.to_array()) {
+                out.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        let sum = fnv1a(&out);
+        out.extend_from_slice(&sum.to_le_bytes());
+        out
+    }
+
+    /// Reads what [`GoldenImage::to_bytes`] wrote; `name` is used in errors.
+    ///
+    /// # Errors
+    /// [`GoldenError::Invalid`] for a wrong signature, a truncated or corrupt file or bad
+    /// metadata.
+    pub fn from_bytes(bytes: &[u8], name: &str) -> Result<Self, GoldenError> {
+        let bad = |reason: &str| GoldenError::Invalid {
+            path: name.to_string(),
+            reason: reason.to_string(),
+        };
+        if bytes.len() < MAGIC.len() + 24 || &bytes[..MAGIC.len()] != MAGIC {
+            return Err(bad(
+                "no caustic golden signature (write it with `caustic golden update`)",
+            ));
+        }
+        let (body, tail) = bytes.split_at(bytes.len() - 8);
+        let stored = u64::from_le_bytes(tail.try_into().map_err(|_| bad("truncated"))?);
+        if fnv1a(body) != stored {
+            return Err(bad("checksum mismatch (truncated or corrupt)"));
+        }
+        let word = |at: usize| -> [u8; 4] {
+            let mut w = [0; 4];
+            w.copy_from_slice(&body[at..at + 4]);
+            w
+        };
+        let at = MAGIC.len();
+        let width = u32::from_le_bytes(word(at));
+        let height = u32::from_le_bytes(word(at + 4));
+        let mut len = [0; 8];
+        len.copy_from_slice(&body[at + 8..at + 16]);
+        let meta_len = usize::try_from(u64::from_le_bytes(len)).map_err(|_| bad("absurd size"))?;
+        let start = at + 16;
+        let n = width as usize * height as usize;
+        let expected = n
+            .checked_mul(24)
+            .and_then(|p| p.checked_add(meta_len))
+            .and_then(|p| p.checked_add(start))
+            .ok_or_else(|| bad("absurd size"))?;
+        if expected != body.len() {
+            return Err(bad("size does not match its header"));
+        }
+        let text = std::str::from_utf8(&body[start..start + meta_len])
+            .map_err(|_| bad("metadata is not UTF-8"))?;
+        let meta = GoldenMeta::parse(text, name)?;
+        let mut mean = Vec::with_capacity(n);
+        let mut variance = Vec::with_capacity(n);
+        let f = |at: usize| f32::from_le_bytes(word(at));
+        for i in 0..n {
+            let p = start + meta_len + i * 24;
+            mean.push(Vec3::new(f(p), f(p + 4), f(p + 8)));
+            variance.push(Vec3::new(f(p + 12), f(p + 16), f(p + 20)));
+        }
+        Ok(Self {
+            estimates: PixelEstimates {
+                width,
+                height,
+                mean,
+                variance,
+            },
+            meta,
+        })
+    }
+
+    /// Reads a golden file.
+    ///
+    /// # Errors
+    /// As [`GoldenImage::from_bytes`], or [`GoldenError::Io`].
+    pub fn read(path: &Path) -> Result<Self, GoldenError> {
+        let bytes = std::fs::read(path).map_err(|source| GoldenError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_bytes(&bytes, &path.display().to_string())
+    }
+
+    /// Writes the golden atomically (temporary file + rename).
+    ///
+    /// # Errors
+    /// When the file cannot be written.
+    pub fn write(&self, path: &Path) -> Result<(), OutputError> {
+        write_atomic(path, &self.to_bytes())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn golden() -> GoldenImage {
+        let mut sums = PixelSums::new(3, 2);
+        for (i, v) in [(0, 0.5), (0, 1.5), (0, 1.0), (4, 2.0), (4, 4.0), (5, 7.0)] {
+            sums.add(i, Vec3::new(v, v * 2.0, 0.25));
+        }
+        GoldenImage {
+            estimates: PixelEstimates::from_sums(&sums),
+            meta: GoldenMeta {
+                hash: 0xfeed_0000_beef,
+                seed: 7,
+                spp: 3,
+                integrator: "Path".into(),
+                sampler: "Sobol".into(),
+                exposure: 1.0,
+                scene: "scenes/cornell.ron".into(),
+                overrides: vec![
+                    ("set".into(), "lights[0].power=[1, 2, 3]".into()),
+                    ("width".into(), "64".into()),
+                ],
+                settings: vec![("render.width".into(), "64".into())],
+            },
+        }
+    }
+
+    #[test]
+    fn estimates_are_the_mean_and_the_variance_of_the_mean() {
+        let e = golden().estimates;
+        // Pixel 0: samples 0.5, 1.5, 1.0 → mean 1, sample variance 0.25, of the mean 0.25/3.
+        assert_eq!(e.mean[0].x, 1.0);
+        assert!(
+            (e.variance[0].x - 0.25 / 3.0).abs() < 1e-6,
+            "{}",
+            e.variance[0]
+        );
+        assert!((e.variance[0].y - 1.0 / 3.0).abs() < 1e-6);
+        assert_eq!(e.variance[0].z, 0.0);
+        // Pixel 4: 2 and 4 → variance 2, of the mean 1. Pixel 5: one sample, no estimate.
+        assert!((e.variance[4].x - 1.0).abs() < 1e-6);
+        assert_eq!((e.mean[5].x, e.variance[5].x), (7.0, 0.0));
+    }
+
+    #[test]
+    fn files_round_trip_and_corruption_is_detected() {
+        let g = golden();
+        let bytes = g.to_bytes();
+        assert_eq!(GoldenImage::from_bytes(&bytes, "g").unwrap(), g);
+        for cut in [0, 20, bytes.len() / 2, bytes.len() - 1] {
+            assert!(
+                GoldenImage::from_bytes(&bytes[..cut], "g").is_err(),
+                "{cut}"
+            );
+        }
+        let mut flipped = bytes.clone();
+        flipped[bytes.len() - 30] ^= 4;
+        let e = GoldenImage::from_bytes(&flipped, "g.golden").unwrap_err();
+        assert!(e.to_string().contains("checksum"), "{e}");
+        let text = g.meta.to_text().replace("seed=7", "seed=x");
+        let e = GoldenMeta::parse(&text, "g.golden").unwrap_err();
+        assert!(e.to_string().contains("`seed=x` is malformed"), "{e}");
+    }
+}
