@@ -7,6 +7,7 @@ pub mod distribution;
 pub mod rng;
 pub mod sampler;
 pub mod sobol;
+pub mod special;
 pub mod warp;
 
 pub use rng::Rng;

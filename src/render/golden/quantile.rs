@@ -4,8 +4,11 @@
 //! The normal tail uses the Chebyshev-fitted complementary error function of Press et al.,
 //! *Numerical Recipes* §6.2 (fractional error below 1.2·10⁻⁷ everywhere); the χ² tail is the
 //! regularized upper incomplete gamma function Q(k/2, x/2), by its series below a + 1 and by
-//! Lentz's continued fraction above (*Numerical Recipes* §6.2), with Lanczos' ln Γ. Quantiles
-//! invert the tails by bisection (to a relative 10⁻¹², far below the tails' own error).
+//! Lentz's continued fraction above — the one implementation the χ² tests of the samplers use
+//! too (`sampling::special`). Quantiles invert the tails by bisection (to a relative
+//! 10⁻¹², far below the tails' own error).
+
+use crate::sampling::special::gamma_q;
 
 /// The complementary error function erfc(x), fractional error < 1.2·10⁻⁷.
 #[must_use]
@@ -34,73 +37,6 @@ pub fn normal_upper_tail(z: f64) -> f64 {
 #[must_use]
 pub fn normal_upper_quantile(p: f64) -> f64 {
     invert_decreasing(normal_upper_tail, p, -40.0, 40.0)
-}
-
-/// ln Γ(x) for x > 0 (Lanczos' approximation, error below 2·10⁻¹⁰).
-fn ln_gamma(x: f64) -> f64 {
-    const C: [f64; 6] = [
-        76.180_091_729_471_46,
-        -86.505_320_329_416_77,
-        24.014_098_240_830_91,
-        -1.231_739_572_450_155,
-        0.120_865_097_386_617_9e-2,
-        -0.539_523_938_495_3e-5,
-    ];
-    let tmp = x + 5.5;
-    let tmp = tmp - (x + 0.5) * tmp.ln();
-    let mut ser = 1.000_000_000_190_015;
-    for (j, c) in C.iter().enumerate() {
-        ser += c / (x + 1.0 + j as f64);
-    }
-    -tmp + (2.506_628_274_631_000_5 * ser / x).ln()
-}
-
-/// The regularized upper incomplete gamma function Q(a, x) = Γ(a, x)/Γ(a), a > 0, x ≥ 0.
-fn gamma_q(a: f64, x: f64) -> f64 {
-    if x <= 0.0 {
-        return 1.0;
-    }
-    let front = (-x + a * x.ln() - ln_gamma(a)).exp();
-    if x < a + 1.0 {
-        // P(a, x) by its series Σ xⁿ/(a(a+1)…(a+n)).
-        let (mut ap, mut del) = (a, 1.0 / a);
-        let mut sum = del;
-        for _ in 0..10_000 {
-            ap += 1.0;
-            del *= x / ap;
-            sum += del;
-            if del.abs() < sum.abs() * 1e-16 {
-                break;
-            }
-        }
-        (1.0 - sum * front).max(0.0)
-    } else {
-        // Q(a, x) by its continued fraction (modified Lentz).
-        let tiny = 1e-300;
-        let mut b = x + 1.0 - a;
-        let mut c = 1.0 / tiny;
-        let mut d = 1.0 / b;
-        let mut h = d;
-        for i in 1..10_000 {
-            let an = -(i as f64) * (i as f64 - a);
-            b += 2.0;
-            d = an * d + b;
-            if d.abs() < tiny {
-                d = tiny;
-            }
-            c = b + an / c;
-            if c.abs() < tiny {
-                c = tiny;
-            }
-            d = 1.0 / d;
-            let del = d * c;
-            h *= del;
-            if (del - 1.0).abs() < 1e-16 {
-                break;
-            }
-        }
-        front * h
-    }
 }
 
 /// P(X > x) for X of the χ² distribution with `k` degrees of freedom.

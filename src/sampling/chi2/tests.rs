@@ -3,6 +3,7 @@
 //! subtly wrong ones (the controls that show it can fail).
 
 use super::*;
+use crate::sampling::special::ln_gamma;
 use crate::sampling::warp::{cosine_hemisphere, uniform_cone, uniform_sphere};
 use std::f32::consts::PI;
 
