@@ -102,9 +102,9 @@ fuzz_target!(|data: &[u8]| {
                 let s = rs.shading_point(&rs.materials[m as usize], &sp, wo, width);
                 if sp.p.is_finite() && sp.uv.is_finite() {
                     assert!(
-                        s.bsdf.color.is_finite(),
+                        s.bsdf.color().is_finite(),
                         "colour {} at {sp:?}",
-                        s.bsdf.color
+                        s.bsdf.color()
                     );
                     assert!(
                         s.ns.is_finite() && (s.ns.length() - 1.0).abs() < 1e-3,

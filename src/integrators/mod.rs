@@ -1,18 +1,28 @@
-//! Light-transport algorithms over the compiled scene: a closed set dispatched through an enum
-//! (no virtual calls per sample, as pbrt-v4's tagged integrators), each prepared once per render
-//! and then asked for the radiance of camera samples by every worker.
+//! Light-transport algorithms over the compiled scene, each prepared once per render and then
+//! asked for the radiance of camera samples by every worker.
+//!
+//! The contract is the [`Estimator`] trait: `li_parts` with one [`Context`] argument (sampler,
+//! counters and a [`PathObserver`], generic so that the no-op observer of normal renders
+//! compiles away), plus optional photon-map and pass hooks. The set of integrators is closed and
+//! dispatched through the [`Integrator`] enum, which the `integrators!` registration below
+//! generates: no virtual call per sample (pbrt-v4's CPU integrators are virtual classes; it
+//! keeps tagged-pointer dispatch for lights, BxDFs and materials — here it is an enum with
+//! exhaustive matches). Adding an integrator: its file, implementing [`Estimator`], and one
+//! line in `integrators!` (plus its `IntegratorKind` variant).
 
+pub mod context;
 pub mod path;
 pub mod photon;
-pub mod progressive;
+pub mod progressive_path;
 pub mod shadow;
 pub mod splat;
 pub mod trace_log;
 pub mod whitted;
 
+pub use context::{Context, NoTrace, PathObserver};
 pub use path::PathTracer;
 pub use photon::PhotonMapper;
-pub use progressive::ProgressivePath;
+pub use progressive_path::ProgressivePath;
 pub use trace_log::TraceLog;
 pub use whitted::Whitted;
 
@@ -20,7 +30,6 @@ use glam::Vec3;
 
 use crate::geometry::Ray;
 use crate::render_scene::{IntegratorKind, RenderScene};
-use crate::sampling::Sampler;
 
 /// Rays an integrator traced; each render worker owns one and the renderer sums them (samples
 /// and NaN/Inf counts are the renderer's own).
@@ -122,20 +131,126 @@ impl Radiance {
     }
 }
 
-/// A prepared integrator: shared, immutable state built once per render (light selection
-/// tables today; photon maps later), read by every worker.
-#[derive(Debug)]
-pub enum Integrator<'a> {
+/// What every integrator provides (the written contract). Implemented by each integrator type
+/// and dispatched statically through [`Integrator`].
+pub trait Estimator<'a> {
+    /// Radiance arriving at the camera along `ray` (W·m⁻²·sr⁻¹ per channel) split by how the
+    /// light reached the camera ([`LightPath`]), drawing random numbers from `cx.sampler`
+    /// (already started on this pixel sample), counting rays in `cx.counters` and telling
+    /// `cx.observer` about its paths.
+    fn li_parts<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance;
+
+    /// The photon maps it reads and how they were built, if it has any.
+    fn photon_maps(&self) -> Option<&photon::PhotonMaps> {
+        None
+    }
+
+    /// The per-pass photon maps of a progressive integrator.
+    fn progressive(&self) -> Option<&photon::ProgressivePhotons<'a>> {
+        None
+    }
+
+    /// Sets up the shared state of pass `sample` (progressive integrators); nothing otherwise.
+    fn begin_pass(&mut self, _sample: u32) {}
+}
+
+/// The registration of every integrator: variant, type, the `IntegratorKind` that selects it
+/// and how it is prepared from the scene and the photon-cache folder. Generates [`Integrator`]
+/// and its dispatch (exhaustive matches: a new variant cannot be forgotten anywhere).
+macro_rules! integrators {
+    ($(
+        $(#[$doc:meta])*
+        $variant:ident($ty:ty) = $kind:ident, |$scene:ident, $cache:ident, $cancel:ident| $make:expr;
+    )*) => {
+        /// A prepared integrator: shared, immutable state built once per render (light
+        /// selection tables, photon maps), read by every worker.
+        #[derive(Debug)]
+        pub enum Integrator<'a> {
+            $($(#[$doc])* $variant($ty),)*
+        }
+
+        impl<'a> Integrator<'a> {
+            /// [`Integrator::prepare`], with photon maps read from and saved to the cache folder
+            /// `photon_cache` (`--photon-cache`; see [`photon::cache`]).
+            #[must_use]
+            pub fn prepare_with(
+                scene: &'a RenderScene,
+                photon_cache: Option<&std::path::Path>,
+            ) -> Self {
+                Self::prepare_cancellable(scene, photon_cache, None)
+            }
+
+            /// [`Integrator::prepare_with`], whose photon tracing (the photon integrator's maps
+            /// here, a progressive one's in every [`Integrator::begin_pass`]) stops soon after
+            /// `cancel` is raised; check the flag before rendering with the result.
+            #[must_use]
+            pub fn prepare_cancellable(
+                scene: &'a RenderScene,
+                photon_cache: Option<&std::path::Path>,
+                cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+            ) -> Self {
+                match scene.params.integrator {
+                    $(IntegratorKind::$kind => {
+                        let ($scene, $cache, $cancel) = (scene, photon_cache, cancel);
+                        let _ = (&$cache, &$cancel);
+                        Integrator::$variant($make)
+                    })*
+                }
+            }
+
+            /// The photon maps and how they were built: the photon integrator's, or the current
+            /// pass's of a progressive one.
+            #[must_use]
+            pub fn photon_maps(&self) -> Option<&photon::PhotonMaps> {
+                match self {
+                    $(Integrator::$variant(x) => x.photon_maps(),)*
+                }
+            }
+
+            /// The per-pass photon maps of a progressive integrator (`None` for the others).
+            #[must_use]
+            pub fn progressive(&self) -> Option<&photon::ProgressivePhotons<'a>> {
+                match self {
+                    $(Integrator::$variant(x) => x.progressive(),)*
+                }
+            }
+
+            /// Sets up the shared state of pass `sample` (progressive integrators: that pass's
+            /// photon maps, built in parallel on the calling thread pool); a no-op for the others.
+            pub fn begin_pass(&mut self, sample: u32) {
+                match self {
+                    $(Integrator::$variant(x) => x.begin_pass(sample),)*
+                }
+            }
+
+            /// [`Integrator::li`] split by how the light reached the camera ([`LightPath`]).
+            #[inline]
+            pub fn li_parts<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance {
+                match self {
+                    $(Integrator::$variant(x) => x.li_parts(ray, cx),)*
+                }
+            }
+        }
+    };
+}
+
+integrators! {
     /// Recursive ray tracing ([`Whitted`]).
-    Whitted(Whitted<'a>),
+    Whitted(Whitted<'a>) = Whitted, |scene, _cache, _cancel| Whitted::new(scene);
     /// Unidirectional path tracing with next-event estimation ([`PathTracer`]).
-    Path(PathTracer<'a>),
+    Path(PathTracer<'a>) = Path, |scene, _cache, _cancel| PathTracer::new(scene);
     /// Photon mapping ([`PhotonMapper`]); its maps are built by `prepare`.
-    Photon(Box<PhotonMapper<'a>>),
+    Photon(Box<PhotonMapper<'a>>) = Photon, |scene, cache, cancel| {
+        Box::new(PhotonMapper::new(scene, cache, cancel))
+    };
     /// Progressive photon mapping ([`ProgressivePath::ppm`]); fresh maps every pass.
-    Ppm(Box<ProgressivePath<'a>>),
+    Ppm(Box<ProgressivePath<'a>>) = Ppm, |scene, _cache, cancel| {
+        Box::new(ProgressivePath::ppm(scene).with_cancel(cancel))
+    };
     /// Path tracing with progressive photon maps ([`ProgressivePath::path_ppm`]).
-    PathPpm(Box<ProgressivePath<'a>>),
+    PathPpm(Box<ProgressivePath<'a>>) = PathPpm, |scene, _cache, cancel| {
+        Box::new(ProgressivePath::path_ppm(scene).with_cancel(cancel))
+    };
 }
 
 impl<'a> Integrator<'a> {
@@ -145,61 +260,6 @@ impl<'a> Integrator<'a> {
         Self::prepare_with(scene, None)
     }
 
-    /// [`Integrator::prepare`], with photon maps read from and saved to the cache folder
-    /// `photon_cache` (`--photon-cache`; see [`photon::cache`]).
-    #[must_use]
-    pub fn prepare_with(scene: &'a RenderScene, photon_cache: Option<&std::path::Path>) -> Self {
-        Self::prepare_cancellable(scene, photon_cache, None)
-    }
-
-    /// [`Integrator::prepare_with`], whose photon tracing (the photon integrator's maps here,
-    /// a progressive one's in every [`Integrator::begin_pass`]) stops soon after `cancel` is
-    /// raised; check the flag before rendering with the result.
-    #[must_use]
-    pub fn prepare_cancellable(
-        scene: &'a RenderScene,
-        photon_cache: Option<&std::path::Path>,
-        cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
-    ) -> Self {
-        match scene.params.integrator {
-            IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(scene)),
-            IntegratorKind::Path => Integrator::Path(PathTracer::new(scene)),
-            IntegratorKind::Photon => {
-                Integrator::Photon(Box::new(PhotonMapper::new(scene, photon_cache, cancel)))
-            }
-            IntegratorKind::Ppm => {
-                let mut p = ProgressivePath::ppm(scene);
-                p.set_cancel(cancel);
-                Integrator::Ppm(Box::new(p))
-            }
-            IntegratorKind::PathPpm => {
-                let mut p = ProgressivePath::path_ppm(scene);
-                p.set_cancel(cancel);
-                Integrator::PathPpm(Box::new(p))
-            }
-        }
-    }
-
-    /// The photon maps and how they were built: the photon integrator's, or the current pass's
-    /// of a progressive one.
-    #[must_use]
-    pub fn photon_maps(&self) -> Option<&photon::PhotonMaps> {
-        match self {
-            Integrator::Photon(p) => Some(p.maps()),
-            Integrator::Ppm(p) | Integrator::PathPpm(p) => Some(p.photons().maps()),
-            _ => None,
-        }
-    }
-
-    /// The per-pass photon maps of a progressive integrator (`None` for the others).
-    #[must_use]
-    pub fn progressive(&self) -> Option<&photon::ProgressivePhotons<'a>> {
-        match self {
-            Integrator::Ppm(p) | Integrator::PathPpm(p) => Some(p.photons()),
-            _ => None,
-        }
-    }
-
     /// True when every sample index is a pass with its own shared state (photon maps), which
     /// [`Integrator::begin_pass`] must set up before that sample of any pixel is taken.
     #[must_use]
@@ -207,43 +267,10 @@ impl<'a> Integrator<'a> {
         self.progressive().is_some()
     }
 
-    /// Sets up the shared state of pass `sample` (progressive integrators: that pass's photon
-    /// maps, built in parallel on the calling thread pool); a no-op for the others.
-    pub fn begin_pass(&mut self, sample: u32) {
-        match self {
-            Integrator::Ppm(p) | Integrator::PathPpm(p) => p.begin_pass(sample),
-            _ => {}
-        }
-    }
-
-    /// Radiance arriving at the camera along `ray` (W·m⁻²·sr⁻¹ per channel), drawing its
-    /// random numbers from `sampler` (already started on this pixel sample), counting rays in
-    /// `counters`; `log` records the ray tree for `caustic debug-pixel`.
+    /// Radiance arriving at the camera along `ray` (W·m⁻²·sr⁻¹ per channel), with the sampler,
+    /// counters and path observer of `cx` ([`Estimator::li_parts`]).
     #[inline]
-    pub fn li(
-        &self,
-        ray: Ray,
-        sampler: &mut Sampler,
-        counters: &mut Counters,
-        log: Option<&mut TraceLog>,
-    ) -> Vec3 {
-        self.li_parts(ray, sampler, counters, log).total()
-    }
-
-    /// [`Integrator::li`] split by how the light reached the camera ([`LightPath`]).
-    #[inline]
-    pub fn li_parts(
-        &self,
-        ray: Ray,
-        sampler: &mut Sampler,
-        counters: &mut Counters,
-        log: Option<&mut TraceLog>,
-    ) -> Radiance {
-        match self {
-            Integrator::Whitted(w) => w.li(ray, sampler, counters, log),
-            Integrator::Path(p) => p.li(ray, sampler, counters, log),
-            Integrator::Photon(p) => p.li(ray, sampler, counters, log),
-            Integrator::Ppm(p) | Integrator::PathPpm(p) => p.li(ray, sampler, counters, log),
-        }
+    pub fn li<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Vec3 {
+        self.li_parts(ray, cx).total()
     }
 }

@@ -5,14 +5,14 @@
 
 use glam::Vec3;
 
+use super::context::{Context, PathObserver};
 use super::photon::PhotonMap;
 use super::shadow::{LightConnection, RayCone, connect_light};
-use super::trace_log::{RayKind, ShadowRecord, TraceLog};
-use super::{Counters, LightPath, Radiance};
+use super::trace_log::{RayKind, ShadowRecord};
+use super::{LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Light, LightSampler, RenderScene, SurfacePoint};
-use crate::sampling::Sampler;
+use crate::render_scene::{Interaction, LightSampler, RenderScene, SurfacePoint};
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
 /// Bounces after which Russian roulette may end a path.
@@ -68,14 +68,8 @@ impl<'a> PathTracer<'a> {
     /// Radiance arriving along camera ray `ray`. Paths have at most `render.max_depth` bounces
     /// and at most `render.diffuse_depth` non-delta ones (0: direct light and delta chains only,
     /// Whitted's light transport); the background is an environment that escaping rays see.
-    pub fn li(
-        &self,
-        ray: Ray,
-        sampler: &mut Sampler,
-        counters: &mut Counters,
-        log: Option<&mut TraceLog>,
-    ) -> Radiance {
-        self.li_with_maps(PathMaps::default(), ray, sampler, counters, log)
+    pub fn li<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance {
+        self.li_with_maps(PathMaps::default(), ray, cx)
     }
 
     /// [`PathTracer::li`] reading photon maps (the progressive integrators):
@@ -92,13 +86,11 @@ impl<'a> PathTracer<'a> {
     ///
     /// The parts are disjoint and together make every path, so the image converges to the
     /// path tracer's as the maps' radii shrink.
-    pub fn li_with_maps(
+    pub fn li_with_maps<O: PathObserver>(
         &self,
         maps: PathMaps<'_>,
         ray: Ray,
-        sampler: &mut Sampler,
-        counters: &mut Counters,
-        mut log: Option<&mut TraceLog>,
+        cx: &mut Context<'_, O>,
     ) -> Radiance {
         let scene = self.scene;
         let params = &scene.params;
@@ -127,90 +119,71 @@ impl<'a> PathTracer<'a> {
         // Debug logs only: each node holds the radiance gathered before it until the path ends.
         let mut root: Option<usize> = None;
         loop {
-            counters.rays += 1;
-            let node = log.as_deref_mut().map(|lg| {
-                let id = lg.push(depth, kind, &ray, beta, parent);
-                lg.nodes[id].radiance = l.total();
-                id
-            });
+            cx.counters.rays += 1;
+            let node = cx.observer.ray(depth, kind, &ray, beta, parent);
+            if O::ACTIVE {
+                cx.observer.set_radiance(node, l.total());
+            }
             root = root.or(node);
-            let Some(hit) = scene.geometry.intersect(&ray) else {
-                let via = since_local.is_some_and(|n| n > 0);
-                l.add(
-                    LightPath::classify(diffuse_bounces, via),
-                    beta * params.background,
-                );
-                break;
-            };
-            let sp = scene.geometry.surface(&ray, &hit);
-            let object = &scene.objects[sp.object as usize];
-            let wo = -ray.dir.normalize();
-            let Some(m) = object.material else {
-                // An emitter (seen from outside only); it absorbs what reaches it.
-                let le = match object.light.map(|i| (i, scene.lights[i as usize])) {
-                    Some(_) if background_only => Vec3::ZERO,
-                    Some(_) if map_read && since_local.is_some_and(|n| n > 0) => Vec3::ZERO,
-                    Some((i, Light::Sphere { radiance, .. })) if wo.dot(sp.ng) > 0.0 => {
-                        let w = if specular {
-                            1.0
-                        } else {
-                            let light_pdf = self.lights.pmf(i as usize)
-                                * scene.lights[i as usize].pdf_li(prev_p, -wo);
-                            power_heuristic(prev_pdf, light_pdf)
-                        };
-                        radiance * w
-                    }
-                    _ => Vec3::ZERO,
-                };
-                let via = since_local.is_some_and(|n| n > 0);
-                l.add(LightPath::classify(diffuse_bounces, via), beta * le);
-                if let Some(lg) = log.as_deref_mut() {
-                    lg.record_hit(node, scene, &hit, &sp, "light");
+            let v = match scene.interact(&ray, |t| cone.width_at(&ray, t)) {
+                Interaction::Escaped => {
+                    let via = since_local.is_some_and(|n| n > 0);
+                    l.add(
+                        LightPath::classify(diffuse_bounces, via),
+                        beta * params.background,
+                    );
+                    break;
                 }
-                break;
+                Interaction::Emitter(e) => {
+                    // An emitter (seen from outside only); it absorbs what reaches it.
+                    let le = match e.light {
+                        None => Vec3::ZERO,
+                        Some(_) if background_only => Vec3::ZERO,
+                        Some(_) if map_read && since_local.is_some_and(|n| n > 0) => Vec3::ZERO,
+                        Some(i) => {
+                            let le = e.le(scene);
+                            if le == Vec3::ZERO {
+                                le
+                            } else {
+                                let w = if specular {
+                                    1.0
+                                } else {
+                                    let light_pdf = self.lights.pmf(i as usize)
+                                        * scene.lights[i as usize].pdf_li(prev_p, -e.wo);
+                                    power_heuristic(prev_pdf, light_pdf)
+                                };
+                                le * w
+                            }
+                        }
+                    };
+                    let via = since_local.is_some_and(|n| n > 0);
+                    l.add(LightPath::classify(diffuse_bounces, via), beta * le);
+                    cx.observer.hit(node, scene, &e.hit, &e.sp, "light");
+                    break;
+                }
+                Interaction::Surface(v) => v,
             };
-            let sh = scene.shading_point(
-                &scene.materials[m as usize],
-                &sp,
-                wo,
-                cone.width_at(&ray, hit.t),
-            );
-            if let Some(lg) = log.as_deref_mut() {
-                let name = scene.material_names[m as usize].clone();
-                lg.record_hit(node, scene, &hit, &sp, &name);
-            }
+            let (hit, sp, wo) = (v.hit, v.sp, v.wo);
+            let name = &scene.material_names[v.material as usize];
+            cx.observer.hit(node, scene, &hit, &sp, name);
             if depth >= params.max_depth {
-                TraceLog::note(log.as_deref_mut(), node, "max depth reached");
+                cx.observer.note(node, "max depth reached");
                 break;
             }
-            let fr = ShadingFrame {
-                ns: sh.ns,
-                ng: sh.ng,
-                entering: sh.entering,
-            };
-            let bsdf = sh.bsdf;
+            let fr = v.frame;
+            let bsdf = v.bsdf;
             let may_scatter = diffuse_bounces < params.diffuse_depth;
             let local = bsdf.has_local() && !background_only;
             let read_global =
                 local && may_scatter && maps.global.is_some() && diffuse_bounces == maps.global_at;
             // Next-event estimation through the non-delta part. Every bounce reserves the same
             // dimensions, whether or not it uses them, and computes only those it uses.
-            let u_light = sampler.defer_1d();
-            let u_point = sampler.defer_2d();
-            if local && let Some((index, pmf)) = self.lights.choose(|| sampler.get_1d(u_light)) {
-                let c = self.direct(
-                    &sp,
-                    wo,
-                    &fr,
-                    &bsdf,
-                    index,
-                    pmf,
-                    sampler.get_2d(u_point),
-                    may_scatter && !read_global,
-                    counters,
-                    log.as_deref_mut(),
-                    node,
-                );
+            let u_light = cx.sampler.defer_1d();
+            let u_point = cx.sampler.defer_2d();
+            if local && let Some((index, pmf)) = self.lights.choose(|| cx.sampler.get_1d(u_light)) {
+                let u = cx.sampler.get_2d(u_point);
+                let scatter = may_scatter && !read_global;
+                let c = self.direct(&sp, wo, &fr, &bsdf, index, pmf, u, scatter, cx, node);
                 l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
             }
             let read_caustic = local
@@ -227,28 +200,28 @@ impl<'a> PathTracer<'a> {
                 ] {
                     let Some(map) = map else { continue };
                     let e = map.estimate(sp.p, wo, &fr, &bsdf);
-                    counters.photon_estimates += 1;
+                    cx.counters.photon_estimates += 1;
                     l.add(kind, beta * e.radiance);
-                    if log.is_some() {
+                    if O::ACTIVE {
                         let text = format!(
                             "{name} map: {} photons within r = {:.4} → ({:.4}, {:.4}, {:.4})",
                             e.found, e.radius, e.radiance.x, e.radiance.y, e.radiance.z
                         );
-                        TraceLog::note(log.as_deref_mut(), node, &text);
+                        cx.observer.note(node, &text);
                     }
                 }
             }
             // Continue the path by sampling the BSDF.
-            let u_lobe = sampler.defer_1d();
-            let u_dir = sampler.next_2d();
-            let u_rr = sampler.defer_1d();
-            let u_lobe = bsdf.lobe_number(|| sampler.get_1d(u_lobe));
+            let u_lobe = cx.sampler.defer_1d();
+            let u_dir = cx.sampler.next_2d();
+            let u_rr = cx.sampler.defer_1d();
+            let u_lobe = bsdf.lobe_number(|| cx.sampler.get_1d(u_lobe));
             let Some(s) = bsdf.sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance) else {
                 break;
             };
             if !s.delta {
                 if !may_scatter {
-                    TraceLog::note(log.as_deref_mut(), node, "diffuse depth reached");
+                    cx.observer.note(node, "diffuse depth reached");
                     break;
                 }
                 diffuse_bounces += 1;
@@ -263,8 +236,8 @@ impl<'a> PathTracer<'a> {
             depth += 1;
             if depth > ROULETTE_DEPTH {
                 let q = (beta / eta_scale).max_element().min(1.0);
-                if sampler.get_1d(u_rr) >= q {
-                    TraceLog::note(log.as_deref_mut(), node, "ended by Russian roulette");
+                if cx.sampler.get_1d(u_rr) >= q {
+                    cx.observer.note(node, "ended by Russian roulette");
                     break;
                 }
                 beta /= q;
@@ -299,15 +272,10 @@ impl<'a> PathTracer<'a> {
             let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
             ray = Ray::new(origin, s.wi);
         }
-        if let (Some(lg), Some(root)) = (log, root) {
+        if O::ACTIVE {
             // The radiance each logged ray brought back: what the path gathered from it on,
             // divided by the path weight it carried.
-            let total = l.total();
-            for n in &mut lg.nodes[root..] {
-                let gathered = total - n.radiance;
-                n.radiance =
-                    Vec3::select(n.weight.cmpgt(Vec3::ZERO), gathered / n.weight, Vec3::ZERO);
-            }
+            cx.observer.finish_path(root, l.total());
         }
         l
     }
@@ -319,7 +287,7 @@ impl PathTracer<'_> {
     /// sampling when the path may still scatter diffusely (else the light sample alone stands
     /// for direct light). Logged as a shadow record.
     #[allow(clippy::too_many_arguments)]
-    fn direct(
+    fn direct<O: PathObserver>(
         &self,
         sp: &SurfacePoint,
         wo: Vec3,
@@ -329,15 +297,14 @@ impl PathTracer<'_> {
         pmf: f32,
         u: (f32, f32),
         may_scatter: bool,
-        counters: &mut Counters,
-        log: Option<&mut TraceLog>,
+        cx: &mut Context<'_, O>,
         node: Option<usize>,
     ) -> Vec3 {
         let Some(LightConnection {
             ls,
             f,
             occluded: blocked,
-        }) = connect_light(self.scene, index, sp, wo, fr, bsdf, u, counters)
+        }) = connect_light(self.scene, index, sp, wo, fr, bsdf, u, cx.counters)
         else {
             return Vec3::ZERO;
         };
@@ -351,15 +318,22 @@ impl PathTracer<'_> {
         } else {
             f * (fr.ns.dot(ls.wi) * w / (ls.pdf * pmf)) * ls.radiance
         };
-        if let (Some(lg), Some(me)) = (log, node) {
-            lg.nodes[me].shadows.push(ShadowRecord {
+        if O::ACTIVE {
+            let record = ShadowRecord {
                 light: index,
                 dir: ls.wi,
                 occluded: blocked,
                 contribution: c,
                 blocker: None,
-            });
+            };
+            cx.observer.shadow(node, record);
         }
         c
+    }
+}
+
+impl<'a> super::Estimator<'a> for PathTracer<'a> {
+    fn li_parts<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance {
+        self.li(ray, cx)
     }
 }

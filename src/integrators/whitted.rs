@@ -3,14 +3,14 @@
 
 use glam::Vec3;
 
+use super::context::{Context, PathObserver};
 use super::shadow::{RayCone, shadow_ray};
-use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog};
+use super::trace_log::{RayKind, ShadowRecord, TraceHit};
 use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Light, RenderScene, ShadingPoint, SurfacePoint};
-use crate::sampling::Sampler;
-use crate::shading::Bsdf;
+use crate::render_scene::{Interaction, RenderScene, SurfacePoint};
+use crate::shading::{Bsdf, LobeFlags, ShadingFrame};
 
 /// The Whitted-style integrator over a compiled scene.
 #[derive(Debug)]
@@ -40,18 +40,15 @@ impl<'a> Whitted<'a> {
         Self {
             scene,
             pixel_spread: scene.pixel_spread(),
-            transmissive: scene.materials.iter().any(|m| m.bsdf.transmit > 0.0),
+            transmissive: scene
+                .materials
+                .iter()
+                .any(|m| m.bsdf.flags().contains(LobeFlags::TRANSMISSION)),
         }
     }
 
     /// Radiance arriving along a camera ray.
-    pub fn li(
-        &self,
-        ray: Ray,
-        rng: &mut Sampler,
-        counters: &mut Counters,
-        log: Option<&mut TraceLog>,
-    ) -> Radiance {
+    pub fn li<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance {
         let path = Path {
             ray,
             depth: 0,
@@ -59,100 +56,82 @@ impl<'a> Whitted<'a> {
             kind: RayKind::Camera,
             cone: RayCone::camera(self.pixel_spread),
         };
-        self.trace(path, rng, counters, log, None)
+        self.trace(path, cx, None)
     }
 
-    fn trace(
+    fn trace<O: PathObserver>(
         &self,
         path: Path,
-        rng: &mut Sampler,
-        counters: &mut Counters,
-        mut log: Option<&mut TraceLog>,
+        cx: &mut Context<'_, O>,
         parent: Option<usize>,
     ) -> Radiance {
-        let me = log
-            .as_deref_mut()
-            .map(|l| l.push(path.depth, path.kind, &path.ray, path.weight, parent));
-        let (l, hit_info) = self.shade(&path, rng, counters, log.as_deref_mut(), me);
-        if let (Some(log), Some(me)) = (log, me) {
-            log.nodes[me].radiance = l.total();
-            log.nodes[me].hit = hit_info;
+        let me = cx
+            .observer
+            .ray(path.depth, path.kind, &path.ray, path.weight, parent);
+        let (l, hit_info) = self.shade(&path, cx, me);
+        if O::ACTIVE {
+            cx.observer.set_radiance(me, l.total());
+            if let Some(h) = hit_info {
+                cx.observer.set_hit(me, h);
+            }
         }
         l
     }
 
-    fn shade(
+    fn shade<O: PathObserver>(
         &self,
         path: &Path,
-        rng: &mut Sampler,
-        counters: &mut Counters,
-        mut log: Option<&mut TraceLog>,
+        cx: &mut Context<'_, O>,
         me: Option<usize>,
     ) -> (Radiance, Option<TraceHit>) {
         let scene = self.scene;
-        counters.rays += 1;
+        cx.counters.rays += 1;
         let ray = &path.ray;
-        let Some(hit) = scene.geometry.intersect(ray) else {
-            return (seen(scene.params.background), None);
+        let v = match scene.interact(ray, |t| path.cone.width_at(ray, t)) {
+            Interaction::Escaped => return (seen(scene.params.background), None),
+            Interaction::Emitter(e) => {
+                let entering = e.wo.dot(e.sp.ng) > 0.0;
+                let info = O::ACTIVE.then(|| TraceHit {
+                    t: e.hit.t,
+                    point: e.sp.p,
+                    normal: if entering { e.sp.ns } else { -e.sp.ns },
+                    object: scene.objects[e.sp.object as usize].name.clone(),
+                    material: "light".into(),
+                    entering,
+                });
+                // An emitter: its radiance is seen from outside only.
+                return (seen(e.le(scene)), info);
+            }
+            Interaction::Surface(v) => v,
         };
-        let sp = scene.geometry.surface(ray, &hit);
-        let object = &scene.objects[sp.object as usize];
-        let wo = -ray.dir.normalize();
-        let entering = wo.dot(sp.ng) > 0.0;
-        let shading = object.material.map(|m| {
-            let width = path.cone.width_at(ray, hit.t);
-            scene.shading_point(&scene.materials[m as usize], &sp, wo, width)
-        });
-        let info = log.is_some().then(|| TraceHit {
+        let (hit, sp, wo) = (v.hit, v.sp, v.wo);
+        let ShadingFrame { ns, ng, entering } = v.frame;
+        let material = v.bsdf;
+        let info = O::ACTIVE.then(|| TraceHit {
             t: hit.t,
             point: sp.p,
-            normal: shading.map_or(if entering { sp.ns } else { -sp.ns }, |s| s.ns),
-            object: object.name.clone(),
-            material: object
-                .material
-                .map_or("light".into(), |m| scene.material_names[m as usize].clone()),
-            entering,
+            normal: ns,
+            object: scene.objects[sp.object as usize].name.clone(),
+            material: scene.material_names[v.material as usize].clone(),
+            entering: wo.dot(sp.ng) > 0.0,
         });
-        let Some(ShadingPoint {
-            bsdf: material,
-            ng,
-            ns,
-            entering,
-        }) = shading
-        else {
-            // An emitter: its radiance is seen from outside only.
-            let l = match object.light.map(|i| scene.lights[i as usize]) {
-                Some(Light::Sphere { radiance, .. }) if entering => radiance,
-                _ => Vec3::ZERO,
-            };
-            return (seen(l), info);
-        };
         let mut l = Radiance::default();
         if material.has_local() {
-            let direct = self.direct(
-                &sp,
-                &material,
-                wo,
-                ng,
-                ns,
-                rng,
-                counters,
-                log.as_deref_mut(),
-                me,
-            );
+            let direct = self.direct(&sp, &material, wo, ng, ns, cx, me);
             l.add(LightPath::Direct, direct);
         }
         if !material.has_delta() {
             return (l, info);
         }
         if path.depth >= scene.params.max_depth {
-            TraceLog::note(log, me, "max depth reached: specular rays not traced");
+            cx.observer
+                .note(me, "max depth reached: specular rays not traced");
             return (l, info);
         }
         let lobes = material.delta_lobes(wo, ns, ng, entering);
         let min = scene.params.min_contribution;
         let curvature = scene.geometry.curvature(&hit);
-        let mut spawn = |dir: Vec3, w: Vec3, kind: RayKind, log: Option<&mut TraceLog>| {
+        let mut spawn = |dir: Vec3, w: Vec3, kind: RayKind, cx: &mut Context<'_, O>| {
             let weight = path.weight * w;
             if weight.max_element() < min || weight.max_element() <= 0.0 {
                 return;
@@ -170,44 +149,39 @@ impl<'a> Whitted<'a> {
                     if kind == RayKind::Reflect { 2.0 } else { 1.0 },
                 ),
             };
-            let seen = self.trace(child, rng, counters, log, me);
+            let seen = self.trace(child, cx, me);
             l.add_scaled(&seen, w);
         };
         spawn(
             lobes.reflect_dir,
             lobes.reflect_weight,
             RayKind::Reflect,
-            log.as_deref_mut(),
+            cx,
         );
         if let Some((dir, w)) = lobes.refract {
-            spawn(dir, w, RayKind::Refract, log);
+            spawn(dir, w, RayKind::Refract, cx);
         }
         (l, info)
     }
 
     /// Light arriving directly from every light source, through the non-delta part of the BSDF.
     #[allow(clippy::too_many_arguments)]
-    fn direct(
+    fn direct<O: PathObserver>(
         &self,
         sp: &SurfacePoint,
         material: &Bsdf,
         wo: Vec3,
         ng: Vec3,
         ns: Vec3,
-        rng: &mut Sampler,
-        counters: &mut Counters,
-        mut log: Option<&mut TraceLog>,
+        cx: &mut Context<'_, O>,
         me: Option<usize>,
     ) -> Vec3 {
         let mut total = Vec3::ZERO;
         for (index, light) in self.scene.lights.iter().enumerate() {
-            let n = match light {
-                Light::Point { .. } => 1,
-                Light::Sphere { .. } => self.scene.params.light_samples,
-            };
+            let n = light.shadow_samples(self.scene.params.light_samples);
             let mut sum = Vec3::ZERO;
             for _ in 0..n {
-                let u = rng.next_2d();
+                let u = cx.sampler.next_2d();
                 let Some(ls) = light.sample_li(sp.p, u) else {
                     continue;
                 };
@@ -221,11 +195,11 @@ impl<'a> Whitted<'a> {
                 }
                 // Aim at the sampled light point itself, stopping just short of it.
                 let shadow = shadow_ray(sp, ng, ls.point);
-                let transmittance = self.transmittance(&shadow, counters);
+                let transmittance = self.transmittance(&shadow, cx.counters);
                 let occluded = transmittance == Vec3::ZERO;
                 let c = f * ls.weight * cos_s * transmittance;
                 sum += c;
-                if let (Some(log), Some(me)) = (log.as_deref_mut(), me) {
+                if O::ACTIVE {
                     let contribution = c / n as f32;
                     let blocker = occluded
                         .then(|| self.scene.geometry.intersect(&shadow))
@@ -241,7 +215,7 @@ impl<'a> Whitted<'a> {
                         contribution,
                         blocker,
                     };
-                    log.nodes[me].shadows.push(record);
+                    cx.observer.shadow(me, record);
                 }
             }
             total += sum / n as f32;
@@ -273,22 +247,18 @@ impl Whitted<'_> {
         let mut ray = *shadow;
         let mut t = Vec3::ONE;
         for _ in 0..MAX_SHADOW_CROSSINGS {
-            let Some(hit) = scene.geometry.intersect(&ray) else {
-                return t;
+            let v = match scene.interact(&ray, |_| 0.0) {
+                Interaction::Escaped => return t,
+                Interaction::Surface(v) if !scene.is_opaque(v.sp.object) => v,
+                Interaction::Surface(_) | Interaction::Emitter(_) => return Vec3::ZERO,
             };
-            let object = scene.geometry.object_of(hit.prim);
-            let material = match scene.objects[object as usize].material {
-                Some(m) if !scene.is_opaque(object) => &scene.materials[m as usize],
-                _ => return Vec3::ZERO,
-            };
-            let sp = scene.geometry.surface(&ray, &hit);
-            let wo = -ray.dir.normalize();
-            let s = scene.shading_point(material, &sp, wo, 0.0);
-            t *= s.bsdf.straight_transmittance(s.ns.dot(wo), s.entering);
+            t *= v
+                .bsdf
+                .straight_transmittance(v.frame.ns.dot(v.wo), v.frame.entering);
             if t.max_element() <= 0.0 {
                 return Vec3::ZERO;
             }
-            let origin = offset_ray_origin(sp.p, sp.p_error, -s.ng, ray.dir);
+            let origin = offset_ray_origin(v.sp.p, v.sp.p_error, -v.frame.ng, ray.dir);
             ray = Ray {
                 origin,
                 dir: end - origin,
@@ -306,4 +276,10 @@ fn seen(l: Vec3) -> Radiance {
     let mut r = Radiance::default();
     r.add(LightPath::Specular, l);
     r
+}
+
+impl<'a> super::Estimator<'a> for Whitted<'a> {
+    fn li_parts<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance {
+        self.li(ray, cx)
+    }
 }

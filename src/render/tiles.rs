@@ -10,7 +10,7 @@ use indicatif::ProgressBar;
 use super::options::Region;
 use super::pixel_sums::PixelSums;
 use crate::geometry::Ray;
-use crate::integrators::{Counters, Integrator, LightPath};
+use crate::integrators::{Context, Counters, Integrator, LightPath, NoTrace};
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
 
@@ -95,7 +95,10 @@ pub(super) fn render_tile(
         );
         for s in samples.clone() {
             let ray = camera_sample(scene, &mut sampler, x, y, s);
-            let r = integrator.li_parts(ray, &mut sampler, &mut counters, None);
+            let r = integrator.li_parts(
+                ray,
+                &mut Context::new(&mut sampler, &mut counters, &mut NoTrace),
+            );
             let l = r.total();
             if l.is_finite() {
                 out.add(i, l);

@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::options::RenderError;
 use super::tiles::camera_sample;
-use crate::integrators::{Counters, Integrator, TraceLog};
+use crate::integrators::{Context, Counters, Integrator, TraceLog};
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
 
@@ -36,6 +36,9 @@ pub fn trace_pixel_with(
     let mut log = TraceLog::default();
     let mut integrator = Integrator::prepare_with(scene, photon_cache);
     integrator.begin_pass(sample);
-    let l = integrator.li(ray, &mut sampler, &mut Counters::default(), Some(&mut log));
+    let l = integrator.li(
+        ray,
+        &mut Context::new(&mut sampler, &mut Counters::default(), &mut log),
+    );
     Ok((log, l))
 }

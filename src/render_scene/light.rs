@@ -9,7 +9,9 @@
 use glam::Vec3;
 use std::f32::consts::{PI, TAU};
 
-use crate::geometry::Frame;
+use crate::geometry::offset::offset_ray_origin;
+use crate::geometry::{Frame, Ray};
+use crate::sampling::Sampler;
 use crate::sampling::warp::{cosine_hemisphere, uniform_sphere};
 
 /// A light source in world space.
@@ -318,6 +320,103 @@ impl Light {
             } => radiance * 4.0 * PI * PI * radius * radius,
         }
     }
+}
+
+impl Light {
+    /// Shadow rays an estimator that lights every point from every light (Whitted) casts
+    /// towards this light: one for a delta light (every sample would be the same ray),
+    /// `per_area_light` (`render.light_samples`) for a light with extent.
+    #[inline]
+    #[must_use]
+    pub fn shadow_samples(&self, per_area_light: u32) -> u32 {
+        match self {
+            Light::Point { .. } => 1,
+            Light::Sphere { .. } => per_area_light,
+        }
+    }
+
+    /// One of `n` photons (or light paths) leaving the light with evenly spread directions, and
+    /// its flux (W per channel). A light that emits from one point uniformly over the sphere
+    /// takes its direction from `lattice()` (a unit direction of an even point set of density
+    /// `1/(4π)`, such as a rotated spherical Fibonacci lattice) and carries `Φ / n`; a light
+    /// with area draws a ray from [`Light::sample_le`] with two pairs of `sampler` uniforms and
+    /// carries `Le · cos θ / (pdf_pos · pdf_dir · n)`. `None` for a black light or a grazing
+    /// emission direction.
+    #[must_use]
+    pub fn emit_spread(
+        &self,
+        lattice: impl FnOnce() -> Vec3,
+        sampler: &mut Sampler,
+        n: f32,
+    ) -> Option<(Ray, Vec3)> {
+        match *self {
+            Light::Point { position, .. } => {
+                let dir = lattice();
+                let power = self.power() / n;
+                (power.max_element() > 0.0).then(|| (Ray::new(position, dir.normalize()), power))
+            }
+            Light::Sphere { .. } => {
+                let u_pos = sampler.next_2d();
+                let u_dir = sampler.next_2d();
+                let e = self.sample_le(u_pos, u_dir)?;
+                let cos = e.dir.dot(e.normal);
+                let power = e.le * (cos / (e.pdf_pos * e.pdf_dir * n));
+                Some((
+                    Ray::new(leave_surface(e.origin, e.normal, e.dir), e.dir),
+                    power,
+                ))
+            }
+        }
+    }
+
+    /// One of `n` photons leaving the light in an aimed direction, and its flux: the emitting
+    /// point (the light's position, or a uniform point on its surface from one `sampler` pair),
+    /// then `aim(point, sampler)` gives a unit direction and its solid-angle density (1/sr);
+    /// the flux divides by that density. `None` when `aim` gives nothing, the direction leaves
+    /// the surface inwards (no light goes there; the photon still counts as emitted, so the
+    /// estimate stays unbiased) or the flux is not finite.
+    #[must_use]
+    pub fn emit_aimed(
+        &self,
+        sampler: &mut Sampler,
+        aim: impl FnOnce(Vec3, &mut Sampler) -> Option<(Vec3, f32)>,
+        n: f32,
+    ) -> Option<(Ray, Vec3)> {
+        match *self {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let (dir, pdf) = aim(position, sampler)?;
+                let power = intensity / (pdf * n);
+                power.is_finite().then(|| (Ray::new(position, dir), power))
+            }
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let normal = uniform_sphere(sampler.next_2d());
+                let origin = center + normal * radius;
+                let (dir, pdf) = aim(origin, sampler)?;
+                let cos = dir.dot(normal);
+                if !(cos > 0.0) {
+                    return None;
+                }
+                let pdf_pos = 1.0 / (4.0 * PI * radius * radius);
+                let power = radiance * (cos / (pdf_pos * pdf * n));
+                power
+                    .is_finite()
+                    .then(|| (Ray::new(leave_surface(origin, normal, dir), dir), power))
+            }
+        }
+    }
+}
+
+/// A ray origin just outside an emitter's surface at `p` (normal `n`), on the side of `dir`.
+fn leave_surface(p: Vec3, n: Vec3, dir: Vec3) -> Vec3 {
+    let err = p.abs() * (4.0 * f32::EPSILON) + Vec3::splat(f32::MIN_POSITIVE);
+    offset_ray_origin(p, err, n, dir)
 }
 
 /// The direction a point light emits its photon/light path with `u ∈ [0, 1)²`: uniform over the

@@ -81,7 +81,7 @@ impl RenderScene {
                 ns = self.textures[t as usize].bump(ns, sps.dpdu, sps.dpdv, &lookup);
             }
             if let Some(t) = material.color_texture {
-                bsdf.color = self.textures[t as usize].color(&lookup);
+                bsdf = bsdf.with_color(self.textures[t as usize].color(&lookup));
             }
         }
         let (ng, ns) = if entering { (sp.ng, ns) } else { (-sp.ng, -ns) };

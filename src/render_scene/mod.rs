@@ -3,6 +3,7 @@
 pub mod camera;
 pub mod geometry;
 pub mod hash;
+pub mod interaction;
 pub mod light;
 pub mod light_sampler;
 pub mod material;
@@ -11,6 +12,7 @@ pub mod texture;
 
 pub use camera::Camera;
 pub use geometry::{Geometry, Hit, PrimRef};
+pub use interaction::{EmitterHit, Interaction, SurfaceHit};
 pub use light::{EmissionSample, Light, LightSample};
 pub use light_sampler::LightSampler;
 pub use material::{ShadingPoint, SurfaceMaterial};
@@ -21,6 +23,7 @@ use glam::Vec3;
 
 use crate::sampling::SamplerKind;
 pub use crate::settings::{IntegratorKind, TextureFilter};
+use crate::shading::LobeFlags;
 
 /// Rendering parameters after command-line overrides.
 #[derive(Debug, Clone, PartialEq)]
@@ -116,13 +119,16 @@ pub struct RenderScene {
 }
 
 impl RenderScene {
-    /// True if object `object` lets no light through (no transmitting part, or an emitter).
+    /// True if object `object` lets no light through (no transmitting lobe, or an emitter).
     #[inline]
     #[must_use]
     pub fn is_opaque(&self, object: u32) -> bool {
-        self.objects[object as usize]
-            .material
-            .is_none_or(|m| self.materials[m as usize].bsdf.transmit == 0.0)
+        self.objects[object as usize].material.is_none_or(|m| {
+            !self.materials[m as usize]
+                .bsdf
+                .flags()
+                .contains(LobeFlags::TRANSMISSION)
+        })
     }
 
     /// The angle one camera sample's footprint subtends: the pixel's angular size, shrunk by

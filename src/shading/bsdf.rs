@@ -1,80 +1,155 @@
-//! The material model as a BSDF (docs/material.md): a weighted mix of a Lambert + normalised-Phong
-//! part, a tinted perfect mirror and a smooth Fresnel dielectric. Every integrator evaluates,
-//! samples and asks densities of it through here, in radiance mode (camera paths) or importance
-//! mode (light and photon paths), so that all of them converge to the same image.
+//! The material model as a BSDF (docs/material.md): a small weighted mixture of lobes. The
+//! scene's `diffuse`, `reflect` and `transmit` weights (normalised to sum to 1) weigh three
+//! parts — a diffuse part of a Lambert ([`super::lambert`]) and a normalised-Phong
+//! ([`super::phong`]) lobe, a tinted perfect mirror ([`super::specular_reflection`]) and a
+//! smooth Fresnel dielectric ([`super::dielectric`]). Every integrator evaluates, samples and
+//! asks densities of it through here, in radiance mode (camera paths) or importance mode (light
+//! and photon paths), so that all of them converge to the same image; they ask what it does
+//! through [`Bsdf::flags`] and its methods, never through its parts.
 //!
-//! Conventions follow pbrt-v4 (Pharr, Jakob, Humphreys, *Physically Based Rendering*, 4th ed.,
-//! §9.1–9.5) and Veach's thesis (1997, §5.2–5.3): `wo` is the direction the path arrived from
-//! (towards the camera for radiance, towards the light for importance), `wi` the direction it
-//! continues in; both unit and pointing away from the surface.
+//! Sampling picks a part with the lobe number in proportion to its weight times its mean
+//! albedo, then, inside the diffuse part, Lambert or Phong in proportion to their albedos (the
+//! same number, rescaled); a delta lobe uses the rest of the number itself (the dielectric's
+//! choice of reflection or refraction). Densities are those of the mixture. The arithmetic is
+//! ordered as the renderer's first, monolithic BSDF computed it, so images stay bit-identical.
+//!
+//! A new lobe (a rough GGX conductor, say) is its own file plus a variant in [`super::lobe`]
+//! and a part here: a non-delta lobe needs only `f`, `sample` and `pdf`.
 
 use glam::Vec3;
-use std::f32::consts::{FRAC_1_PI, TAU};
 
-use super::optics::{fresnel_dielectric, reflect, refract};
-use crate::geometry::Frame;
-use crate::sampling::warp::cosine_hemisphere;
+use super::dielectric::Dielectric;
+use super::lambert::Lambert;
+use super::lobe::{Lobe, Prepared};
+use super::phong::Phong;
+use super::scattering::mean;
+pub use super::scattering::{
+    BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction,
+};
+use super::specular_reflection::{SpecularReflection, mirror_above};
 
-/// A compiled material's scattering function; the three weights are normalised to sum to 1.
+/// Parts of the mixture (each a weight and its lobes).
+const PARTS: usize = 3;
+/// Most lobes in one part.
+const LOBES_PER_PART: usize = 2;
+
+/// One weighted part of the mixture: lobes that share one weight (all non-delta, or one delta
+/// lobe).
 #[derive(Debug, Clone, Copy, PartialEq)]
+struct Part {
+    weight: f32,
+    lobes: [Option<Lobe>; LOBES_PER_PART],
+}
+
+impl Part {
+    fn new(weight: f32, first: Lobe, second: Option<Lobe>) -> Self {
+        Self {
+            weight,
+            lobes: [Some(first), second],
+        }
+    }
+
+    /// The lobes present.
+    #[inline]
+    fn lobes(&self) -> impl Iterator<Item = &Lobe> {
+        self.lobes.iter().flatten()
+    }
+
+    /// Whether the part is a delta lobe (by its first lobe; parts never mix).
+    #[inline]
+    fn is_delta(&self) -> bool {
+        self.lobes().next().is_some_and(|l| l.flags().is_delta())
+    }
+
+    /// The union of the lobes' flags.
+    #[inline]
+    fn flags(&self) -> LobeFlags {
+        self.lobes().fold(LobeFlags::NONE, |f, l| f | l.flags())
+    }
+
+    /// The per-direction state of the part's (first) lobe.
+    #[inline]
+    fn prepare(&self, wo: Vec3, fr: &ShadingFrame) -> Prepared {
+        self.lobes()
+            .next()
+            .map_or(Prepared::Nothing, |l| l.prepare(wo, fr))
+    }
+
+    /// The lobes' sampling weights and each lobe's share of the part: `aⱼ / Σa` for all but the
+    /// last, which takes the rest (all to the first when Σa is 0).
+    #[inline]
+    fn shares(&self, prepared: &Prepared, rho: f32) -> [f32; LOBES_PER_PART] {
+        let mut a = [0.0f32; LOBES_PER_PART];
+        let mut total = 0.0f32;
+        let mut count = 0;
+        for (slot, lobe) in a.iter_mut().zip(self.lobes()) {
+            *slot = lobe.albedo(prepared, rho);
+            total += *slot;
+            count += 1;
+        }
+        let mut shares = [0.0f32; LOBES_PER_PART];
+        let mut taken = 0.0f32;
+        for j in 0..count {
+            shares[j] = if j + 1 == count {
+                1.0 - taken
+            } else if total > 0.0 {
+                a[j] / total
+            } else if j == 0 {
+                1.0
+            } else {
+                0.0
+            };
+            taken += shares[j];
+        }
+        shares
+    }
+
+    /// The part's sampling weight: its weight times the sum of its lobes' albedos.
+    #[inline]
+    fn probability_weight(&self, prepared: &Prepared, rho: f32) -> f32 {
+        if self.weight == 0.0 {
+            return 0.0;
+        }
+        let mut a = 0.0f32;
+        for lobe in self.lobes() {
+            a += lobe.albedo(prepared, rho);
+        }
+        self.weight * a
+    }
+}
+
+/// A compiled material's scattering function: a tint (the colour; texture lookups replace it)
+/// and a weighted mixture of lobes. Its `Debug` text is the material's parameters (the scene
+/// hash of `.part` files and photon caches reads it, so it stays as it always was).
+#[derive(Clone, Copy, PartialEq)]
 pub struct Bsdf {
     /// Diffuse albedo; also tints the mirror and transmitted light.
-    pub color: Vec3,
-    /// Reflectance of the normalised Phong lobe.
-    pub specular: Vec3,
-    /// Phong exponent.
-    pub shininess: f32,
-    /// Weight of the diffuse + Phong part.
-    pub diffuse: f32,
-    /// Weight of the perfect mirror.
-    pub reflect: f32,
-    /// Weight of the smooth dielectric.
-    pub transmit: f32,
-    /// Index of refraction of the inside relative to the outside.
-    pub ior: f32,
+    tint: Vec3,
+    /// The diffuse, mirror and dielectric parts, in this order (the order sampling walks).
+    parts: [Part; PARTS],
 }
 
-/// Which quantity a path carries (pbrt-v4's `TransportMode`; Veach 1997, §5.2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TransportMode {
-    /// Camera paths carry radiance: crossing from the side of index ηₒ to the side of index ηᵢ
-    /// scales it by (ηₒ/ηᵢ)² (radiance is not conserved across a refracting boundary).
-    Radiance,
-    /// Light and photon paths carry flux (importance): no η² scaling, and the adjoint
-    /// shading-normal correction [`shading_normal_correction`] applies.
-    Importance,
-}
-
-/// The local frame a BSDF is evaluated in.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ShadingFrame {
-    /// Unit shading normal on the side of `wo`.
-    pub ns: Vec3,
-    /// Unit geometric normal on the side of `wo`.
-    pub ng: Vec3,
-    /// Whether `wo` is on the outside of the object (the side its geometric normal points to),
-    /// so that a transmitted path goes from index 1 to index `ior`.
-    pub entering: bool,
-}
-
-/// A direction sampled from the BSDF.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BsdfSample {
-    /// Unit direction the path continues in.
-    pub wi: Vec3,
-    /// The path throughput multiplier `f · |ns·wi| / pdf` (times the adjoint correction in
-    /// importance mode, and the η² factor of a refraction in radiance mode).
-    pub weight: Vec3,
-    /// Solid-angle density of `wi` (per steradian) for a non-delta sample; for a delta lobe, the
-    /// discrete probability of having chosen it.
-    pub pdf: f32,
-    /// The sample came from a mirror or the dielectric (a Dirac delta in direction).
-    pub delta: bool,
-    /// The path crossed the surface (refraction).
-    pub transmitted: bool,
-    /// The radiance-mode factor (ηₒ/ηᵢ)² included in `weight` (1 unless refracted in radiance
-    /// mode); path tracers divide it out again for Russian roulette.
-    pub eta_scale: f32,
+impl std::fmt::Debug for Bsdf {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let lobes = || self.parts.iter().flat_map(Part::lobes);
+        let (specular, shininess) = lobes()
+            .find_map(|l| match l {
+                Lobe::Phong(p) => Some((p.specular, p.exponent)),
+                _ => None,
+            })
+            .unwrap_or((Vec3::ZERO, 1.0));
+        let ior = lobes().find_map(Lobe::ior).unwrap_or(1.0);
+        let [diffuse, reflect, transmit] = self.weights();
+        f.debug_struct("Bsdf")
+            .field("color", &self.tint)
+            .field("specular", &specular)
+            .field("shininess", &shininess)
+            .field("diffuse", &diffuse)
+            .field("reflect", &reflect)
+            .field("transmit", &transmit)
+            .field("ior", &ior)
+            .finish()
+    }
 }
 
 /// The specular (delta) directions leaving a surface point and their weights, given as radiance
@@ -87,36 +162,22 @@ pub struct DeltaLobes {
     pub reflect_weight: Vec3,
     /// Refracted direction and its weight, when the dielectric part transmits.
     pub refract: Option<(Vec3, Vec3)>,
+    /// The radiance factor (ηₒ/ηᵢ)² included in the refracted weight (1 without refraction),
+    /// which path tracers divide out for Russian roulette.
+    pub eta_scale: f32,
 }
 
-/// The dielectric's split at one incidence: Fresnel reflectance, refracted direction (if any)
-/// and the relative index `eta = ηₒ/ηᵢ` of the crossing.
-struct Dielectric {
-    fresnel: f32,
-    refracted: Option<Vec3>,
-    eta: f32,
-}
-
-/// Mean of the three channels: how lobes are weighed against each other when sampling.
-#[inline]
-fn mean(c: Vec3) -> f32 {
-    (c.x + c.y + c.z) * (1.0 / 3.0)
-}
-
-/// Veach's adjoint correction for shading normals (thesis §5.3, eq. 5.19): the factor
-/// `|wo·ns| |wi·ng| / (|wo·ng| |wi·ns|)` that makes light paths that scatter at a point with a
-/// shading normal carry the flux that the camera-side BSDF (with `|wi·ns|`) implies. 1 when
-/// `ns == ng`; 0 when `wo` grazes the geometric surface.
-#[inline]
-#[must_use]
-pub fn shading_normal_correction(wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
-    let num = wo.dot(fr.ns).abs() * wi.dot(fr.ng).abs();
-    let den = wo.dot(fr.ng).abs() * wi.dot(fr.ns).abs();
-    if den > 0.0 { num / den } else { 0.0 }
+/// The part probabilities of one sampling decision (summing to 1, or all 0 for a black BSDF),
+/// and each part's per-direction state.
+struct Choice {
+    p: [f32; PARTS],
+    prepared: [Prepared; PARTS],
 }
 
 impl Bsdf {
-    /// Builds a BSDF, normalising the weights (`None` ones count as 0; all `None` means diffuse).
+    /// Builds a BSDF, normalising the weights (`None` ones count as 0; all `None` means diffuse):
+    /// `weights` are the diffuse (Lambert `color` + Phong `specular`, `shininess`), mirror and
+    /// dielectric (`ior`, inside over outside) parts' weights.
     #[must_use]
     pub fn new(
         color: Vec3,
@@ -136,46 +197,123 @@ impl Bsdf {
         } else {
             [1.0, 0.0, 0.0]
         };
-        Self {
-            color,
+        // Phong is kept even when black (it contributes nothing then), so the exponent stays
+        // part of the material's description.
+        let phong = Some(Lobe::Phong(Phong {
             specular,
-            shininess,
-            diffuse: w[0],
-            reflect: w[1],
-            transmit: w[2],
-            ior,
+            exponent: shininess,
+        }));
+        Self {
+            tint: color,
+            parts: [
+                Part::new(w[0], Lobe::Lambert(Lambert), phong),
+                Part::new(w[1], Lobe::SpecularReflection(SpecularReflection), None),
+                Part::new(w[2], Lobe::Dielectric(Dielectric { ior }), None),
+            ],
         }
+    }
+
+    /// The tint: the diffuse albedo, which also tints the mirror and the transmitted light.
+    #[inline]
+    #[must_use]
+    pub fn color(&self) -> Vec3 {
+        self.tint
+    }
+
+    /// The same BSDF with tint `color` (a colour texture's value at a point).
+    #[inline]
+    #[must_use]
+    pub fn with_color(mut self, color: Vec3) -> Self {
+        self.tint = color;
+        self
+    }
+
+    /// The normalised weights of the three parts (diffuse, mirror, dielectric) as the scene gave
+    /// them, for diagnostics and tests; integrators ask [`Bsdf::flags`] instead.
+    #[must_use]
+    pub fn weights(&self) -> [f32; PARTS] {
+        self.parts.map(|p| p.weight)
+    }
+
+    /// What the BSDF does: the union of the flags of its lobes of non-zero weight.
+    #[inline]
+    #[must_use]
+    pub fn flags(&self) -> LobeFlags {
+        self.parts
+            .iter()
+            .filter(|p| p.weight > 0.0)
+            .fold(LobeFlags::NONE, |f, p| f | p.flags())
     }
 
     /// True if the BSDF has a non-delta (diffuse or glossy) part that direct lighting sees.
     #[inline]
     #[must_use]
     pub fn has_local(&self) -> bool {
-        self.diffuse > 0.0
+        self.flags().is_non_delta()
+    }
+
+    /// True when no glossy lobe of non-zero weight scatters (the non-delta part is diffuse
+    /// alone), so the non-delta radiance is `f · E` whatever direction the light arrives from:
+    /// what lets a photon map's precomputed irradiance stand in for a density estimate.
+    #[inline]
+    #[must_use]
+    pub fn is_diffuse_only(&self) -> bool {
+        self.parts
+            .iter()
+            .filter(|p| p.weight > 0.0)
+            .flat_map(Part::lobes)
+            .all(|l| !l.flags().contains(LobeFlags::GLOSSY) || l.is_black(self.tint))
     }
 
     /// True if the BSDF has mirror or dielectric parts.
     #[inline]
     #[must_use]
     pub fn has_delta(&self) -> bool {
-        self.reflect > 0.0 || self.transmit > 0.0
+        self.flags().is_delta()
+    }
+
+    /// The total weight of the delta parts (mirror and dielectric): the share of the light
+    /// that can be focused, by which caustic photons are aimed at an object.
+    #[inline]
+    #[must_use]
+    pub fn delta_share(&self) -> f32 {
+        let mut s = 0.0f32;
+        for p in self.parts.iter().filter(|p| p.is_delta()) {
+            s += p.weight;
+        }
+        s
+    }
+
+    /// The relative index of refraction (inside over outside) of the transmitting part, if it
+    /// has weight.
+    #[must_use]
+    pub fn ior(&self) -> Option<f32> {
+        self.parts
+            .iter()
+            .filter(|p| p.weight > 0.0)
+            .flat_map(Part::lobes)
+            .find_map(Lobe::ior)
     }
 
     /// The non-delta part `f(wo, wi)` (per steradian) with `n` the shading normal on the side of
-    /// `wo`: `diffuse · (ρ/π + k_s (m+2)/(2π) max(0, r·wi)^m)`, `r` the mirror of `wo`.
-    /// Zero when `wi` is below `n`. Symmetric in `wo` and `wi` (reciprocal).
+    /// `wo`: each non-delta part's weight times the sum of its lobes (here
+    /// `diffuse · (ρ/π + k_s (m+2)/(2π) max(0, r·wi)^m)`, `r` the mirror of `wo`). Zero when
+    /// `wi` is below `n`. Symmetric in `wo` and `wi` (reciprocal).
     #[inline]
     #[must_use]
     pub fn f(&self, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
-        if self.diffuse == 0.0 || n.dot(wi) <= 0.0 {
-            return Vec3::ZERO;
+        let mut f = Vec3::ZERO;
+        for part in &self.parts {
+            if part.weight == 0.0 || part.is_delta() {
+                continue;
+            }
+            let mut fp = Vec3::ZERO;
+            for lobe in part.lobes() {
+                fp += lobe.f(wo, wi, n, self.tint);
+            }
+            f += fp * part.weight;
         }
-        let mut f = self.color * FRAC_1_PI;
-        if self.specular != Vec3::ZERO {
-            let cos_a = reflect(wo, n).dot(wi).max(0.0);
-            f += self.specular * ((self.shininess + 2.0) / TAU * cos_a.powf(self.shininess));
-        }
-        f * self.diffuse
+        f
     }
 
     /// The non-delta BSDF value in frame `fr`, for `wi` above both the shading and the geometric
@@ -197,15 +335,26 @@ impl Bsdf {
 
     /// Whether [`Bsdf::sample`]'s lobe number `u_lobe` can change its result: false for a
     /// single lobe (pure Lambert, pure Phong, a pure mirror, or black), so integrators need not
-    /// draw it (`Sampler::defer_1d`). Any dielectric part, or two parts of non-zero weight,
-    /// make it matter.
+    /// draw it (`Sampler::defer_1d`). A lobe that reads the number itself (the dielectric), two
+    /// parts of non-zero weight, or two non-black lobes in one part make it matter.
     #[inline]
     #[must_use]
     pub fn lobe_choice_matters(&self) -> bool {
-        let diffuse = self.diffuse > 0.0;
-        self.transmit > 0.0
-            || (diffuse && self.reflect > 0.0)
-            || (diffuse && self.specular != Vec3::ZERO && self.color != Vec3::ZERO)
+        let mut parts = 0;
+        for part in self.parts.iter().filter(|p| p.weight > 0.0) {
+            parts += 1;
+            let mut lit = 0;
+            for lobe in part.lobes() {
+                if lobe.uses_lobe_number() {
+                    return true;
+                }
+                lit += usize::from(!lobe.is_black(self.tint));
+            }
+            if lit > 1 {
+                return true;
+            }
+        }
+        parts > 1
     }
 
     /// The lobe number for [`Bsdf::sample`]: `draw()` where the choice matters
@@ -220,69 +369,69 @@ impl Bsdf {
         }
     }
 
-    /// Probabilities of sampling the diffuse part, the mirror and the dielectric (summing to 1,
-    /// or all 0 for a black BSDF), and within the diffuse part the Lambert lobe's share.
+    /// The parts' probabilities for `wo` (each part's weight times its lobes' mean albedo,
+    /// normalised) and their per-direction state.
     #[inline]
-    fn lobe_probabilities(&self, fresnel: f32) -> ([f32; 3], f32) {
-        let rho = mean(self.color);
-        let ks = mean(self.specular);
-        let q = [
-            self.diffuse * (rho + ks),
-            self.reflect * rho,
-            self.transmit * (fresnel + (1.0 - fresnel) * rho),
-        ];
-        let sum = q[0] + q[1] + q[2];
-        let lambert = if rho + ks > 0.0 {
-            rho / (rho + ks)
-        } else {
-            1.0
-        };
-        if sum > 0.0 {
-            (q.map(|x| x / sum), lambert)
-        } else {
-            ([0.0; 3], lambert)
+    fn choice(&self, wo: Vec3, fr: &ShadingFrame, rho: f32) -> Choice {
+        let prepared = self.parts.map(|p| {
+            if p.weight > 0.0 {
+                p.prepare(wo, fr)
+            } else {
+                Prepared::Nothing
+            }
+        });
+        let mut q = [0.0f32; PARTS];
+        let mut sum = 0.0f32;
+        for ((q, part), prep) in q.iter_mut().zip(&self.parts).zip(&prepared) {
+            *q = part.probability_weight(prep, rho);
+            sum += *q;
         }
+        let p = if sum > 0.0 {
+            q.map(|x| x / sum)
+        } else {
+            [0.0; PARTS]
+        };
+        Choice { p, prepared }
     }
 
-    /// The dielectric's Fresnel split for `wo` in frame `fr`.
+    /// The density with which non-delta part `part`, chosen with probability `prob`, samples
+    /// `wi`: `prob · Σⱼ shareⱼ · pdfⱼ`, 0 below the shading or geometric surface.
     #[inline]
-    fn dielectric(&self, wo: Vec3, fr: &ShadingFrame) -> Dielectric {
-        let eta = if fr.entering {
-            1.0 / self.ior
-        } else {
-            self.ior
-        };
-        let fresnel = fresnel_dielectric(fr.ns.dot(wo), eta);
-        let refracted = if fresnel < 1.0 {
-            refract_below(wo, fr.ns, fr.ng, eta)
-        } else {
-            None
-        };
-        Dielectric {
-            fresnel: if refracted.is_some() { fresnel } else { 1.0 },
-            refracted,
-            eta,
-        }
-    }
-
-    /// The Fresnel reflectance the sampler weighs the dielectric with (only when it transmits).
-    #[inline]
-    fn sampling_fresnel(&self, wo: Vec3, fr: &ShadingFrame) -> f32 {
-        if self.transmit > 0.0 {
-            self.dielectric(wo, fr).fresnel
-        } else {
-            0.0
-        }
-    }
-
-    /// Density of the normalised Phong sampling lobe around `r` at `wi` (per steradian).
-    #[inline]
-    fn phong_pdf(&self, r: Vec3, wi: Vec3) -> f32 {
-        let c = r.dot(wi);
-        if c <= 0.0 {
+    #[allow(clippy::too_many_arguments)]
+    fn part_pdf(
+        &self,
+        part: &Part,
+        prepared: &Prepared,
+        prob: f32,
+        rho: f32,
+        wo: Vec3,
+        wi: Vec3,
+        fr: &ShadingFrame,
+    ) -> f32 {
+        if prob == 0.0 || fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0 {
             return 0.0;
         }
-        (self.shininess + 1.0) / TAU * c.powf(self.shininess)
+        let shares = part.shares(prepared, rho);
+        let mut d = 0.0f32;
+        for (lobe, &share) in part.lobes().zip(&shares) {
+            if share > 0.0 {
+                d += lobe.scaled_pdf(share, wo, wi, fr);
+            }
+        }
+        prob * d
+    }
+
+    /// The mixture density of the non-delta parts at `wi` given a choice.
+    #[inline]
+    fn mixture_pdf(&self, c: &Choice, rho: f32, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
+        let mut pdf = 0.0f32;
+        for (i, part) in self.parts.iter().enumerate() {
+            if part.weight == 0.0 || part.is_delta() {
+                continue;
+            }
+            pdf += self.part_pdf(part, &c.prepared[i], c.p[i], rho, wo, wi, fr);
+        }
+        pdf
     }
 
     /// Solid-angle density with which [`Bsdf::sample`] returns the non-delta direction `wi`
@@ -290,35 +439,15 @@ impl Bsdf {
     /// have no density; their discrete probabilities are in the samples themselves.
     #[must_use]
     pub fn pdf(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
-        if self.diffuse == 0.0 {
+        if !self.parts.iter().any(|p| p.weight != 0.0 && !p.is_delta()) {
             return 0.0;
         }
-        let (p, lambert) = self.lobe_probabilities(self.sampling_fresnel(wo, fr));
-        self.diffuse_pdf(p[0], lambert, wo, wi, fr)
+        let rho = mean(self.tint);
+        let c = self.choice(wo, fr, rho);
+        self.mixture_pdf(&c, rho, wo, wi, fr)
     }
 
-    /// [`Bsdf::pdf`] given the diffuse part's probability `p_diffuse` and Lambert's share in
-    /// it (so `sample`, which has them, does not recompute the Fresnel split).
-    #[inline]
-    fn diffuse_pdf(
-        &self,
-        p_diffuse: f32,
-        lambert: f32,
-        wo: Vec3,
-        wi: Vec3,
-        fr: &ShadingFrame,
-    ) -> f32 {
-        if p_diffuse == 0.0 || fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0 {
-            return 0.0;
-        }
-        let mut d = lambert * fr.ns.dot(wi) * FRAC_1_PI;
-        if lambert < 1.0 {
-            d += (1.0 - lambert) * self.phong_pdf(reflect(wo, fr.ns), wi);
-        }
-        p_diffuse * d
-    }
-
-    /// Samples a direction for a path arriving from `wo`: a lobe chosen with `u_lobe` (the
+    /// Samples a direction for a path arriving from `wo`: a part chosen with `u_lobe` (the
     /// diffuse part, the mirror or the dielectric, in proportion to their weights times their
     /// mean albedo; inside the dielectric, reflection or refraction in proportion to F and
     /// (1 − F)·ρ), then a direction from `u` (cosine-weighted for Lambert, Phong's
@@ -333,95 +462,65 @@ impl Bsdf {
         fr: &ShadingFrame,
         mode: TransportMode,
     ) -> Option<BsdfSample> {
-        let diel = (self.transmit > 0.0).then(|| self.dielectric(wo, fr));
-        let fresnel = diel.as_ref().map_or(0.0, |d| d.fresnel);
-        let (p, lambert) = self.lobe_probabilities(fresnel);
-        if u_lobe < p[0] {
-            // Diffuse + Phong part; reuse the lobe number to pick Lambert or Phong.
-            let v = u_lobe / p[0];
-            let wi = if v < lambert {
-                cosine_hemisphere(u, fr.ns)
-            } else {
-                let r = reflect(wo, fr.ns);
-                let cos_a = u.0.powf(1.0 / (self.shininess + 1.0));
-                let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
-                let phi = TAU * u.1;
-                Frame::from_normal(r).to_world(Vec3::new(
-                    sin_a * phi.cos(),
-                    sin_a * phi.sin(),
-                    cos_a,
-                ))
-            };
-            let pdf = self.diffuse_pdf(p[0], lambert, wo, wi, fr);
-            let f = self.eval(wo, wi, fr, mode);
-            if !(pdf > 0.0) || f == Vec3::ZERO {
-                return None;
+        let rho = mean(self.tint);
+        let c = self.choice(wo, fr, rho);
+        // Walk the parts: the first whose interval holds u_lobe, else (rounding) the last of
+        // non-zero weight; `rest` is u_lobe less the probabilities before the part.
+        let mut chosen = None;
+        let mut cum = 0.0f32;
+        let mut rest = u_lobe;
+        let mut rests = [0.0f32; PARTS];
+        for (i, (slot, &p)) in rests.iter_mut().zip(&c.p).enumerate() {
+            *slot = rest;
+            if u_lobe < cum + p {
+                chosen = Some(i);
+                break;
             }
-            return Some(BsdfSample {
-                wi,
-                weight: f * (fr.ns.dot(wi) / pdf),
-                pdf,
-                delta: false,
-                transmitted: false,
-                eta_scale: 1.0,
-            });
+            cum += p;
+            rest -= p;
         }
-        let correct = |wi: Vec3| match mode {
-            TransportMode::Radiance => 1.0,
-            TransportMode::Importance => shading_normal_correction(wo, wi, fr),
-        };
-        if u_lobe < p[0] + p[1] || diel.is_none() {
-            if p[1] == 0.0 {
-                return None;
-            }
-            let wi = mirror_above(wo, fr.ns, fr.ng);
-            return Some(BsdfSample {
-                wi,
-                weight: self.color * (self.reflect / p[1] * correct(wi)),
-                pdf: p[1],
-                delta: true,
-                transmitted: false,
-                eta_scale: 1.0,
-            });
+        let i = chosen.or_else(|| self.parts.iter().rposition(|p| p.weight > 0.0))?;
+        let part = &self.parts[i];
+        let v = rests[i] / c.p[i];
+        if part.is_delta() {
+            let lobe = part.lobes().next()?;
+            return lobe.sample_delta(
+                &c.prepared[i],
+                wo,
+                v,
+                fr,
+                mode,
+                part.weight,
+                c.p[i],
+                self.tint,
+                rho,
+            );
         }
-        let d = diel?;
-        // Inside the dielectric: reflect with probability F / (F + (1 − F)ρ̄).
-        let rho = mean(self.color);
-        let denom = d.fresnel + (1.0 - d.fresnel) * rho;
-        let p_reflect = if denom > 0.0 { d.fresnel / denom } else { 1.0 };
-        let v = (u_lobe - p[0] - p[1]) / p[2];
-        match d.refracted {
-            Some(wt) if v >= p_reflect => {
-                let pdf = p[2] * (1.0 - p_reflect);
-                let (scale, eta_scale) = match mode {
-                    TransportMode::Radiance => (d.eta * d.eta, d.eta * d.eta),
-                    TransportMode::Importance => (correct(wt), 1.0),
-                };
-                Some(BsdfSample {
-                    wi: wt,
-                    weight: self.color * (self.transmit * (1.0 - d.fresnel) * scale / pdf),
-                    pdf,
-                    delta: true,
-                    transmitted: true,
-                    eta_scale,
-                })
+        // A non-delta part: reuse the lobe number to pick one of its lobes.
+        let shares = part.shares(&c.prepared[i], rho);
+        let mut lobe = None;
+        let mut cum = 0.0f32;
+        for (l, &share) in part.lobes().zip(&shares) {
+            lobe = Some(l);
+            if v < cum + share {
+                break;
             }
-            _ => {
-                let wi = mirror_above(wo, fr.ns, fr.ng);
-                let pdf = p[2] * p_reflect;
-                if !(pdf > 0.0) {
-                    return None;
-                }
-                Some(BsdfSample {
-                    wi,
-                    weight: Vec3::splat(self.transmit * d.fresnel / pdf * correct(wi)),
-                    pdf,
-                    delta: true,
-                    transmitted: false,
-                    eta_scale: 1.0,
-                })
-            }
+            cum += share;
         }
+        let wi = lobe?.sample_direction(wo, u, fr)?;
+        let pdf = self.mixture_pdf(&c, rho, wo, wi, fr);
+        let f = self.eval(wo, wi, fr, mode);
+        if !(pdf > 0.0) || f == Vec3::ZERO {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            weight: f * (fr.ns.dot(wi) / pdf),
+            pdf,
+            delta: false,
+            transmitted: false,
+            eta_scale: 1.0,
+        })
     }
 
     /// The fraction of light that crosses the surface in a straight line, for shadow rays of
@@ -437,15 +536,16 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn straight_transmittance(&self, cos: f32, entering: bool) -> Vec3 {
-        if self.transmit == 0.0 {
-            return Vec3::ZERO;
+        let mut t = Vec3::ZERO;
+        for part in &self.parts {
+            if part.weight == 0.0 || !part.flags().contains(LobeFlags::TRANSMISSION) {
+                continue;
+            }
+            for lobe in part.lobes() {
+                t += lobe.straight_transmittance(part.weight, self.tint, cos, entering);
+            }
         }
-        let eta2 = if entering {
-            1.0 / (self.ior * self.ior)
-        } else {
-            self.ior * self.ior
-        };
-        self.color * (self.transmit * (1.0 - fresnel_dielectric(cos, 1.0 / self.ior)) * eta2)
+        t
     }
 
     /// The mirror and dielectric lobes at a point in radiance mode (for Whitted, which follows
@@ -453,45 +553,31 @@ impl Bsdf {
     /// side of `wo`; `entering` says whether `wo` is outside the object.
     #[must_use]
     pub fn delta_lobes(&self, wo: Vec3, n: Vec3, ng: Vec3, entering: bool) -> DeltaLobes {
-        let reflect_dir = mirror_above(wo, n, ng);
-        let mut reflect_weight = self.color * self.reflect;
-        let mut refracted = None;
-        if self.transmit > 0.0 {
-            let fr = ShadingFrame {
-                ns: n,
-                ng,
-                entering,
-            };
-            let d = self.dielectric(wo, &fr);
-            reflect_weight += Vec3::splat(self.transmit * d.fresnel);
-            if let Some(dir) = d.refracted {
-                let w = self.transmit * (1.0 - d.fresnel) * d.eta * d.eta;
-                refracted = Some((dir, self.color * w));
+        let fr = ShadingFrame {
+            ns: n,
+            ng,
+            entering,
+        };
+        let mut lobes = DeltaLobes {
+            reflect_dir: mirror_above(wo, n, ng),
+            reflect_weight: Vec3::ZERO,
+            refract: None,
+            eta_scale: 1.0,
+        };
+        for part in &self.parts {
+            if part.weight == 0.0 || !part.is_delta() {
+                continue;
+            }
+            for lobe in part.lobes() {
+                let d = lobe.delta_weights(wo, &fr, part.weight, self.tint);
+                lobes.reflect_weight += d.reflect;
+                if let Some((dir, w, eta_scale)) = d.refract {
+                    lobes.refract = Some((dir, w));
+                    lobes.eta_scale = eta_scale;
+                }
             }
         }
-        DeltaLobes {
-            reflect_dir,
-            reflect_weight,
-            refract: refracted,
-        }
-    }
-}
-
-/// Mirror of `wo` about `n`, replaced by the mirror about `ng` if it would go below the geometric
-/// surface (shading normals must not send rays into the surface they leave).
-#[inline]
-fn mirror_above(wo: Vec3, n: Vec3, ng: Vec3) -> Vec3 {
-    let r = reflect(wo, n);
-    if r.dot(ng) > 0.0 { r } else { reflect(wo, ng) }
-}
-
-/// Refraction of `wo` through `n`, replaced by refraction through `ng` if the result would not
-/// cross the geometric surface.
-#[inline]
-fn refract_below(wo: Vec3, n: Vec3, ng: Vec3, eta: f32) -> Option<Vec3> {
-    match refract(wo, n, eta) {
-        Some(t) if t.dot(ng) < 0.0 => Some(t),
-        _ => refract(wo, ng, eta).filter(|t| t.dot(ng) < 0.0),
+        lobes
     }
 }
 

@@ -57,13 +57,13 @@ fn weights_are_normalised() {
         [Some(2.0), Some(1.0), Some(1.0)],
         1.5,
     );
-    assert!(
-        (m.diffuse - 0.5).abs() < 1e-6
-            && (m.reflect - 0.25).abs() < 1e-6
-            && (m.transmit - 0.25).abs() < 1e-6
-    );
+    let [d, r, t] = m.weights();
+    assert!((d - 0.5).abs() < 1e-6 && (r - 0.25).abs() < 1e-6 && (t - 0.25).abs() < 1e-6);
     let m = Bsdf::new(Vec3::ONE, Vec3::ZERO, 1.0, [None, Some(3.0), None], 1.5);
-    assert_eq!((m.diffuse, m.reflect, m.transmit), (0.0, 1.0, 0.0));
+    assert_eq!(m.weights(), [0.0, 1.0, 0.0]);
+    assert!(m.has_delta() && !m.has_local() && m.flags().contains(LobeFlags::REFLECTION));
+    assert!(!m.flags().intersects(LobeFlags::TRANSMISSION) && m.ior().is_none());
+    assert_eq!(m.delta_share(), 1.0);
 }
 
 /// Hemispherical albedo ∫ f cos dω by quadrature.

@@ -1,15 +1,24 @@
-//! The one material model shared by every integrator, and the optics it is built from.
+//! The one material model shared by every integrator: a BSDF mixture of lobes, each lobe in its
+//! own file, and the optics they are built from.
 
 pub mod absorption;
 pub mod bsdf;
 pub mod conductor;
+pub mod dielectric;
+pub mod lambert;
+pub mod lobe;
 pub mod microfacet;
 pub mod normals;
 pub mod optics;
+pub mod phong;
 pub mod rough_conductor;
 pub mod rough_dielectric;
+pub mod scattering;
+pub mod specular_reflection;
 
-pub use bsdf::{
-    Bsdf, BsdfSample, DeltaLobes, ShadingFrame, TransportMode, shading_normal_correction,
-};
+pub use bsdf::{Bsdf, DeltaLobes};
+pub use lobe::Lobe;
 pub use normals::usable_shading_normal;
+pub use scattering::{
+    BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction,
+};

@@ -5,7 +5,7 @@
 use glam::Vec3;
 
 use caustic::geometry::Ray;
-use caustic::integrators::{Counters, Integrator};
+use caustic::integrators::{Context, Counters, Integrator, NoTrace};
 use caustic::render::{RenderOptions, render};
 use caustic::render_scene::RenderScene;
 use caustic::sampling::Sampler;
@@ -26,7 +26,10 @@ fn estimate(scene: &RenderScene, ray: Ray, n: u32) -> (Vec3, Vec3) {
         sampler.start_pixel_sample(0, 0, i);
         let _ = sampler.pixel_2d();
         let l = integrator
-            .li(ray, &mut sampler, &mut counters, None)
+            .li(
+                ray,
+                &mut Context::new(&mut sampler, &mut counters, &mut NoTrace),
+            )
             .as_dvec3();
         assert!(l.is_finite(), "sample {i}: {l}");
         sum += l;

@@ -10,7 +10,7 @@ use caustic::integrators::photon::emit::LightEmitter;
 use caustic::integrators::photon::maps::trace_map;
 use caustic::integrators::photon::trace::{MapKind, TraceCounts, TraceSettings};
 use caustic::integrators::photon::{Kernel, PhotonMap, build_maps};
-use caustic::integrators::{Counters, Integrator};
+use caustic::integrators::{Context, Counters, Integrator, NoTrace};
 use caustic::render::{RenderOptions, render};
 use caustic::render_scene::RenderScene;
 use caustic::sampling::Sampler;
@@ -300,9 +300,7 @@ fn photons_under_water_match_the_analytic_radiance_of_the_floor() {
             i += 1;
             let l = integrator.li(
                 Ray::new(from, (p - from).normalize()),
-                &mut sampler,
-                &mut Counters::default(),
-                None,
+                &mut Context::new(&mut sampler, &mut Counters::default(), &mut NoTrace),
             );
             below += f64::from(l.x);
             let entry = Vec3::new(x, 0.0, z + (0.3 * th_w.tan()) as f32);
@@ -310,9 +308,7 @@ fn photons_under_water_match_the_analytic_radiance_of_the_floor() {
             i += 1;
             let l = integrator.li(
                 Ray::new(entry - down, down),
-                &mut sampler,
-                &mut Counters::default(),
-                None,
+                &mut Context::new(&mut sampler, &mut Counters::default(), &mut NoTrace),
             );
             above += f64::from(l.x);
         }

@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use caustic::geometry::Ray;
-use caustic::integrators::{Counters, Integrator};
+use caustic::integrators::{Context, Counters, Integrator, NoTrace};
 use caustic::render::{Film, RenderOptions, render};
 use caustic::sampling::Sampler;
 
@@ -69,9 +69,7 @@ fn ppm_error_under_water_falls_across_4_16_64_256_passes_towards_the_analytic_ra
                 sampler.start_pixel_sample(i as u32, 0, pass);
                 let l = it.li(
                     Ray::new(from, (*p - from).normalize()),
-                    &mut sampler,
-                    &mut Counters::default(),
-                    None,
+                    &mut Context::new(&mut sampler, &mut Counters::default(), &mut NoTrace),
                 );
                 sums[i] += f64::from(l.x);
             }
@@ -150,9 +148,7 @@ fn a_point_lights_caustic_through_a_ball_lens_carries_the_power_it_passes() {
                 let from = p + Vec3::new(0.3, 0.05, 0.0);
                 let l = it.li(
                     Ray::new(from, (p - from).normalize()),
-                    &mut sampler,
-                    &mut Counters::default(),
-                    None,
+                    &mut Context::new(&mut sampler, &mut Counters::default(), &mut NoTrace),
                 );
                 flux += PI / 0.8 * f64::from(l.x) * f64::from(cell * cell);
             }

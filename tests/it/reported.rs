@@ -159,7 +159,7 @@ fn a_sphere_light_too_small_to_sample_is_its_point_light() {
     ] {
         let light = format!("Sphere(center: (0, 2, 0), radius: {radius}, power: (400, 400, 400))");
         let (scene, warnings) = compile_text(&floor_under(&light));
-        let is_point = matches!(scene.lights[0], caustic::render_scene::Light::Point { .. });
+        let is_point = scene.lights[0].is_delta();
         assert_eq!(is_point, point, "radius {radius}");
         assert_eq!(
             warnings

@@ -73,7 +73,7 @@ fn shade(s: &RenderScene, from: Vec3, to: Vec3) -> caustic::render_scene::Shadin
 }
 
 fn colour_at(s: &RenderScene, from: Vec3, to: Vec3) -> Vec3 {
-    shade(s, from, to).bsdf.color
+    shade(s, from, to).bsdf.color()
 }
 
 fn assert_colour(got: Vec3, want: Vec3, what: &str) {

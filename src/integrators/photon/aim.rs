@@ -86,10 +86,8 @@ impl CausticTargets {
             .objects
             .iter()
             .map(|o| {
-                o.material.map_or(0.0, |m| {
-                    let b = &scene.materials[m as usize].bsdf;
-                    b.reflect + b.transmit
-                })
+                o.material
+                    .map_or(0.0, |m| scene.materials[m as usize].bsdf.delta_share())
             })
             .collect();
         let is_target: Vec<bool> = share.iter().map(|&s| s > 0.0).collect();

@@ -12,7 +12,6 @@ use glam::{Mat3, Vec3};
 
 use super::aim::{AimCone, CausticTargets, sample_cones};
 use crate::geometry::Ray;
-use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::Light;
 use crate::sampling::Sampler;
 use crate::sampling::warp::{spherical_fibonacci, uniform_rotation};
@@ -78,37 +77,25 @@ impl LightEmitter {
         }
     }
 
-    /// Photon `index` of a global map: its ray and flux (W per channel). Point lights follow the
-    /// rotated lattice; sphere lights draw from `sampler` (started on this photon). Every photon
-    /// carries `Φ / count`. `None` for a black light.
+    /// Photon `index` of a global map: its ray and flux (W per channel), through
+    /// [`Light::emit_spread`]: lights that emit from a point follow the rotated lattice, lights
+    /// with area draw from `sampler` (started on this photon). Every photon carries
+    /// `Φ / count` on average. `None` for a black light.
     #[must_use]
     pub fn global(&self, index: u64, sampler: &mut Sampler) -> Option<(Ray, Vec3)> {
         let n = self.count.max(1) as f32;
-        match self.light {
-            Light::Point { position, .. } => {
-                let i = u32::try_from(index).unwrap_or(u32::MAX);
-                let m = u32::try_from(self.count).unwrap_or(u32::MAX);
-                let dir = self.rotation * spherical_fibonacci(i, m);
-                let power = self.light.power() / n;
-                (power.max_element() > 0.0).then(|| (Ray::new(position, dir.normalize()), power))
-            }
-            Light::Sphere { .. } => {
-                let u_pos = sampler.next_2d();
-                let u_dir = sampler.next_2d();
-                let e = self.light.sample_le(u_pos, u_dir)?;
-                let cos = e.dir.dot(e.normal);
-                let power = e.le * (cos / (e.pdf_pos * e.pdf_dir * n));
-                Some((
-                    Ray::new(leave_surface(e.origin, e.normal, e.dir), e.dir),
-                    power,
-                ))
-            }
-        }
+        let lattice = || {
+            let i = u32::try_from(index).unwrap_or(u32::MAX);
+            let m = u32::try_from(self.count).unwrap_or(u32::MAX);
+            self.rotation * spherical_fibonacci(i, m)
+        };
+        self.light.emit_spread(lattice, sampler, n)
     }
 
-    /// Photon `index` of a caustic map, aimed at `targets`: its ray and flux, or `None` when the
-    /// drawn direction leaves a sphere light's surface inwards (no light goes there; the photon
-    /// still counts as emitted, so the estimate stays unbiased). `cones` is scratch space.
+    /// Photon `index` of a caustic map, aimed at `targets` ([`Light::emit_aimed`]): its ray
+    /// and flux, or `None` when the drawn direction leaves the light's surface inwards (no
+    /// light goes there; the photon still counts as emitted, so the estimate stays unbiased).
+    /// `cones` is scratch space.
     #[must_use]
     pub fn caustic(
         &self,
@@ -117,45 +104,13 @@ impl LightEmitter {
         cones: &mut Vec<AimCone>,
     ) -> Option<(Ray, Vec3)> {
         let n = self.count.max(1) as f32;
-        match self.light {
-            Light::Point {
-                position,
-                intensity,
-            } => {
-                let total = targets.cones(position, cones);
-                let u_pick = sampler.next_1d();
-                let (dir, pdf) = sample_cones(cones, total, u_pick, sampler.next_2d())?;
-                let power = intensity / (pdf * n);
-                power.is_finite().then(|| (Ray::new(position, dir), power))
-            }
-            Light::Sphere {
-                center,
-                radius,
-                radiance,
-            } => {
-                let normal = crate::sampling::warp::uniform_sphere(sampler.next_2d());
-                let origin = center + normal * radius;
-                let total = targets.cones(origin, cones);
-                let u_pick = sampler.next_1d();
-                let (dir, pdf) = sample_cones(cones, total, u_pick, sampler.next_2d())?;
-                let cos = dir.dot(normal);
-                if !(cos > 0.0) {
-                    return None;
-                }
-                let pdf_pos = 1.0 / (4.0 * std::f32::consts::PI * radius * radius);
-                let power = radiance * (cos / (pdf_pos * pdf * n));
-                power
-                    .is_finite()
-                    .then(|| (Ray::new(leave_surface(origin, normal, dir), dir), power))
-            }
-        }
+        let aim = |from: Vec3, sampler: &mut Sampler| {
+            let total = targets.cones(from, cones);
+            let u_pick = sampler.next_1d();
+            sample_cones(cones, total, u_pick, sampler.next_2d())
+        };
+        self.light.emit_aimed(sampler, aim, n)
     }
-}
-
-/// A ray origin just outside an emitter's surface at `p` (normal `n`), on the side of `dir`.
-fn leave_surface(p: Vec3, n: Vec3, dir: Vec3) -> Vec3 {
-    let err = p.abs() * (4.0 * f32::EPSILON) + Vec3::splat(f32::MIN_POSITIVE);
-    offset_ray_origin(p, err, n, dir)
 }
 
 #[cfg(test)]

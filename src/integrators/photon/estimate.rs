@@ -21,7 +21,7 @@
 //!   stored normal must face the query's normal (`nₚ·ng > 0.1`) and their direction must arrive
 //!   from the side of `ωo` (`ωₚ·ng > 0`), the tests of Mitsuba 0.6's photon map (hard case 12).
 //!
-//! Progressive passes ([`PhotonMap::set_shrink`], `integrators::photon::progressive`) read
+//! Progressive passes ([`PhotonMap::set_shrink`], `integrators::photon::passes`) read
 //! only the photons strictly inside `s·r`, `s` ∈ (0, 1], over the area `π (s r)² c`. Given
 //! `r`, the k − 1 photons inside the k-nearest disc are independent draws from the density
 //! restricted to it, so the count inside `s·r` is (k − 1)·P(inside `s·r` | inside `r`) on

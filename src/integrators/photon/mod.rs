@@ -20,23 +20,24 @@ pub mod cache;
 pub mod emit;
 pub mod estimate;
 pub mod maps;
-pub mod progressive;
+pub mod passes;
 pub mod trace;
 
 pub use estimate::{Estimate, IrradianceCache, Kernel, PhotonMap};
 pub use maps::{MapSet, PhotonMaps, PhotonSummary, build_maps};
-pub use progressive::{PassTotals, ProgressivePhotons, RadiusSchedule};
+pub use passes::{PassTotals, ProgressivePhotons, RadiusSchedule};
 
 use glam::Vec3;
 
+use super::context::{Context, PathObserver};
 use super::shadow::{RayCone, connect_light};
-use super::trace_log::{RayKind, TraceLog};
+use super::trace_log::RayKind;
 use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{LightSampler, RenderScene, ShadingPoint, SurfacePoint};
+use crate::render_scene::{Interaction, LightSampler, RenderScene, SurfacePoint};
 use crate::sampling::Sampler;
-use crate::shading::{ShadingFrame, TransportMode};
+use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
 /// Bounces after which Russian roulette may end a camera path's specular chain.
 const ROULETTE_DEPTH: u32 = 3;
@@ -76,13 +77,6 @@ impl Default for Branch {
             kind: RayKind::Camera,
             parent: None,
         }
-    }
-}
-
-/// Stores the weighted radiance gathered at `node`'s hit (see [`TraceLog::finish_tree`]).
-fn set_radiance(log: Option<&mut TraceLog>, node: Option<usize>, gathered: Vec3) {
-    if let (Some(lg), Some(me)) = (log, node) {
-        lg.nodes[me].radiance = gathered;
     }
 }
 
@@ -142,24 +136,16 @@ impl<'a> PhotonMapper<'a> {
     /// chains are split into both branches for the first two delta bounces (as
     /// Whitted does: no noise from choosing between Fresnel reflection and refraction) and
     /// followed by sampling one delta lobe after that.
-    pub fn li(
-        &self,
-        ray: Ray,
-        sampler: &mut Sampler,
-        counters: &mut Counters,
-        log: Option<&mut TraceLog>,
-    ) -> Radiance {
-        self.li_from(&self.maps, ray, sampler, counters, log)
+    pub fn li<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance {
+        self.li_from(&self.maps, ray, cx)
     }
 
     /// [`PhotonMapper::li`] reading `maps` instead of the integrator's own.
-    pub fn li_from(
+    pub fn li_from<O: PathObserver>(
         &self,
         maps: &PhotonMaps,
         ray: Ray,
-        sampler: &mut Sampler,
-        counters: &mut Counters,
-        mut log: Option<&mut TraceLog>,
+        cx: &mut Context<'_, O>,
     ) -> Radiance {
         let scene = self.scene;
         let params = &scene.params;
@@ -175,66 +161,64 @@ impl<'a> PhotonMapper<'a> {
             parent: None,
         };
         let mut len = 1;
-        let root = log.as_deref().map(|lg| lg.nodes.len());
+        let root = cx.observer.next_node();
         while len > 0 {
             len -= 1;
             let b = stack[len];
             let (ray, beta, depth) = (b.ray, b.beta, b.depth);
-            counters.rays += 1;
-            let node = log
-                .as_deref_mut()
-                .map(|lg| lg.push(depth, b.kind, &ray, beta, b.parent));
+            cx.counters.rays += 1;
+            let node = cx.observer.ray(depth, b.kind, &ray, beta, b.parent);
             let mut gathered = Vec3::ZERO;
-            let Some(hit) = scene.geometry.intersect(&ray) else {
-                gathered = beta * params.background;
-                l.add(LightPath::Specular, gathered);
-                set_radiance(log.as_deref_mut(), node, gathered);
-                continue;
-            };
-            let sp = scene.geometry.surface(&ray, &hit);
-            let wo = -ray.dir.normalize();
-            let object = &scene.objects[sp.object as usize];
-            let Some(m) = object.material else {
-                // Reached along a specular chain (or directly): the emitter is seen.
-                if let Some(i) = object.light {
-                    gathered = beta * scene.lights[i as usize].le(sp.ng, wo);
+            let v = match scene.interact(&ray, |t| b.cone.width_at(&ray, t)) {
+                Interaction::Escaped => {
+                    gathered = beta * params.background;
                     l.add(LightPath::Specular, gathered);
+                    cx.observer.set_radiance(node, gathered);
+                    continue;
                 }
-                if let Some(lg) = log.as_deref_mut() {
-                    lg.record_hit(node, scene, &hit, &sp, "light");
-                    set_radiance(Some(lg), node, gathered);
+                Interaction::Emitter(e) => {
+                    // Reached along a specular chain (or directly): the emitter is seen.
+                    if e.light.is_some() {
+                        gathered = beta * e.le(scene);
+                        l.add(LightPath::Specular, gathered);
+                    }
+                    cx.observer.hit(node, scene, &e.hit, &e.sp, "light");
+                    cx.observer.set_radiance(node, gathered);
+                    continue;
                 }
-                continue;
+                Interaction::Surface(v) => v,
             };
-            let sh = scene.shading_point(
-                &scene.materials[m as usize],
-                &sp,
-                wo,
-                b.cone.width_at(&ray, hit.t),
-            );
-            if let Some(lg) = log.as_deref_mut() {
-                let name = scene.material_names[m as usize].clone();
-                lg.record_hit(node, scene, &hit, &sp, &name);
-            }
+            let (hit, sp, wo) = (v.hit, v.sp, v.wo);
+            let name = &scene.material_names[v.material as usize];
+            cx.observer.hit(node, scene, &hit, &sp, name);
             if depth >= params.max_depth {
-                TraceLog::note(log.as_deref_mut(), node, "max depth reached");
+                cx.observer.note(node, "max depth reached");
                 continue;
             }
-            if sh.bsdf.has_local() {
+            let (bsdf, fr) = (v.bsdf, v.frame);
+            if bsdf.has_local() {
                 let full = beta.max_element() >= FINAL_GATHER_MIN_WEIGHT;
-                let (c, note) =
-                    self.local(maps, &sp, &sh, wo, full, sampler, counters, log.is_some());
+                let (c, note) = self.local(
+                    maps,
+                    &sp,
+                    &fr,
+                    &bsdf,
+                    wo,
+                    full,
+                    cx.sampler,
+                    cx.counters,
+                    O::ACTIVE,
+                );
                 gathered = beta * c.total();
                 l.add_scaled(&c, beta);
                 if let Some(text) = note {
-                    TraceLog::note(log.as_deref_mut(), node, &text);
+                    cx.observer.note(node, &text);
                 }
             }
-            set_radiance(log.as_deref_mut(), node, gathered);
-            if !sh.bsdf.has_delta() {
+            cx.observer.set_radiance(node, gathered);
+            if !bsdf.has_delta() {
                 continue;
             }
-            let fr = frame(&sh);
             let curvature = scene.geometry.curvature(&hit);
             let mut push = |dir: Vec3, weight: Vec3, transmitted: bool, eta_scale: f32| {
                 let beta = beta * weight;
@@ -261,15 +245,10 @@ impl<'a> PhotonMapper<'a> {
                 };
                 len += 1;
             };
-            if depth < SPLIT_DEPTH && !sh.bsdf.has_local() {
-                let lobes = sh.bsdf.delta_lobes(wo, fr.ns, fr.ng, fr.entering);
+            if depth < SPLIT_DEPTH && !bsdf.has_local() {
+                let lobes = bsdf.delta_lobes(wo, fr.ns, fr.ng, fr.entering);
                 if let Some((dir, w)) = lobes.refract {
-                    let eta = if fr.entering {
-                        1.0 / sh.bsdf.ior
-                    } else {
-                        sh.bsdf.ior
-                    };
-                    push(dir, w, true, eta * eta);
+                    push(dir, w, true, lobes.eta_scale);
                 }
                 if lobes.reflect_weight.max_element() > 0.0 {
                     push(lobes.reflect_dir, lobes.reflect_weight, false, 1.0);
@@ -277,14 +256,11 @@ impl<'a> PhotonMapper<'a> {
                 continue;
             }
             // Deeper: one delta lobe, sampled (the diffuse part was accounted for above).
-            let u_lobe = sampler.defer_1d();
-            let u_dir = sampler.next_2d();
-            let u_rr = sampler.next_1d();
-            let u_lobe = sh.bsdf.lobe_number(|| sampler.get_1d(u_lobe));
-            let Some(s) = sh
-                .bsdf
-                .sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance)
-            else {
+            let u_lobe = cx.sampler.defer_1d();
+            let u_dir = cx.sampler.next_2d();
+            let u_rr = cx.sampler.next_1d();
+            let u_lobe = bsdf.lobe_number(|| cx.sampler.get_1d(u_lobe));
+            let Some(s) = bsdf.sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance) else {
                 continue;
             };
             if !s.delta {
@@ -295,7 +271,7 @@ impl<'a> PhotonMapper<'a> {
                 let eta_scale = b.eta_scale * if s.transmitted { s.eta_scale } else { 1.0 };
                 let q = (beta * w / eta_scale).max_element().min(1.0);
                 if !(q > 0.0) || u_rr >= q {
-                    TraceLog::note(log.as_deref_mut(), node, "ended by Russian roulette");
+                    cx.observer.note(node, "ended by Russian roulette");
                     continue;
                 }
                 w /= q;
@@ -307,9 +283,7 @@ impl<'a> PhotonMapper<'a> {
                 if s.transmitted { s.eta_scale } else { 1.0 },
             );
         }
-        if let (Some(lg), Some(root)) = (log, root) {
-            lg.finish_tree(root);
-        }
+        cx.observer.finish_tree(root);
         l
     }
 
@@ -321,23 +295,23 @@ impl<'a> PhotonMapper<'a> {
         &self,
         maps: &PhotonMaps,
         sp: &SurfacePoint,
-        sh: &ShadingPoint,
+        fr: &ShadingFrame,
+        bsdf: &Bsdf,
         wo: Vec3,
         full: bool,
         sampler: &mut Sampler,
         counters: &mut Counters,
         describe: bool,
     ) -> (Radiance, Option<String>) {
-        let fr = frame(sh);
-        let direct = self.direct(sp, &fr, sh, wo, sampler, counters);
-        if !full && let Some(l) = cached_radiance(maps, sp, &fr, sh, wo, counters) {
+        let direct = self.direct(sp, fr, bsdf, wo, sampler, counters);
+        if !full && let Some(l) = cached_radiance(maps, sp, fr, bsdf, wo, counters) {
             let note = describe.then(|| {
                 format!(
                     "direct ({:.4}, {:.4}, {:.4}); caustic + indirect {} ({:.4}, {:.4}, {:.4}) (dim branch)",
                     direct.x,
                     direct.y,
                     direct.z,
-                    if lambertian(&sh.bsdf) {
+                    if bsdf.is_diffuse_only() {
                         "from precomputed irradiance"
                     } else {
                         "from both maps (glossy)"
@@ -355,18 +329,18 @@ impl<'a> PhotonMapper<'a> {
         let caustic = maps
             .caustic
             .as_ref()
-            .map(|m| counted(m, sp.p, wo, &fr, sh, counters));
+            .map(|m| counted(m, sp.p, wo, fr, bsdf, counters));
         let gather = self.final_gather;
         let (indirect, global) = if gather > 0 {
             (
-                self.final_gather(maps, sp, &fr, sh, wo, gather, sampler, counters),
+                self.final_gather(maps, sp, fr, bsdf, wo, gather, sampler, counters),
                 None,
             )
         } else {
             let e = maps
                 .global
                 .as_ref()
-                .map(|m| counted(m, sp.p, wo, &fr, sh, counters));
+                .map(|m| counted(m, sp.p, wo, fr, bsdf, counters));
             (e.map_or(Vec3::ZERO, |e| e.radiance), e)
         };
         let caustic_l = caustic.map_or(Vec3::ZERO, |e| e.radiance);
@@ -412,7 +386,7 @@ impl<'a> PhotonMapper<'a> {
         &self,
         sp: &SurfacePoint,
         fr: &ShadingFrame,
-        sh: &ShadingPoint,
+        bsdf: &Bsdf,
         wo: Vec3,
         sampler: &mut Sampler,
         counters: &mut Counters,
@@ -422,7 +396,7 @@ impl<'a> PhotonMapper<'a> {
         let Some((index, pmf)) = self.lights.sample(u_light) else {
             return Vec3::ZERO;
         };
-        match connect_light(self.scene, index, sp, wo, fr, &sh.bsdf, u_point, counters) {
+        match connect_light(self.scene, index, sp, wo, fr, bsdf, u_point, counters) {
             Some(c) if !c.occluded => c.f * c.ls.weight * (fr.ns.dot(c.ls.wi) / pmf),
             _ => Vec3::ZERO,
         }
@@ -438,7 +412,7 @@ impl<'a> PhotonMapper<'a> {
         maps: &PhotonMaps,
         sp: &SurfacePoint,
         fr: &ShadingFrame,
-        sh: &ShadingPoint,
+        bsdf: &Bsdf,
         wo: Vec3,
         n: u32,
         sampler: &mut Sampler,
@@ -449,11 +423,8 @@ impl<'a> PhotonMapper<'a> {
         for _ in 0..n {
             let u_lobe = sampler.defer_1d();
             let u_dir = sampler.next_2d();
-            let u_lobe = sh.bsdf.lobe_number(|| sampler.get_1d(u_lobe));
-            let Some(s) = sh
-                .bsdf
-                .sample(wo, u_lobe, u_dir, fr, TransportMode::Radiance)
-            else {
+            let u_lobe = bsdf.lobe_number(|| sampler.get_1d(u_lobe));
+            let Some(s) = bsdf.sample(wo, u_lobe, u_dir, fr, TransportMode::Radiance) else {
                 continue;
             };
             if s.delta {
@@ -464,54 +435,52 @@ impl<'a> PhotonMapper<'a> {
             let (mut specular, mut shortcuts) = (0u32, 0u32);
             loop {
                 counters.rays += 1;
-                let Some(hit) = scene.geometry.intersect(&ray) else {
-                    sum += beta * scene.params.background;
-                    break;
+                let g = match scene.interact(&ray, |_| 0.0) {
+                    Interaction::Escaped => {
+                        sum += beta * scene.params.background;
+                        break;
+                    }
+                    Interaction::Emitter(_) => break, // Direct light is the shadow ray's.
+                    Interaction::Surface(g) => g,
                 };
-                let gp = scene.geometry.surface(&ray, &hit);
-                let gwo = -ray.dir.normalize();
-                let Some(m) = scene.objects[gp.object as usize].material else {
-                    break; // Direct light is the shadow ray's.
-                };
-                let gsh = scene.shading_point(&scene.materials[m as usize], &gp, gwo, 0.0);
-                let gfr = frame(&gsh);
+                let (gp, gwo, gfr) = (g.sp, g.wo, g.frame);
                 let mut short = false;
-                if gsh.bsdf.has_local() {
-                    let mut lo = self.direct(&gp, &gfr, &gsh, gwo, sampler, counters);
+                if g.bsdf.has_local() {
+                    let mut lo = self.direct(&gp, &gfr, &g.bsdf, gwo, sampler, counters);
                     let near = maps
                         .irradiance
                         .as_ref()
                         .and_then(|c| c.lookup_with_radius(gp.p, gfr.ng));
                     short = shortcuts < SHORT_GATHER_BOUNCES
-                        && near.is_some_and(|(_, r)| hit.t < SHORT_GATHER * r);
+                        && near.is_some_and(|(_, r)| g.hit.t < SHORT_GATHER * r);
                     if short {
                         // The caustics here still come from their map; the rest of the light
                         // arriving here is gathered by the bounce below.
                         if let Some(map) = &maps.caustic {
-                            lo += counted(map, gp.p, gwo, &gfr, &gsh, counters).radiance;
+                            lo += counted(map, gp.p, gwo, &gfr, &g.bsdf, counters).radiance;
                         }
-                    } else if let Some((e, _)) = near.filter(|_| lambertian(&gsh.bsdf)) {
-                        lo += gsh.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e;
+                    } else if let Some((e, _)) = near.filter(|_| g.bsdf.is_diffuse_only()) {
+                        lo += g.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e;
                     } else {
                         for map in [&maps.caustic, &maps.global].into_iter().flatten() {
-                            lo += counted(map, gp.p, gwo, &gfr, &gsh, counters).radiance;
+                            lo += counted(map, gp.p, gwo, &gfr, &g.bsdf, counters).radiance;
                         }
                     }
                     sum += beta * lo;
                 }
-                if !short && (specular == GATHER_SPECULAR_DEPTH || !gsh.bsdf.has_delta()) {
+                if !short && (specular == GATHER_SPECULAR_DEPTH || !g.bsdf.has_delta()) {
                     break;
                 }
                 let u_lobe = sampler.defer_1d();
                 let u_dir = sampler.next_2d();
-                let u_lobe = gsh.bsdf.lobe_number(|| sampler.get_1d(u_lobe));
-                let Some(g) = gsh
+                let u_lobe = g.bsdf.lobe_number(|| sampler.get_1d(u_lobe));
+                let Some(gs) = g
                     .bsdf
                     .sample(gwo, u_lobe, u_dir, &gfr, TransportMode::Radiance)
                 else {
                     break;
                 };
-                if g.delta {
+                if gs.delta {
                     if specular == GATHER_SPECULAR_DEPTH {
                         break;
                     }
@@ -521,11 +490,11 @@ impl<'a> PhotonMapper<'a> {
                 } else {
                     break;
                 }
-                beta *= g.weight;
+                beta *= gs.weight;
                 if !beta.is_finite() || beta.max_element() <= 0.0 {
                     break;
                 }
-                ray = Ray::new(offset_ray_origin(gp.p, gp.p_error, gfr.ng, g.wi), g.wi);
+                ray = Ray::new(offset_ray_origin(gp.p, gp.p_error, gfr.ng, gs.wi), gs.wi);
             }
         }
         sum / n as f32
@@ -545,30 +514,23 @@ fn cached_radiance(
     maps: &PhotonMaps,
     sp: &SurfacePoint,
     fr: &ShadingFrame,
-    sh: &ShadingPoint,
+    bsdf: &Bsdf,
     wo: Vec3,
     counters: &mut Counters,
 ) -> Option<Vec3> {
     let cache = maps.irradiance.as_ref()?;
-    if lambertian(&sh.bsdf) {
+    if bsdf.is_diffuse_only() {
         let e = cache.lookup(sp.p, fr.ng)?;
-        return Some(sh.bsdf.eval(wo, fr.ns, fr, TransportMode::Radiance) * e);
+        return Some(bsdf.eval(wo, fr.ns, fr, TransportMode::Radiance) * e);
     }
     let mut l = Vec3::ZERO;
     for map in [&maps.caustic, &maps.global].into_iter().flatten() {
-        l += counted(map, sp.p, wo, fr, sh, counters).radiance;
+        l += counted(map, sp.p, wo, fr, bsdf, counters).radiance;
     }
     Some(l)
 }
 
-/// True when the non-delta part of `bsdf` is Lambert alone (no Phong lobe), so its radiance
-/// is `f · E` whatever direction the light arrives from.
-#[inline]
-fn lambertian(bsdf: &crate::shading::Bsdf) -> bool {
-    bsdf.specular == Vec3::ZERO
-}
-
-/// `map`'s estimate at `p` towards `wo` through `sh`'s BSDF, counted in `counters` (estimates
+/// `map`'s estimate at `p` towards `wo` through `bsdf`, counted in `counters` (estimates
 /// made, and those the largest radius cut short).
 #[inline]
 fn counted(
@@ -576,21 +538,21 @@ fn counted(
     p: Vec3,
     wo: Vec3,
     fr: &ShadingFrame,
-    sh: &ShadingPoint,
+    bsdf: &Bsdf,
     counters: &mut Counters,
 ) -> Estimate {
-    let e = map.estimate(p, wo, fr, &sh.bsdf);
+    let e = map.estimate(p, wo, fr, bsdf);
     counters.photon_estimates += 1;
     counters.photon_radius_cut += u64::from(e.cut);
     e
 }
 
-/// The BSDF frame of a shading point.
-#[inline]
-fn frame(sh: &ShadingPoint) -> ShadingFrame {
-    ShadingFrame {
-        ns: sh.ns,
-        ng: sh.ng,
-        entering: sh.entering,
+impl<'a> super::Estimator<'a> for PhotonMapper<'a> {
+    fn li_parts<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance {
+        self.li(ray, cx)
+    }
+
+    fn photon_maps(&self) -> Option<&PhotonMaps> {
+        Some(self.maps())
     }
 }

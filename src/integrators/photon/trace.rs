@@ -13,9 +13,9 @@ use glam::Vec3;
 
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::RenderScene;
+use crate::render_scene::{Interaction, RenderScene};
 use crate::sampling::Sampler;
-use crate::shading::{ShadingFrame, TransportMode};
+use crate::shading::TransportMode;
 use crate::spatial::Photon;
 
 /// Largest factor by which a photon's flux may grow along its path (the adjoint shading-normal
@@ -93,18 +93,13 @@ pub fn trace_photon(
     let mut diffuse_bounces = 0u32;
     let mut bounces = 0u32;
     loop {
-        let Some(hit) = scene.geometry.intersect(&ray) else {
-            return;
+        let v = match scene.interact(&ray, |_| 0.0) {
+            Interaction::Surface(v) => v,
+            // Escaped, or an emitter: it absorbs what reaches it.
+            Interaction::Escaped | Interaction::Emitter(_) => return,
         };
-        let sp = scene.geometry.surface(&ray, &hit);
-        let object = &scene.objects[sp.object as usize];
-        let Some(m) = object.material else {
-            return; // An emitter absorbs what reaches it.
-        };
-        let dir = ray.dir.normalize();
-        let wo = -dir;
-        let sh = scene.shading_point(&scene.materials[m as usize], &sp, wo, 0.0);
-        let bsdf = sh.bsdf;
+        let (sp, wo, fr, bsdf) = (v.sp, v.wo, v.frame, v.bsdf);
+        let dir = -wo;
         if bounces == 0 && settings.kind == MapKind::Caustic {
             if !bsdf.has_delta() {
                 return; // Aimed at a target but blocked by a diffuse object.
@@ -118,16 +113,11 @@ pub fn trace_photon(
                 MapKind::Global => diffuse_bounces >= settings.min_bounces,
             };
             if store {
-                out.push(Photon::new(sp.p, dir, sh.ng, power));
+                out.push(Photon::new(sp.p, dir, fr.ng, power));
                 counts.stored += 1;
                 counts.stored_flux += power;
             }
         }
-        let fr = ShadingFrame {
-            ns: sh.ns,
-            ng: sh.ng,
-            entering: sh.entering,
-        };
         let u_lobe = sampler.defer_1d();
         let u = sampler.next_2d();
         let u_rr = sampler.next_1d();

@@ -19,12 +19,12 @@
 //! Both are [`PathTracer::li_with_maps`] with different [`PathMaps`]; the parts are disjoint
 //! and together make every path, so the images converge to the path tracer's.
 
+use super::context::{Context, PathObserver};
 use super::path::PathMaps;
 use super::photon::{MapSet, ProgressivePhotons};
-use super::{Counters, PathTracer, Radiance, TraceLog};
+use super::{PathTracer, Radiance};
 use crate::geometry::Ray;
 use crate::render_scene::RenderScene;
-use crate::sampling::Sampler;
 
 /// A progressive integrator: the current pass's maps and the camera paths that read them.
 #[derive(Debug)]
@@ -77,9 +77,15 @@ impl<'a> ProgressivePath<'a> {
         &self.photons
     }
 
-    /// Makes every later pass's photon tracing stop soon after `cancel` (Ctrl-C) is raised.
-    pub fn set_cancel(&mut self, cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
+    /// This integrator, whose every later pass's photon tracing stops soon after `cancel`
+    /// (Ctrl-C) is raised.
+    #[must_use]
+    pub fn with_cancel(
+        mut self,
+        cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    ) -> Self {
         self.photons.set_cancel(cancel);
+        self
     }
 
     /// Makes the maps those of pass `pass` (the sample index about to be taken).
@@ -88,13 +94,7 @@ impl<'a> ProgressivePath<'a> {
     }
 
     /// Radiance along camera ray `ray` from the current pass's maps.
-    pub fn li(
-        &self,
-        ray: Ray,
-        sampler: &mut Sampler,
-        counters: &mut Counters,
-        log: Option<&mut TraceLog>,
-    ) -> Radiance {
+    pub fn li<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance {
         let m = self.photons.maps();
         let maps = PathMaps {
             caustic: m.caustic.as_ref(),
@@ -102,6 +102,24 @@ impl<'a> ProgressivePath<'a> {
             global_at: self.global_at,
             global_has_caustics: self.global_has_caustics,
         };
-        self.path.li_with_maps(maps, ray, sampler, counters, log)
+        self.path.li_with_maps(maps, ray, cx)
+    }
+}
+
+impl<'a> super::Estimator<'a> for ProgressivePath<'a> {
+    fn li_parts<O: PathObserver>(&self, ray: Ray, cx: &mut Context<'_, O>) -> Radiance {
+        self.li(ray, cx)
+    }
+
+    fn photon_maps(&self) -> Option<&super::photon::PhotonMaps> {
+        Some(self.photons.maps())
+    }
+
+    fn progressive(&self) -> Option<&ProgressivePhotons<'a>> {
+        Some(&self.photons)
+    }
+
+    fn begin_pass(&mut self, sample: u32) {
+        ProgressivePath::begin_pass(self, sample);
     }
 }

@@ -1,0 +1,107 @@
+//! The path-vertex step every integrator and photon path takes, written once: intersect a ray,
+//! expand the hit into a surface point, and resolve what is there — nothing (the ray escaped),
+//! an emitter, or a surface with its BSDF and shading frame (the role of pbrt-v4's
+//! `SurfaceInteraction::GetBSDF` and Tungsten's `TraceBase`, our own code).
+
+use glam::Vec3;
+
+use super::{Hit, RenderScene, SurfacePoint};
+use crate::geometry::Ray;
+use crate::shading::{Bsdf, ShadingFrame};
+
+/// What a ray found ([`RenderScene::interact`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Interaction {
+    /// The ray left the scene (it sees the background).
+    Escaped,
+    /// The ray hit an emitter's surface (an object without a material: it absorbs what reaches
+    /// it and emits [`EmitterHit::le`]).
+    Emitter(EmitterHit),
+    /// The ray hit a surface with a material.
+    Surface(SurfaceHit),
+}
+
+/// A ray's hit on an emitter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EmitterHit {
+    /// The hit (distance, primitive).
+    pub hit: Hit,
+    /// The surface point.
+    pub sp: SurfacePoint,
+    /// Unit direction back along the ray (from the surface towards the ray's origin).
+    pub wo: Vec3,
+    /// The light this surface emits as (`RenderScene::lights` index), if any.
+    pub light: Option<u32>,
+}
+
+/// A ray's hit on a surface with a material, resolved for shading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceHit {
+    /// The hit (distance, primitive).
+    pub hit: Hit,
+    /// The surface point.
+    pub sp: SurfacePoint,
+    /// Unit direction back along the ray (from the surface towards the ray's origin).
+    pub wo: Vec3,
+    /// Material index (`RenderScene::materials`, `material_names`).
+    pub material: u32,
+    /// The BSDF with textures applied.
+    pub bsdf: Bsdf,
+    /// The shading frame on the side of `wo` (bumped, usable shading normal; geometric normal;
+    /// which side `wo` is on).
+    pub frame: ShadingFrame,
+}
+
+impl EmitterHit {
+    /// Radiance the emitter sends back along the ray (W·m⁻²·sr⁻¹ per channel), through the
+    /// light's own interface ([`super::Light::le`]): zero on the side it does not emit from and
+    /// for an emitter surface that carries no light.
+    #[inline]
+    #[must_use]
+    pub fn le(&self, scene: &RenderScene) -> Vec3 {
+        self.light.map_or(Vec3::ZERO, |i| {
+            scene.lights[i as usize].le(self.sp.ng, self.wo)
+        })
+    }
+}
+
+impl RenderScene {
+    /// Traces `ray` to its first hit and resolves it: [`Interaction::Escaped`], an emitter, or a
+    /// surface shaded by [`RenderScene::shading_point`] with the texture footprint
+    /// `footprint(t)` world units wide at hit distance `t` (in `ray`'s parameter units; a ray
+    /// cone's width there, or 0 for the sharpest lookup). This is the one vertex step of every
+    /// integrator and of photon tracing.
+    #[inline]
+    #[must_use]
+    pub fn interact(&self, ray: &Ray, footprint: impl FnOnce(f32) -> f32) -> Interaction {
+        let Some(hit) = self.geometry.intersect(ray) else {
+            return Interaction::Escaped;
+        };
+        let sp = self.geometry.surface(ray, &hit);
+        let object = &self.objects[sp.object as usize];
+        let wo = -ray.dir.normalize();
+        match object.material {
+            None => Interaction::Emitter(EmitterHit {
+                hit,
+                sp,
+                wo,
+                light: object.light,
+            }),
+            Some(m) => {
+                let sh = self.shading_point(&self.materials[m as usize], &sp, wo, footprint(hit.t));
+                Interaction::Surface(SurfaceHit {
+                    hit,
+                    sp,
+                    wo,
+                    material: m,
+                    bsdf: sh.bsdf,
+                    frame: ShadingFrame {
+                        ns: sh.ns,
+                        ng: sh.ng,
+                        entering: sh.entering,
+                    },
+                })
+            }
+        }
+    }
+}
