@@ -1,0 +1,179 @@
+//! Scene-graph nodes and their transforms.
+
+use std::collections::BTreeMap;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::Vec3Spec;
+use super::values::{ScaleSpec, exact_floats, one, unique_keys, unit_size, yes};
+
+/// A node of the scene graph. Transforms apply in list order (the first one first), and a
+/// group's transform applies after its children's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub enum NodeSpec {
+    /// A transformed collection of nodes.
+    Group {
+        /// Optional name, shown in diagnostics and `debug-pixel`.
+        #[serde(default)]
+        name: Option<String>,
+        /// Transform steps.
+        #[serde(default)]
+        transform: Vec<TransformStep>,
+        /// Child nodes.
+        #[serde(default)]
+        children: Vec<NodeSpec>,
+    },
+    /// A sphere (an ellipsoid under non-uniform scale).
+    Sphere {
+        /// Optional name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Transform steps.
+        #[serde(default)]
+        transform: Vec<TransformStep>,
+        /// Material name.
+        material: String,
+        /// Centre in object space.
+        #[serde(default)]
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
+        center: Vec3Spec,
+        /// Radius in object space (> 0).
+        #[serde(default = "one")]
+        radius: f32,
+    },
+    /// An axis-aligned cube centred on the origin in object space.
+    Cube {
+        /// Optional name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Transform steps.
+        #[serde(default)]
+        transform: Vec<TransformStep>,
+        /// Material name.
+        material: String,
+        /// Edge length in object space (> 0).
+        #[serde(default = "one")]
+        size: f32,
+    },
+    /// A bounded rectangle in the object's xy plane, centred on the origin, facing +z.
+    Quad {
+        /// Optional name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Transform steps.
+        #[serde(default)]
+        transform: Vec<TransformStep>,
+        /// Material name.
+        material: String,
+        /// Width (x) and height (y) in object space (> 0).
+        #[serde(default = "unit_size")]
+        #[serde(deserialize_with = "exact_floats::<_, 2>")]
+        size: [f32; 2],
+    },
+    /// A triangle mesh from a Wavefront OBJ file (path relative to the scene file), with one
+    /// material or one per OBJ group.
+    Mesh {
+        /// Optional name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Transform steps.
+        #[serde(default)]
+        transform: Vec<TransformStep>,
+        /// Material name: of every face, or with `materials` of the faces it does not map.
+        /// Required unless `materials` maps every face of the file.
+        #[serde(default)]
+        material: Option<String>,
+        /// Materials by the file's names: each key is a group (`g` or `o`) or a `usemtl` name
+        /// of the OBJ file, each value a material name. A face takes the material of its
+        /// `usemtl` name if that is a key, else of its group, else `material`. A key the file
+        /// does not use is an error (a typo would otherwise go unnoticed).
+        #[serde(
+            default,
+            skip_serializing_if = "BTreeMap::is_empty",
+            deserialize_with = "unique_keys"
+        )]
+        materials: BTreeMap<String, String>,
+        /// OBJ file, relative to the scene file.
+        file: String,
+        /// Interpolate the file's vertex normals when it has them.
+        #[serde(default = "yes")]
+        smooth: bool,
+    },
+}
+
+/// One step of a node's transform.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub enum TransformStep {
+    /// Translation by (x, y, z).
+    Translate(f32, f32, f32),
+    /// Rotation about the x axis, in degrees (right-handed).
+    RotateX(f32),
+    /// Rotation about the y axis, in degrees.
+    RotateY(f32),
+    /// Rotation about the z axis, in degrees.
+    RotateZ(f32),
+    /// Uniform scale `Scale(s)` or per-axis scale `Scale((x, y, z))`.
+    Scale(ScaleSpec),
+}
+
+impl NodeSpec {
+    /// The node's kind as written in the file.
+    #[must_use]
+    pub fn kind(&self) -> &'static str {
+        match self {
+            NodeSpec::Group { .. } => "Group",
+            NodeSpec::Sphere { .. } => "Sphere",
+            NodeSpec::Cube { .. } => "Cube",
+            NodeSpec::Quad { .. } => "Quad",
+            NodeSpec::Mesh { .. } => "Mesh",
+        }
+    }
+
+    /// The node's transform steps.
+    #[must_use]
+    pub fn transform(&self) -> &[TransformStep] {
+        match self {
+            NodeSpec::Group { transform, .. }
+            | NodeSpec::Sphere { transform, .. }
+            | NodeSpec::Cube { transform, .. }
+            | NodeSpec::Quad { transform, .. }
+            | NodeSpec::Mesh { transform, .. } => transform,
+        }
+    }
+
+    /// The node's optional name.
+    #[must_use]
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            NodeSpec::Group { name, .. }
+            | NodeSpec::Sphere { name, .. }
+            | NodeSpec::Cube { name, .. }
+            | NodeSpec::Quad { name, .. }
+            | NodeSpec::Mesh { name, .. } => name.as_deref(),
+        }
+    }
+
+    /// The material a leaf node references (None for groups, and for a mesh that gives only
+    /// `materials`).
+    #[must_use]
+    pub fn material(&self) -> Option<&str> {
+        match self {
+            NodeSpec::Group { .. } => None,
+            NodeSpec::Sphere { material, .. }
+            | NodeSpec::Cube { material, .. }
+            | NodeSpec::Quad { material, .. } => Some(material),
+            NodeSpec::Mesh { material, .. } => material.as_deref(),
+        }
+    }
+
+    /// The materials a mesh maps its OBJ groups and `usemtl` names to (None for other nodes).
+    #[must_use]
+    pub fn group_materials(&self) -> Option<&BTreeMap<String, String>> {
+        match self {
+            NodeSpec::Mesh { materials, .. } => Some(materials),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,102 @@
+//! Checks of the `render` and `camera` blocks.
+
+use super::*;
+
+impl<'a> Validator<'a> {
+    pub(super) fn render(&mut self, r: &RenderSettings) {
+        for (field, v) in [("width", r.width), ("height", r.height)] {
+            let path = format!("render.{field}");
+            if v == 0 {
+                self.err(&path, "must be at least 1 pixel, found 0".into());
+            } else if v > MAX_IMAGE_SIDE {
+                self.err(
+                    &path,
+                    format!("must be at most {MAX_IMAGE_SIDE} pixels, found {v}"),
+                );
+            }
+        }
+        let pixels = u64::from(r.width) * u64::from(r.height);
+        if r.width <= MAX_IMAGE_SIDE && r.height <= MAX_IMAGE_SIDE && pixels > MAX_IMAGE_PIXELS {
+            self.err(
+                "render.width",
+                format!(
+                    "{}×{} = {pixels} pixels exceeds the limit of {MAX_IMAGE_PIXELS} pixels (the film alone would need {:.1} GB)",
+                    r.width,
+                    r.height,
+                    pixels as f64 * 12.0 / 1e9
+                ),
+            );
+        }
+        if r.samples_per_pixel == 0 || r.samples_per_pixel > MAX_SAMPLES_PER_PIXEL {
+            self.err(
+                "render.samples_per_pixel",
+                format!(
+                    "must be within [1, {MAX_SAMPLES_PER_PIXEL}], found {}",
+                    r.samples_per_pixel
+                ),
+            );
+        }
+        if r.max_depth > MAX_DEPTH {
+            self.err(
+                "render.max_depth",
+                format!("must be at most {MAX_DEPTH}, found {}", r.max_depth),
+            );
+        }
+        if r.light_samples == 0 || r.light_samples > 1024 {
+            self.err(
+                "render.light_samples",
+                format!("must be within [1, 1024], found {}", r.light_samples),
+            );
+        }
+        self.range("render.min_contribution", r.min_contribution, 0.0, 1.0);
+        if self.finite3("render.background", r.background) && r.background.iter().any(|c| *c < 0.0)
+        {
+            self.err(
+                "render.background",
+                format!("must not be negative, found {}", fmt3(r.background)),
+            );
+        }
+        self.positive("render.exposure", r.exposure, "exposure");
+    }
+
+    pub(super) fn camera(&mut self, c: &CameraSpec) {
+        let CameraSpec::Pinhole {
+            eye,
+            look_at,
+            up,
+            fov_y,
+        } = c;
+        let ok = self.finite3("camera.eye", *eye)
+            & self.finite3("camera.look_at", *look_at)
+            & self.finite3("camera.up", *up);
+        if self.finite("camera.fov_y", *fov_y) && !(*fov_y > 0.0 && *fov_y < 180.0) {
+            self.err(
+                "camera.fov_y",
+                format!("must be within (0, 180) degrees, found {fov_y}"),
+            );
+        }
+        if !ok {
+            return;
+        }
+        let forward = glam::Vec3::from(*look_at) - glam::Vec3::from(*eye);
+        if !(forward.length_squared() > 0.0) {
+            self.err(
+                "camera.look_at",
+                format!("must differ from `eye`, both are {}", fmt3(*eye)),
+            );
+        } else if !(forward
+            .normalize()
+            .cross(glam::Vec3::from(*up))
+            .length_squared()
+            > 1e-12)
+        {
+            self.err(
+                "camera.up",
+                format!(
+                    "must not be parallel to the view direction, found {}",
+                    fmt3(*up)
+                ),
+            );
+        }
+    }
+}
