@@ -226,3 +226,70 @@ fn lower_layers_do_not_import_upper_ones() {
         }
     }
 }
+
+/// The `src/…` paths that `docs/architecture.md` names in backticks, each with whether the page
+/// marks it as a file a recipe creates (`` `src/x.rs` (new) ``).
+fn architecture_doc_paths(doc: &str) -> Vec<(String, bool)> {
+    let mut out = Vec::new();
+    for (i, piece) in doc.split('`').enumerate() {
+        if i % 2 == 1 && piece.starts_with("src/") {
+            let after = doc.split('`').nth(i + 1).unwrap_or("");
+            out.push((piece.to_string(), after.starts_with(" (new)")));
+        }
+    }
+    out
+}
+
+#[test]
+fn every_module_the_architecture_page_names_exists() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let doc = std::fs::read_to_string(root.join("docs/architecture.md")).expect("read the page");
+    let paths = architecture_doc_paths(&doc);
+    assert!(paths.len() > 20, "the page names only {} paths", paths.len());
+    for (path, new) in &paths {
+        let exists = root.join(path).exists();
+        if *new {
+            assert!(!exists, "{path} is marked (new) but exists: name another example");
+        } else {
+            assert!(exists, "docs/architecture.md names {path}, which does not exist");
+        }
+    }
+    // Every layered module has its line in the page's table.
+    for (dir, _) in RULES {
+        assert!(
+            doc.contains(&format!("| `{dir}` |")) || doc.contains(&format!("| `{dir}.rs` |")),
+            "docs/architecture.md has no table row for {dir}"
+        );
+    }
+}
+
+#[test]
+fn each_recipe_of_the_architecture_page_touches_at_most_three_files() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let doc = std::fs::read_to_string(root.join("docs/architecture.md")).expect("read the page");
+    let recipes: Vec<&str> = doc.split("\n### ").skip(1).collect();
+    assert_eq!(recipes.len(), 3, "an integrator, a light, a lobe");
+    for recipe in recipes {
+        let title = recipe.lines().next().unwrap_or("");
+        let body = recipe.split("\n## ").next().unwrap_or("");
+        // A numbered step with its indented continuation lines.
+        let mut steps: Vec<String> = Vec::new();
+        for line in body.lines() {
+            if line.len() > 2 && line.as_bytes()[0].is_ascii_digit() && &line[1..3] == ". " {
+                steps.push(line.to_string());
+            } else if let (Some(last), true) = (steps.last_mut(), line.starts_with("   ")) {
+                last.push(' ');
+                last.push_str(line.trim());
+            }
+        }
+        assert!(
+            (1..=3).contains(&steps.len()),
+            "recipe {title}: {} steps",
+            steps.len()
+        );
+        for step in steps {
+            let named = architecture_doc_paths(&step);
+            assert_eq!(named.len(), 1, "recipe {title}: each step changes one file: {step}");
+        }
+    }
+}
