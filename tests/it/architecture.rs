@@ -245,13 +245,23 @@ fn every_module_the_architecture_page_names_exists() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let doc = std::fs::read_to_string(root.join("docs/architecture.md")).expect("read the page");
     let paths = architecture_doc_paths(&doc);
-    assert!(paths.len() > 20, "the page names only {} paths", paths.len());
+    assert!(
+        paths.len() > 20,
+        "the page names only {} paths",
+        paths.len()
+    );
     for (path, new) in &paths {
         let exists = root.join(path).exists();
         if *new {
-            assert!(!exists, "{path} is marked (new) but exists: name another example");
+            assert!(
+                !exists,
+                "{path} is marked (new) but exists: name another example"
+            );
         } else {
-            assert!(exists, "docs/architecture.md names {path}, which does not exist");
+            assert!(
+                exists,
+                "docs/architecture.md names {path}, which does not exist"
+            );
         }
     }
     // Every layered module has its line in the page's table.
@@ -289,7 +299,11 @@ fn each_recipe_of_the_architecture_page_touches_at_most_three_files() {
         );
         for step in steps {
             let named = architecture_doc_paths(&step);
-            assert_eq!(named.len(), 1, "recipe {title}: each step changes one file: {step}");
+            assert_eq!(
+                named.len(),
+                1,
+                "recipe {title}: each step changes one file: {step}"
+            );
         }
     }
 }
