@@ -26,11 +26,11 @@ use super::microfacet::Ggx;
 use super::phong::Phong;
 use super::rough_conductor::RoughConductor;
 use super::rough_dielectric::RoughDielectric;
-use super::specular_conductor::SpecularConductor;
 use super::scattering::mean;
 pub use super::scattering::{
     BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction,
 };
+use super::specular_conductor::SpecularConductor;
 use super::specular_reflection::{SpecularReflection, mirror_above};
 
 /// Parts of the mixture (each a weight and its lobes).
@@ -167,7 +167,10 @@ impl std::fmt::Debug for Bsdf {
         }
         if let Some(c) = lobes().find_map(|l| match l {
             Lobe::SpecularConductor(s) => Some(s.fresnel),
-            Lobe::RoughConductor { lobe, tinted: false } => Some(lobe.fresnel),
+            Lobe::RoughConductor {
+                lobe,
+                tinted: false,
+            } => Some(lobe.fresnel),
             _ => None,
         }) {
             d.field("conductor", &c);

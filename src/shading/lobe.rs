@@ -110,10 +110,9 @@ impl Lobe {
             Lobe::Dielectric(d) => Prepared::Fresnel(d.split(wo, fr)),
             Lobe::SpecularConductor(s) => Prepared::Reflectance(s.albedo(wo, fr)),
             Lobe::RoughConductor { lobe, .. } => Prepared::Reflectance(lobe.albedo(wo, fr)),
-            Lobe::RoughDielectric(d) => Prepared::Reflectance(fresnel_dielectric(
-                wo.dot(fr.ns),
-                1.0 / d.eta(fr.entering),
-            )),
+            Lobe::RoughDielectric(d) => {
+                Prepared::Reflectance(fresnel_dielectric(wo.dot(fr.ns), 1.0 / d.eta(fr.entering)))
+            }
         }
     }
 
@@ -173,14 +172,7 @@ impl Lobe {
     /// `share` times the lobe's sampling density at `wi` (0 for delta lobes).
     #[inline]
     #[must_use]
-    pub fn scaled_pdf(
-        &self,
-        share: f32,
-        wo: Vec3,
-        wi: Vec3,
-        fr: &ShadingFrame,
-        tint: Vec3,
-    ) -> f32 {
+    pub fn scaled_pdf(&self, share: f32, wo: Vec3, wi: Vec3, fr: &ShadingFrame, tint: Vec3) -> f32 {
         match self {
             Lobe::Lambert(l) => l.scaled_pdf(share, wi, fr),
             Lobe::Phong(p) => p.scaled_pdf(share, wo, wi, fr),

@@ -6,7 +6,9 @@
 use glam::Vec3;
 
 use super::conductor::ConductorFresnel;
-use super::scattering::{BsdfSample, LobeFlags, ShadingFrame, TransportMode, mean, mode_correction};
+use super::scattering::{
+    BsdfSample, LobeFlags, ShadingFrame, TransportMode, mean, mode_correction,
+};
 use super::specular_reflection::mirror_above;
 
 /// A polished metal: the Fresnel reflectance of its perfect mirror.
