@@ -10,8 +10,13 @@ use glam::{Vec2, Vec3};
 use crate::render_scene::texture::{Mapping as RenderMapping, NoiseTexture};
 use crate::render_scene::{SurfaceMaterial, Texture};
 use crate::scene::Diagnostic;
-use crate::scene::schema::{ColorSpec, Mapping, SceneFile, TextureSpec};
+use crate::scene::schema::{
+    AbsorptionSpec, ColorSpec, ConductorSpec, Mapping, SceneFile, TextureSpec,
+};
 use crate::shading::Bsdf;
+use crate::shading::absorption::Absorption;
+use crate::shading::conductor::{ConductorFresnel, ConductorPreset};
+use crate::shading::microfacet::Ggx;
 use crate::texture::bitmap::read_colour_image;
 use crate::texture::{
     BitmapTexture, GreyMipMap, HeightMap, Marble, MipMap, Noise, Ripples, TextureError,
@@ -61,13 +66,48 @@ impl MaterialTable {
                 errors,
             )
         });
+        let [rx, ry] = m.roughness.pair();
+        // Perceptual roughness r to the GGX width α = r² (docs/material.md); 0 is smooth.
+        let distribution = (rx > 0.0 || ry > 0.0).then(|| Ggx::new(rx * rx, ry * ry));
+        let conductor = match &m.conductor {
+            None => None,
+            Some(ConductorSpec::Preset(p)) => {
+                let preset = ConductorPreset::from_name(p);
+                if preset.is_none() {
+                    errors.push(Diagnostic::error(
+                        format!("materials.{name}.conductor"),
+                        format!("unknown conductor `{p}`"),
+                    ));
+                }
+                preset.map(ConductorFresnel::preset)
+            }
+            Some(ConductorSpec::Tint(t)) => Some(ConductorFresnel::F82Tint {
+                f0: Vec3::from(t.f0),
+                tint: Vec3::from(t.tint),
+            }),
+        };
+        let absorption = match m.absorption {
+            None => Ok(Absorption::CLEAR),
+            Some(AbsorptionSpec::Coefficient(sigma)) => Absorption::from_coefficient(sigma),
+            Some(AbsorptionSpec::ColorAtDepth(c)) => {
+                Absorption::from_colour_at_depth(c.color, c.depth)
+            }
+        };
+        let absorption = absorption.unwrap_or_else(|e| {
+            errors.push(Diagnostic::error(
+                format!("materials.{name}.absorption"),
+                e.to_string(),
+            ));
+            Absorption::CLEAR
+        });
         let bsdf = Bsdf::new(
             color,
             Vec3::from(m.specular),
             m.shininess,
             [m.diffuse, m.reflect, m.transmit],
             m.ior,
-        );
+        )
+        .with_microfacets(distribution, conductor);
         let filtered = [color_texture, bump]
             .into_iter()
             .flatten()
@@ -80,6 +120,7 @@ impl MaterialTable {
                 color_texture,
                 bump,
                 filtered,
+                absorption,
             },
         ));
         self.index.insert(name.to_string(), i);
@@ -299,5 +340,16 @@ fn image_error_text(e: &TextureError) -> String {
         TextureError::Image(image::ImageError::IoError(io)) => io.to_string(),
         TextureError::Image(img) => img.to_string(),
         other => other.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scene::schema::CONDUCTOR_PRESETS;
+    use crate::shading::conductor::ConductorPreset;
+
+    #[test]
+    fn the_scene_format_names_the_same_conductor_presets_as_the_shading_table() {
+        assert_eq!(CONDUCTOR_PRESETS, ConductorPreset::NAMES);
     }
 }

@@ -12,7 +12,7 @@ use super::trace_log::{RayKind, ShadowRecord};
 use super::{LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Interaction, LightSampler, RenderScene, SurfacePoint};
+use crate::render_scene::{Interaction, LightSampler, Medium, RenderScene, SurfacePoint};
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
 /// Bounces after which Russian roulette may end a path.
@@ -116,6 +116,7 @@ impl<'a> PathTracer<'a> {
         let mut kind = RayKind::Camera;
         let mut parent: Option<usize> = None;
         let mut depth = 0u32;
+        let mut medium = Medium::OUTSIDE;
         // Debug logs only: each node holds the radiance gathered before it until the path ends.
         let mut root: Option<usize> = None;
         loop {
@@ -125,7 +126,10 @@ impl<'a> PathTracer<'a> {
                 cx.observer.set_radiance(node, l.total());
             }
             root = root.or(node);
-            let v = match scene.interact(&ray, |t| cone.width_at(&ray, t)) {
+            let it = scene.interact(&ray, |t| cone.width_at(&ray, t));
+            // Beer–Lambert absorption along the segment just travelled (1 outside media).
+            beta *= medium.transmittance(&ray, &it);
+            let v = match it {
                 Interaction::Escaped => {
                     let via = since_local.is_some_and(|n| n > 0);
                     l.add(
@@ -269,6 +273,7 @@ impl<'a> PathTracer<'a> {
                 (false, false) => RayKind::Scatter,
             };
             parent = node;
+            medium = medium.after(scene, &v, s.wi);
             let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
             ray = Ray::new(origin, s.wi);
         }

@@ -6,6 +6,7 @@ use glam::{Vec2, Vec3};
 use super::texture::Lookup;
 use super::{RenderScene, SurfacePoint, TextureFilter};
 use crate::geometry::Frame;
+use crate::shading::absorption::Absorption;
 use crate::shading::{Bsdf, usable_shading_normal};
 use crate::texture::Footprint;
 
@@ -13,9 +14,11 @@ use crate::texture::Footprint;
 /// elongation at 1000 : 1 instead of dividing by zero).
 const MIN_FOOTPRINT_COS: f32 = 1e-3;
 
-/// A material as compiled from the scene: the BSDF with constant parameters, and the textures
-/// that replace its colour and perturb its shading normal.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A material as compiled from the scene: the BSDF with constant parameters, the textures
+/// that replace its colour and perturb its shading normal, and the absorption of the medium it
+/// encloses. Its `Debug` text (read by the scene hash) names the absorption only when there is
+/// one, so clear materials hash as they always did.
+#[derive(Clone, Copy, PartialEq)]
 pub struct SurfaceMaterial {
     /// The BSDF; its `color` is used when `color_texture` is `None`.
     pub bsdf: Bsdf,
@@ -25,6 +28,23 @@ pub struct SurfaceMaterial {
     pub bump: Option<u32>,
     /// Some texture of this material is an image, so lookups need the pixel's footprint.
     pub filtered: bool,
+    /// Beer–Lambert absorption inside the object (the side its geometric normal points away
+    /// from), applied along path segments inside it ([`super::Medium`]).
+    pub absorption: Absorption,
+}
+
+impl std::fmt::Debug for SurfaceMaterial {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = f.debug_struct("SurfaceMaterial");
+        d.field("bsdf", &self.bsdf)
+            .field("color_texture", &self.color_texture)
+            .field("bump", &self.bump)
+            .field("filtered", &self.filtered);
+        if !self.absorption.is_clear() {
+            d.field("absorption", &self.absorption.sigma());
+        }
+        d.finish()
+    }
 }
 
 /// The BSDF and frame at one hit, as seen from the outgoing direction `wo`.

@@ -7,6 +7,7 @@ pub mod interaction;
 pub mod light;
 pub mod light_sampler;
 pub mod material;
+pub mod medium;
 pub mod surface;
 pub mod texture;
 
@@ -16,6 +17,7 @@ pub use interaction::{EmitterHit, Interaction, SurfaceHit};
 pub use light::{EmissionSample, Light, LightSample};
 pub use light_sampler::LightSampler;
 pub use material::{ShadingPoint, SurfaceMaterial};
+pub use medium::Medium;
 pub use surface::{SurfaceParams, SurfacePoint};
 pub use texture::Texture;
 

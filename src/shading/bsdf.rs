@@ -18,14 +18,19 @@
 
 use glam::Vec3;
 
+use super::conductor::ConductorFresnel;
 use super::dielectric::Dielectric;
 use super::lambert::Lambert;
 use super::lobe::{Lobe, Prepared};
+use super::microfacet::Ggx;
 use super::phong::Phong;
+use super::rough_conductor::RoughConductor;
+use super::rough_dielectric::RoughDielectric;
 use super::scattering::mean;
 pub use super::scattering::{
     BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction,
 };
+use super::specular_conductor::SpecularConductor;
 use super::specular_reflection::{SpecularReflection, mirror_above};
 
 /// Parts of the mixture (each a weight and its lobes).
@@ -65,6 +70,13 @@ impl Part {
     #[inline]
     fn flags(&self) -> LobeFlags {
         self.lobes().fold(LobeFlags::NONE, |f, l| f | l.flags())
+    }
+
+    /// Whether the part has a non-delta lobe that transmits (the rough dielectric), so that
+    /// directions below the surface have a value and a density.
+    #[inline]
+    fn transmits_glossy(&self) -> bool {
+        !self.is_delta() && self.flags().contains(LobeFlags::TRANSMISSION)
     }
 
     /// The per-direction state of the part's (first) lobe.
@@ -140,15 +152,30 @@ impl std::fmt::Debug for Bsdf {
             .unwrap_or((Vec3::ZERO, 1.0));
         let ior = lobes().find_map(Lobe::ior).unwrap_or(1.0);
         let [diffuse, reflect, transmit] = self.weights();
-        f.debug_struct("Bsdf")
-            .field("color", &self.tint)
+        let mut d = f.debug_struct("Bsdf");
+        d.field("color", &self.tint)
             .field("specular", &specular)
             .field("shininess", &shininess)
             .field("diffuse", &diffuse)
             .field("reflect", &reflect)
             .field("transmit", &transmit)
-            .field("ior", &ior)
-            .finish()
+            .field("ior", &ior);
+        // Only materials that use the microfacet lobes or a conductor say so, so the text (and
+        // the scene hash) of every other material is what it always was.
+        if let Some(g) = self.distribution() {
+            d.field("roughness_alpha", &(g.alpha_x, g.alpha_y));
+        }
+        if let Some(c) = lobes().find_map(|l| match l {
+            Lobe::SpecularConductor(s) => Some(s.fresnel),
+            Lobe::RoughConductor {
+                lobe,
+                tinted: false,
+            } => Some(lobe.fresnel),
+            _ => None,
+        }) {
+            d.field("conductor", &c);
+        }
+        d.finish()
     }
 }
 
@@ -211,6 +238,61 @@ impl Bsdf {
                 Part::new(w[2], Lobe::Dielectric(Dielectric { ior }), None),
             ],
         }
+    }
+
+    /// The same BSDF with rough or metallic delta parts: with a microfacet `distribution` the
+    /// mirror part becomes a GGX rough conductor ([`RoughConductor`]; with the conductor's
+    /// Fresnel, else Fresnel 1 tinted by the colour, the rough counterpart of the mirror) and the
+    /// dielectric part a GGX rough dielectric ([`RoughDielectric`], except at `ior == 1`, which
+    /// bends nothing and stays the smooth pass-through); without one, a `conductor` makes the
+    /// mirror a polished metal ([`SpecularConductor`]). `(None, None)` changes nothing: the
+    /// perfect mirror and the smooth dielectric, bit for bit.
+    #[must_use]
+    pub fn with_microfacets(
+        mut self,
+        distribution: Option<Ggx>,
+        conductor: Option<ConductorFresnel>,
+    ) -> Self {
+        let mirror = match (distribution, conductor) {
+            (None, None) => None,
+            (None, Some(fresnel)) => Some(Lobe::SpecularConductor(SpecularConductor { fresnel })),
+            (Some(g), c) => Some(Lobe::RoughConductor {
+                lobe: RoughConductor {
+                    distribution: g,
+                    fresnel: c.unwrap_or(ConductorFresnel::schlick(Vec3::ONE)),
+                },
+                tinted: c.is_none(),
+            }),
+        };
+        if let Some(m) = mirror {
+            self.parts[1].lobes = [Some(m), None];
+        }
+        if let Some(g) = distribution {
+            let ior = self.parts[2].lobes().find_map(Lobe::ior).unwrap_or(1.0);
+            if ior != 1.0 {
+                self.parts[2].lobes = [
+                    Some(Lobe::RoughDielectric(RoughDielectric {
+                        distribution: g,
+                        ior,
+                    })),
+                    None,
+                ];
+            }
+        }
+        self
+    }
+
+    /// The microfacet distribution of the rough parts, if any.
+    #[must_use]
+    pub fn distribution(&self) -> Option<Ggx> {
+        self.parts
+            .iter()
+            .flat_map(Part::lobes)
+            .find_map(|l| match l {
+                Lobe::RoughConductor { lobe, .. } => Some(lobe.distribution),
+                Lobe::RoughDielectric(d) => Some(d.distribution),
+                _ => None,
+            })
     }
 
     /// The tint: the diffuse albedo, which also tints the mirror and the transmitted light.
@@ -299,21 +381,45 @@ impl Bsdf {
     /// `wo`: each non-delta part's weight times the sum of its lobes (here
     /// `diffuse · (ρ/π + k_s (m+2)/(2π) max(0, r·wi)^m)`, `r` the mirror of `wo`). Zero when
     /// `wi` is below `n`. Symmetric in `wo` and `wi` (reciprocal).
+    ///
+    /// The frame is taken as `ns = ng = n` seen from outside, in radiance mode; [`Bsdf::eval`]
+    /// is the full form.
     #[inline]
     #[must_use]
     pub fn f(&self, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
+        let fr = ShadingFrame {
+            ns: n,
+            ng: n,
+            entering: true,
+        };
+        self.f_in(wo, wi, &fr, TransportMode::Radiance)
+    }
+
+    /// The non-delta parts' value in frame `fr` and mode `mode`: reflecting parts only for `wi`
+    /// above the geometric surface, transmitting (rough dielectric) parts on either side.
+    #[inline]
+    fn f_in(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, mode: TransportMode) -> Vec3 {
+        let below = fr.ng.dot(wi) <= 0.0;
         let mut f = Vec3::ZERO;
         for part in &self.parts {
-            if part.weight == 0.0 || part.is_delta() {
+            if part.weight == 0.0 || part.is_delta() || (below && !part.transmits_glossy()) {
                 continue;
             }
             let mut fp = Vec3::ZERO;
             for lobe in part.lobes() {
-                fp += lobe.f(wo, wi, n, self.tint);
+                fp += lobe.f(wo, wi, fr, mode, self.tint);
             }
             f += fp * part.weight;
         }
         f
+    }
+
+    /// True if a part of non-zero weight transmits through a non-delta lobe.
+    #[inline]
+    fn transmits_glossy(&self) -> bool {
+        self.parts
+            .iter()
+            .any(|p| p.weight > 0.0 && p.transmits_glossy())
     }
 
     /// The non-delta BSDF value in frame `fr`, for `wi` above both the shading and the geometric
@@ -323,10 +429,10 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn eval(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, mode: TransportMode) -> Vec3 {
-        if fr.ng.dot(wi) <= 0.0 {
+        if fr.ng.dot(wi) <= 0.0 && !self.transmits_glossy() {
             return Vec3::ZERO;
         }
-        let f = self.f(wo, wi, fr.ns);
+        let f = self.f_in(wo, wi, fr, mode);
         match mode {
             TransportMode::Radiance => f,
             TransportMode::Importance => f * shading_normal_correction(wo, wi, fr),
@@ -408,14 +514,16 @@ impl Bsdf {
         wi: Vec3,
         fr: &ShadingFrame,
     ) -> f32 {
-        if prob == 0.0 || fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0 {
+        if prob == 0.0
+            || ((fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0) && !part.transmits_glossy())
+        {
             return 0.0;
         }
         let shares = part.shares(prepared, rho);
         let mut d = 0.0f32;
         for (lobe, &share) in part.lobes().zip(&shares) {
             if share > 0.0 {
-                d += lobe.scaled_pdf(share, wo, wi, fr);
+                d += lobe.scaled_pdf(share, wo, wi, fr, self.tint);
             }
         }
         prob * d
@@ -500,26 +608,42 @@ impl Bsdf {
         let shares = part.shares(&c.prepared[i], rho);
         let mut lobe = None;
         let mut cum = 0.0f32;
+        let mut rest = v;
         for (l, &share) in part.lobes().zip(&shares) {
             lobe = Some(l);
+            rest = if share > 0.0 { (v - cum) / share } else { 0.0 };
             if v < cum + share {
                 break;
             }
             cum += share;
         }
-        let wi = lobe?.sample_direction(wo, u, fr)?;
+        let lobe = lobe?;
+        let rest = if lobe.uses_lobe_number() {
+            rest.clamp(0.0, 1.0 - f32::EPSILON)
+        } else {
+            0.0
+        };
+        let wi = lobe.sample_direction(wo, rest, u, fr, self.tint)?;
         let pdf = self.mixture_pdf(&c, rho, wo, wi, fr);
         let f = self.eval(wo, wi, fr, mode);
         if !(pdf > 0.0) || f == Vec3::ZERO {
             return None;
         }
+        let transmitted = fr.ng.dot(wi) < 0.0;
+        // A glossy refraction in radiance mode carries (ηₒ/ηᵢ)² = 1/η² in `f` (Walter 2007,
+        // eq. 21), reported for Russian roulette as the smooth dielectric reports its own.
+        let mut eta_scale = 1.0;
+        if let (true, TransportMode::Radiance, Some(ior)) = (transmitted, mode, lobe.ior()) {
+            let eta = if fr.entering { ior } else { 1.0 / ior };
+            eta_scale = 1.0 / (eta * eta);
+        }
         Some(BsdfSample {
             wi,
-            weight: f * (fr.ns.dot(wi) / pdf),
+            weight: f * (fr.ns.dot(wi).abs() / pdf),
             pdf,
             delta: false,
-            transmitted: false,
-            eta_scale: 1.0,
+            transmitted,
+            eta_scale,
         })
     }
 

@@ -7,9 +7,14 @@ use glam::Vec3;
 
 use super::dielectric::{DeltaWeights, Dielectric, FresnelSplit};
 use super::lambert::Lambert;
+use super::optics::fresnel_dielectric;
 use super::phong::Phong;
+use super::rough_conductor::RoughConductor;
+use super::rough_dielectric::RoughDielectric;
 use super::scattering::{BsdfSample, LobeFlags, ShadingFrame, TransportMode};
+use super::specular_conductor::SpecularConductor;
 use super::specular_reflection::SpecularReflection;
+use crate::geometry::Frame;
 
 /// One lobe of the mixture. Lobes tinted by the material's colour (Lambert's albedo, the mirror's
 /// reflectance, the dielectric's transmittance) take it as the `tint` argument, so a colour
@@ -22,18 +27,33 @@ pub enum Lobe {
     Phong(Phong),
     /// Perfect mirror.
     SpecularReflection(SpecularReflection),
+    /// Perfect mirror with a conductor's Fresnel reflectance (a polished metal).
+    SpecularConductor(SpecularConductor),
     /// Smooth Fresnel dielectric.
     Dielectric(Dielectric),
+    /// GGX microfacet metal ([`RoughConductor`]).
+    RoughConductor {
+        /// The microfacet lobe.
+        lobe: RoughConductor,
+        /// Multiply by the tint (a rough mirror without a conductor: its Fresnel is 1 and the
+        /// material's colour is its reflectance, as for the perfect mirror).
+        tinted: bool,
+    },
+    /// GGX microfacet dielectric ([`RoughDielectric`]): glossy reflection and transmission.
+    RoughDielectric(RoughDielectric),
 }
 
 /// What a lobe works out once per outgoing direction and reuses while the mixture weighs and
-/// samples it: the dielectric's Fresnel split; nothing for the others.
+/// samples it: the dielectric's Fresnel split, the mean macro-surface reflectance of the metals
+/// and the rough dielectric; nothing for the others.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Prepared {
     /// The lobe needs nothing.
     Nothing,
     /// The dielectric's split.
     Fresnel(FresnelSplit),
+    /// The mean Fresnel reflectance at the macro-surface normal.
+    Reflectance(f32),
 }
 
 impl Lobe {
@@ -45,7 +65,12 @@ impl Lobe {
             Lobe::Lambert(_) => Lambert::FLAGS,
             Lobe::Phong(_) => Phong::FLAGS,
             Lobe::SpecularReflection(_) => SpecularReflection::FLAGS,
+            Lobe::SpecularConductor(_) => SpecularConductor::FLAGS,
             Lobe::Dielectric(_) => Dielectric::FLAGS,
+            Lobe::RoughConductor { .. } => LobeFlags::GLOSSY.union(LobeFlags::REFLECTION),
+            Lobe::RoughDielectric(_) => LobeFlags::GLOSSY
+                .union(LobeFlags::REFLECTION)
+                .union(LobeFlags::TRANSMISSION),
         }
     }
 
@@ -56,18 +81,23 @@ impl Lobe {
         match self {
             Lobe::Lambert(_) | Lobe::SpecularReflection(_) => tint == Vec3::ZERO,
             Lobe::Phong(p) => p.specular == Vec3::ZERO,
-            Lobe::Dielectric(_) => false,
+            Lobe::RoughConductor { tinted, .. } => *tinted && tint == Vec3::ZERO,
+            Lobe::SpecularConductor(_) | Lobe::Dielectric(_) | Lobe::RoughDielectric(_) => false,
         }
     }
 
-    /// True if the lobe's own sampling reads the lobe number (the dielectric chooses between
+    /// True if the lobe's own sampling reads the lobe number (the dielectrics choose between
     /// reflection and refraction with it).
     #[inline]
     #[must_use]
     pub fn uses_lobe_number(&self) -> bool {
         match self {
-            Lobe::Lambert(_) | Lobe::Phong(_) | Lobe::SpecularReflection(_) => false,
-            Lobe::Dielectric(_) => true,
+            Lobe::Lambert(_)
+            | Lobe::Phong(_)
+            | Lobe::SpecularReflection(_)
+            | Lobe::SpecularConductor(_)
+            | Lobe::RoughConductor { .. } => false,
+            Lobe::Dielectric(_) | Lobe::RoughDielectric(_) => true,
         }
     }
 
@@ -78,6 +108,11 @@ impl Lobe {
         match self {
             Lobe::Lambert(_) | Lobe::Phong(_) | Lobe::SpecularReflection(_) => Prepared::Nothing,
             Lobe::Dielectric(d) => Prepared::Fresnel(d.split(wo, fr)),
+            Lobe::SpecularConductor(s) => Prepared::Reflectance(s.albedo(wo, fr)),
+            Lobe::RoughConductor { lobe, .. } => Prepared::Reflectance(lobe.albedo(wo, fr)),
+            Lobe::RoughDielectric(d) => {
+                Prepared::Reflectance(fresnel_dielectric(wo.dot(fr.ns), 1.0 / d.eta(fr.entering)))
+            }
         }
     }
 
@@ -90,43 +125,100 @@ impl Lobe {
             (Lobe::Lambert(_) | Lobe::SpecularReflection(_), _) => rho,
             (Lobe::Phong(p), _) => p.albedo(),
             (Lobe::Dielectric(d), Prepared::Fresnel(s)) => d.albedo(s, rho),
-            (Lobe::Dielectric(_), Prepared::Nothing) => 0.0,
+            (Lobe::Dielectric(_), Prepared::Nothing | Prepared::Reflectance(_)) => 0.0,
+            (Lobe::SpecularConductor(_), Prepared::Reflectance(r)) => *r,
+            (Lobe::RoughConductor { tinted, .. }, Prepared::Reflectance(r)) => {
+                if *tinted {
+                    r * rho
+                } else {
+                    *r
+                }
+            }
+            (Lobe::RoughDielectric(_), Prepared::Reflectance(f)) => f + (1.0 - f) * rho,
+            (
+                Lobe::SpecularConductor(_) | Lobe::RoughConductor { .. } | Lobe::RoughDielectric(_),
+                Prepared::Nothing | Prepared::Fresnel(_),
+            ) => 0.0,
         }
     }
 
-    /// The lobe's value `f(wo, wi)` (per steradian) with shading normal `n`: 0 for delta lobes.
+    /// The lobe's value `f(wo, wi)` (per steradian) in frame `fr` and transport mode `mode`
+    /// (only the rough dielectric's transmission depends on it: η² in importance mode): 0 for
+    /// delta lobes.
     #[inline]
     #[must_use]
-    pub fn f(&self, wo: Vec3, wi: Vec3, n: Vec3, tint: Vec3) -> Vec3 {
+    pub fn f(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        fr: &ShadingFrame,
+        mode: TransportMode,
+        tint: Vec3,
+    ) -> Vec3 {
         match self {
-            Lobe::Lambert(l) => l.f(tint, wi, n),
-            Lobe::Phong(p) => p.f(wo, wi, n),
+            Lobe::Lambert(l) => l.f(tint, wi, fr.ns),
+            Lobe::Phong(p) => p.f(wo, wi, fr.ns),
             Lobe::SpecularReflection(s) => s.f(),
             Lobe::Dielectric(d) => d.f(),
+            Lobe::SpecularConductor(_) => Vec3::ZERO,
+            Lobe::RoughConductor { lobe, tinted } => {
+                let f = lobe.f(wo, wi, fr);
+                if *tinted { f * tint } else { f }
+            }
+            Lobe::RoughDielectric(d) => d.f(wo, wi, fr, mode, tint),
         }
     }
 
     /// `share` times the lobe's sampling density at `wi` (0 for delta lobes).
     #[inline]
     #[must_use]
-    pub fn scaled_pdf(&self, share: f32, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
+    pub fn scaled_pdf(&self, share: f32, wo: Vec3, wi: Vec3, fr: &ShadingFrame, tint: Vec3) -> f32 {
         match self {
             Lobe::Lambert(l) => l.scaled_pdf(share, wi, fr),
             Lobe::Phong(p) => p.scaled_pdf(share, wo, wi, fr),
             Lobe::SpecularReflection(s) => share * s.pdf(),
             Lobe::Dielectric(d) => share * d.pdf(),
+            Lobe::SpecularConductor(_) => 0.0,
+            Lobe::RoughConductor { lobe, .. } => share * lobe.pdf(wo, wi, fr),
+            Lobe::RoughDielectric(d) => share * d.pdf(wo, wi, fr, tint),
         }
     }
 
     /// A direction from a non-delta lobe's density (`None` for delta lobes, which the mixture
-    /// samples through [`Lobe::sample_delta`]).
+    /// samples through [`Lobe::sample_delta`], and when the sample is lost below the surface);
+    /// `v ∈ [0, 1)` is the rest of the lobe number (the rough dielectric's choice of reflection
+    /// or refraction).
     #[inline]
     #[must_use]
-    pub fn sample_direction(&self, wo: Vec3, u: (f32, f32), fr: &ShadingFrame) -> Option<Vec3> {
+    pub fn sample_direction(
+        &self,
+        wo: Vec3,
+        v: f32,
+        u: (f32, f32),
+        fr: &ShadingFrame,
+        tint: Vec3,
+    ) -> Option<Vec3> {
         match self {
             Lobe::Lambert(l) => Some(l.sample(u, fr)),
             Lobe::Phong(p) => Some(p.sample(wo, u, fr)),
-            Lobe::SpecularReflection(_) | Lobe::Dielectric(_) => None,
+            Lobe::SpecularReflection(_) | Lobe::SpecularConductor(_) | Lobe::Dielectric(_) => None,
+            Lobe::RoughConductor { lobe, .. } => {
+                let frame = Frame::from_normal(fr.ns);
+                let li = lobe.sample_local(frame.to_local(wo), u)?;
+                Some(frame.to_world(li))
+            }
+            Lobe::RoughDielectric(d) => {
+                let frame = Frame::from_normal(fr.ns);
+                let s = d.sample_local(
+                    frame.to_local(wo),
+                    v,
+                    u,
+                    fr.entering,
+                    TransportMode::Radiance,
+                    tint,
+                )?;
+                Some(frame.to_world(s.wi))
+            }
         }
     }
 
@@ -148,12 +240,19 @@ impl Lobe {
         rho: f32,
     ) -> Option<BsdfSample> {
         match (self, prepared) {
-            (Lobe::Lambert(_) | Lobe::Phong(_), _) => None,
+            (
+                Lobe::Lambert(_)
+                | Lobe::Phong(_)
+                | Lobe::RoughConductor { .. }
+                | Lobe::RoughDielectric(_),
+                _,
+            ) => None,
             (Lobe::SpecularReflection(s), _) => s.sample(wo, fr, mode, weight, prob, tint),
+            (Lobe::SpecularConductor(s), _) => s.sample(wo, fr, mode, weight, prob),
             (Lobe::Dielectric(d), Prepared::Fresnel(split)) => {
                 d.sample(split, wo, v, fr, mode, weight, prob, tint, rho)
             }
-            (Lobe::Dielectric(d), Prepared::Nothing) => {
+            (Lobe::Dielectric(d), Prepared::Nothing | Prepared::Reflectance(_)) => {
                 d.sample(&d.split(wo, fr), wo, v, fr, mode, weight, prob, tint, rho)
             }
         }
@@ -171,7 +270,10 @@ impl Lobe {
         tint: Vec3,
     ) -> DeltaWeights {
         match self {
-            Lobe::Lambert(_) | Lobe::Phong(_) => DeltaWeights {
+            Lobe::Lambert(_)
+            | Lobe::Phong(_)
+            | Lobe::RoughConductor { .. }
+            | Lobe::RoughDielectric(_) => DeltaWeights {
                 reflect: Vec3::ZERO,
                 refract: None,
             },
@@ -179,11 +281,17 @@ impl Lobe {
                 reflect: tint * weight,
                 refract: None,
             },
+            Lobe::SpecularConductor(s) => DeltaWeights {
+                reflect: s.reflectance(wo, fr) * weight,
+                refract: None,
+            },
             Lobe::Dielectric(d) => d.delta_weights(&d.split(wo, fr), weight, tint),
         }
     }
 
-    /// The straight-line transmittance of a part of weight `weight` (0 unless it transmits).
+    /// The straight-line transmittance of a part of weight `weight` (0 unless it transmits);
+    /// a rough dielectric is treated as its smooth counterpart (its Fresnel at the
+    /// macro-surface), for integrators that do not follow refraction.
     #[inline]
     #[must_use]
     pub fn straight_transmittance(
@@ -194,8 +302,15 @@ impl Lobe {
         entering: bool,
     ) -> Vec3 {
         match self {
-            Lobe::Lambert(_) | Lobe::Phong(_) | Lobe::SpecularReflection(_) => Vec3::ZERO,
+            Lobe::Lambert(_)
+            | Lobe::Phong(_)
+            | Lobe::SpecularReflection(_)
+            | Lobe::SpecularConductor(_)
+            | Lobe::RoughConductor { .. } => Vec3::ZERO,
             Lobe::Dielectric(d) => d.straight_transmittance(weight, tint, cos, entering),
+            Lobe::RoughDielectric(r) => {
+                Dielectric { ior: r.ior }.straight_transmittance(weight, tint, cos, entering)
+            }
         }
     }
 
@@ -204,8 +319,13 @@ impl Lobe {
     #[must_use]
     pub fn ior(&self) -> Option<f32> {
         match self {
-            Lobe::Lambert(_) | Lobe::Phong(_) | Lobe::SpecularReflection(_) => None,
+            Lobe::Lambert(_)
+            | Lobe::Phong(_)
+            | Lobe::SpecularReflection(_)
+            | Lobe::SpecularConductor(_)
+            | Lobe::RoughConductor { .. } => None,
             Lobe::Dielectric(d) => Some(d.ior),
+            Lobe::RoughDielectric(r) => Some(r.ior),
         }
     }
 }

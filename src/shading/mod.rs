@@ -14,6 +14,7 @@ pub mod phong;
 pub mod rough_conductor;
 pub mod rough_dielectric;
 pub mod scattering;
+pub mod specular_conductor;
 pub mod specular_reflection;
 
 pub use bsdf::{Bsdf, DeltaLobes};

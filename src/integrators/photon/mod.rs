@@ -35,7 +35,7 @@ use super::trace_log::RayKind;
 use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Interaction, LightSampler, RenderScene, SurfacePoint};
+use crate::render_scene::{Interaction, LightSampler, Medium, RenderScene, SurfacePoint};
 use crate::sampling::Sampler;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
@@ -64,6 +64,8 @@ struct Branch {
     cone: RayCone,
     kind: RayKind,
     parent: Option<usize>,
+    /// The absorbing medium the branch's ray travels in.
+    medium: Medium,
 }
 
 impl Default for Branch {
@@ -76,6 +78,7 @@ impl Default for Branch {
             cone: RayCone::camera(0.0),
             kind: RayKind::Camera,
             parent: None,
+            medium: Medium::OUTSIDE,
         }
     }
 }
@@ -159,6 +162,7 @@ impl<'a> PhotonMapper<'a> {
             cone: RayCone::camera(self.pixel_spread),
             kind: RayKind::Camera,
             parent: None,
+            medium: Medium::OUTSIDE,
         };
         let mut len = 1;
         let root = cx.observer.next_node();
@@ -169,7 +173,10 @@ impl<'a> PhotonMapper<'a> {
             cx.counters.rays += 1;
             let node = cx.observer.ray(depth, b.kind, &ray, beta, b.parent);
             let mut gathered = Vec3::ZERO;
-            let v = match scene.interact(&ray, |t| b.cone.width_at(&ray, t)) {
+            let it = scene.interact(&ray, |t| b.cone.width_at(&ray, t));
+            // Beer–Lambert absorption along the segment just travelled (1 outside media).
+            let beta = beta * b.medium.transmittance(&ray, &it);
+            let v = match it {
                 Interaction::Escaped => {
                     gathered = beta * params.background;
                     l.add(LightPath::Specular, gathered);
@@ -242,6 +249,7 @@ impl<'a> PhotonMapper<'a> {
                         RayKind::Reflect
                     },
                     parent: node,
+                    medium: b.medium.after(scene, &v, dir),
                 };
                 len += 1;
             };

@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Interaction, RenderScene};
+use crate::render_scene::{Interaction, Medium, RenderScene};
 use crate::sampling::Sampler;
 use crate::shading::TransportMode;
 use crate::spatial::Photon;
@@ -92,8 +92,12 @@ pub fn trace_photon(
     let max_flux = power.max_element() * MAX_FLUX_GROWTH;
     let mut diffuse_bounces = 0u32;
     let mut bounces = 0u32;
+    let mut medium = Medium::OUTSIDE;
     loop {
-        let v = match scene.interact(&ray, |_| 0.0) {
+        let it = scene.interact(&ray, |_| 0.0);
+        // Beer–Lambert absorption along the segment just travelled (1 outside media).
+        power *= medium.transmittance(&ray, &it);
+        let v = match it {
             Interaction::Surface(v) => v,
             // Escaped, or an emitter: it absorbs what reaches it.
             Interaction::Escaped | Interaction::Emitter(_) => return,
@@ -149,6 +153,7 @@ pub fn trace_photon(
             counts.lost_flux += power;
             return;
         }
+        medium = medium.after(scene, &v, s.wi);
         let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
         ray = Ray::new(origin, s.wi);
     }

@@ -38,6 +38,96 @@ pub struct MaterialSpec {
     /// marble with a `depth`).
     #[serde(default)]
     pub bump: Option<String>,
+    /// Microfacet roughness of the mirror and dielectric parts, in [0, 1]: `r`, or `(r_x, r_y)`
+    /// along the shading frame's two tangents (anisotropic). GGX with α = r² (docs/material.md).
+    /// 0 (the default) is the perfect mirror and the smooth dielectric.
+    #[serde(default)]
+    pub roughness: RoughnessSpec,
+    /// Makes the mirror part a metal: a preset name (`"chrome"`, `"aluminium"`, `"gold"`,
+    /// `"copper"`, `"silver"`: measured complex indices) or an artist's colours
+    /// `(f0: (r, g, b), tint: (r, g, b))` (F82-tint; `tint` defaults to white, Schlick). The
+    /// metal's colour is its Fresnel reflectance: `color` does not tint it.
+    #[serde(default)]
+    pub conductor: Option<ConductorSpec>,
+    /// Beer–Lambert absorption inside the dielectric part (water, coloured glass): the
+    /// coefficient per metre `(σ_r, σ_g, σ_b)`, or the colour left after a depth
+    /// `(color: (r, g, b), depth: d)` with colour in (0, 1] and `d` in metres.
+    #[serde(default)]
+    pub absorption: Option<AbsorptionSpec>,
+}
+
+/// A microfacet roughness: isotropic, or one value per tangent axis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum RoughnessSpec {
+    /// The same roughness in every direction, in [0, 1].
+    Isotropic(f32),
+    /// Roughness along the first and the second tangent, each in [0, 1].
+    Anisotropic([f32; 2]),
+}
+
+impl Default for RoughnessSpec {
+    fn default() -> Self {
+        RoughnessSpec::Isotropic(0.0)
+    }
+}
+
+impl RoughnessSpec {
+    /// The roughness per tangent axis.
+    #[must_use]
+    pub fn pair(&self) -> [f32; 2] {
+        match *self {
+            RoughnessSpec::Isotropic(r) => [r, r],
+            RoughnessSpec::Anisotropic(p) => p,
+        }
+    }
+}
+
+/// The conductor presets' names (the order and spelling of `shading::conductor::ConductorPreset`,
+/// which a compile test checks).
+pub const CONDUCTOR_PRESETS: [&str; 5] = ["chrome", "aluminium", "gold", "copper", "silver"];
+
+/// A metal's Fresnel reflectance: a named preset or an artist's colours.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum ConductorSpec {
+    /// A measured metal: `"chrome"`, `"aluminium"`, `"gold"`, `"copper"` or `"silver"`.
+    Preset(String),
+    /// The F82-tint model's colours.
+    Tint(ConductorTint),
+}
+
+/// The artist's F82-tint conductor (Hoffman 2023): reflectance at normal incidence and its
+/// tint near grazing incidence.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConductorTint {
+    /// Reflectance at normal incidence, linear RGB in [0, 1].
+    pub f0: Rgb,
+    /// Multiplier of Schlick's reflectance at about 82°, linear RGB in [0, 1] (white:
+    /// Schlick's approximation).
+    #[serde(default = "white")]
+    pub tint: Rgb,
+}
+
+/// Absorption inside a dielectric, as given: one of two equivalent forms (one σ is stored).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum AbsorptionSpec {
+    /// The absorption coefficient σ per metre, per channel, ≥ 0.
+    Coefficient(Rgb),
+    /// The colour light keeps after travelling `depth` metres: σ = −ln(color)/depth.
+    ColorAtDepth(ColorAtDepth),
+}
+
+/// The colour reached at a depth (an easier way to give absorption).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ColorAtDepth {
+    /// The fraction of light left per channel, in (0, 1].
+    pub color: Rgb,
+    /// The depth at which it is left, in metres (> 0).
+    pub depth: f32,
 }
 
 fn default_color() -> ColorSpec {

@@ -17,7 +17,10 @@ mod node;
 mod values;
 
 pub use light::LightSpec;
-pub use material::{ColorSpec, Mapping, MaterialSpec, TextureSpec};
+pub use material::{
+    AbsorptionSpec, CONDUCTOR_PRESETS, ColorAtDepth, ColorSpec, ConductorSpec, ConductorTint,
+    Mapping, MaterialSpec, RoughnessSpec, TextureSpec,
+};
 pub use node::{NodeSpec, TransformStep};
 pub use values::ScaleSpec;
 use values::{exact_floats, unique_keys};

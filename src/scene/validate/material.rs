@@ -1,6 +1,7 @@
 //! Checks of materials and textures, and of the textures a material names.
 
 use super::*;
+use crate::scene::schema::{AbsorptionSpec, CONDUCTOR_PRESETS, ConductorSpec, RoughnessSpec};
 
 impl<'a> Validator<'a> {
     pub(super) fn material(&mut self, path: &str, m: &'a MaterialSpec) {
@@ -61,6 +62,7 @@ impl<'a> Validator<'a> {
                 .with_help("typical values: 1.0 air, 1.33 water, 1.5 glass, 2.42 diamond"),
             );
         }
+        self.microfacets(path, m);
         let Some(color) = color else { return };
         let gains = (0..3).any(|i| color[i] + m.specular[i] > 1.0 + 1e-6);
         if m.diffuse.unwrap_or(if any_given { 0.0 } else { 1.0 }) > 0.0
@@ -70,6 +72,92 @@ impl<'a> Validator<'a> {
             self.out.push(Diagnostic::warning(
                 format!("{path}.specular"),
                 format!("color + specular exceeds 1 ({} + {}), so the surface reflects more light than it receives", fmt3(color), fmt3(m.specular)),
+            ));
+        }
+    }
+
+    /// Roughness in [0, 1], a known conductor or tint colours in [0, 1], and a valid
+    /// absorption (the rules of `shading::absorption`, whose error text is reported).
+    fn microfacets(&mut self, path: &str, m: &MaterialSpec) {
+        let rough = match m.roughness {
+            RoughnessSpec::Isotropic(r) => vec![(format!("{path}.roughness"), r)],
+            RoughnessSpec::Anisotropic([x, y]) => vec![
+                (format!("{path}.roughness[0]"), x),
+                (format!("{path}.roughness[1]"), y),
+            ],
+        };
+        for (p, r) in rough {
+            if self.finite(&p, r) && !(0.0..=1.0).contains(&r) {
+                self.out.push(
+                    Diagnostic::error(&p, format!("roughness must be in [0, 1], found {r}"))
+                        .with_help("0 is a perfect mirror or smooth glass, 0.1 polished, 0.3 brushed or frosted, 1 very rough; the GGX width is α = roughness²"),
+                );
+            }
+        }
+        match &m.conductor {
+            None => {}
+            Some(ConductorSpec::Preset(name)) => {
+                if !CONDUCTOR_PRESETS.contains(&name.as_str()) {
+                    let p = format!("{path}.conductor");
+                    let mut d = Diagnostic::error(
+                        &p,
+                        format!(
+                            "unknown conductor `{name}`; the presets are {}",
+                            quoted_list(CONDUCTOR_PRESETS)
+                        ),
+                    );
+                    d = match did_you_mean(name, CONDUCTOR_PRESETS) {
+                        Some(s) => d.with_help(format!("did you mean `{s}`?")),
+                        None => d.with_help("or give an artist's colours: `conductor: (f0: (r, g, b), tint: (r, g, b))`"),
+                    };
+                    self.out.push(d);
+                }
+            }
+            Some(ConductorSpec::Tint(t)) => {
+                self.unit_rgb(&format!("{path}.conductor.f0"), t.f0, "f0");
+                self.unit_rgb(&format!("{path}.conductor.tint"), t.tint, "tint");
+            }
+        }
+        let Some(a) = &m.absorption else { return };
+        let p = format!("{path}.absorption");
+        let help = "give `absorption: (σr, σg, σb)` per metre, or `absorption: (color: (r, g, b), depth: d)`: the colour left after d metres";
+        let before = self.out.len();
+        match a {
+            AbsorptionSpec::Coefficient(sigma) => {
+                if self.finite3(&p, *sigma) && sigma.iter().any(|s| *s < 0.0) {
+                    self.out.push(
+                        Diagnostic::error(
+                            &p,
+                            format!(
+                                "absorption coefficients must be ≥ 0 per metre, found {}",
+                                fmt3(*sigma)
+                            ),
+                        )
+                        .with_help(help),
+                    );
+                }
+            }
+            AbsorptionSpec::ColorAtDepth(c) => {
+                let pc = format!("{p}.color");
+                if self.finite3(&pc, c.color) && c.color.iter().any(|x| !(*x > 0.0 && *x <= 1.0)) {
+                    self.out.push(
+                        Diagnostic::error(
+                            &pc,
+                            format!(
+                                "the colour left at the depth must be in (0, 1] per channel, found {}",
+                                fmt3(c.color)
+                            ),
+                        )
+                        .with_help(help),
+                    );
+                }
+                self.positive(&format!("{p}.depth"), c.depth, "the depth");
+            }
+        }
+        if self.out.len() == before && m.transmit.is_none_or(|w| w <= 0.0) {
+            self.out.push(Diagnostic::warning(
+                &p,
+                "absorption acts inside the dielectric part, but `transmit` is 0, so no light enters",
             ));
         }
     }

@@ -1,0 +1,97 @@
+//! The smooth metal: a delta lobe reflecting `wo` about the shading normal with a conductor's
+//! Fresnel reflectance `F(cos θ)` ([`super::conductor`]): what a rough conductor becomes at
+//! roughness 0 (the limit of the GGX lobe as α → 0 is a mirror weighted by `F`; Walter et al.
+//! 2007, §5). The material's colour does not tint it: a metal's colour is its Fresnel.
+
+use glam::Vec3;
+
+use super::conductor::ConductorFresnel;
+use super::scattering::{
+    BsdfSample, LobeFlags, ShadingFrame, TransportMode, mean, mode_correction,
+};
+use super::specular_reflection::mirror_above;
+
+/// A polished metal: the Fresnel reflectance of its perfect mirror.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpecularConductor {
+    /// Reflectance at the incidence cosine `|wo·ns|`.
+    pub fresnel: ConductorFresnel,
+}
+
+impl SpecularConductor {
+    /// Delta reflection.
+    pub const FLAGS: LobeFlags = LobeFlags::DELTA.union(LobeFlags::REFLECTION);
+
+    /// The reflectance `F(|wo·ns|)` per channel.
+    #[inline]
+    #[must_use]
+    pub fn reflectance(&self, wo: Vec3, fr: &ShadingFrame) -> Vec3 {
+        self.fresnel.eval(wo.dot(fr.ns).abs())
+    }
+
+    /// The lobe's sampling weight: the mean reflectance at `wo`.
+    #[inline]
+    #[must_use]
+    pub fn albedo(&self, wo: Vec3, fr: &ShadingFrame) -> f32 {
+        mean(self.reflectance(wo, fr))
+    }
+
+    /// The mirror direction, chosen by the mixture with probability `prob` for a part of
+    /// weight `weight`: weight `F · weight / prob` (times the adjoint correction in importance
+    /// mode), `pdf = prob`. `None` when `prob` is 0.
+    #[inline]
+    #[must_use]
+    pub fn sample(
+        &self,
+        wo: Vec3,
+        fr: &ShadingFrame,
+        mode: TransportMode,
+        weight: f32,
+        prob: f32,
+    ) -> Option<BsdfSample> {
+        if prob == 0.0 {
+            return None;
+        }
+        let wi = mirror_above(wo, fr.ns, fr.ng);
+        Some(BsdfSample {
+            wi,
+            weight: self.reflectance(wo, fr) * (weight / prob * mode_correction(mode, wo, wi, fr)),
+            pdf: prob,
+            delta: true,
+            transmitted: false,
+            eta_scale: 1.0,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shading::conductor::{ConductorPreset, fresnel_conductor};
+
+    #[test]
+    fn reflects_with_the_conductor_fresnel_at_the_incidence_angle() {
+        let fr = ShadingFrame {
+            ns: Vec3::Z,
+            ng: Vec3::Z,
+            entering: true,
+        };
+        let gold = SpecularConductor {
+            fresnel: ConductorFresnel::preset(ConductorPreset::Gold),
+        };
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let s = gold
+            .sample(wo, &fr, TransportMode::Radiance, 0.5, 0.25)
+            .expect("sample");
+        assert!(s.wi.distance(Vec3::new(-0.6, 0.0, 0.8)) < 1e-6);
+        // By hand: the red channel's F at cos 0.8 from gold's (η, k), times 0.5 / 0.25.
+        let (eta, k) = ConductorPreset::Gold.complex_index();
+        let want = 2.0 * fresnel_conductor(0.8, eta.x, k.x);
+        assert!((s.weight.x - want).abs() < 1e-6, "{} vs {want}", s.weight.x);
+        assert!(s.delta && s.pdf == 0.25 && !s.transmitted);
+        assert!(
+            gold.sample(wo, &fr, TransportMode::Radiance, 0.5, 0.0)
+                .is_none()
+        );
+    }
+}
