@@ -244,7 +244,10 @@ pub(super) fn spec_light(
     base_dir: &Path,
 ) -> Result<Option<Light>, Diagnostic> {
     let bad = |what: &str| {
-        Diagnostic::error(format!("lights[{index}]"), format!("cannot build this light: {what}"))
+        Diagnostic::error(
+            format!("lights[{index}]"),
+            format!("cannot build this light: {what}"),
+        )
     };
     Ok(Some(match l {
         LightSpec::Point { .. } | LightSpec::Sphere { .. } => return Ok(None),
@@ -277,7 +280,9 @@ pub(super) fn spec_light(
                 angular_radius.to_radians(),
                 scene,
             )
-            .ok_or_else(|| bad("its direction is zero or its angular radius too small for single precision"))?,
+            .ok_or_else(|| {
+                bad("its direction is zero or its angular radius too small for single precision")
+            })?,
         ),
         LightSpec::Environment {
             radiance,
@@ -288,7 +293,13 @@ pub(super) fn spec_light(
             let scale = Vec3::from(*radiance);
             let env = match file {
                 None => EnvironmentLight::constant(scale, scene),
-                Some(f) => load_environment(index, &base_dir.join(f), scale, rotation.to_radians(), scene)?,
+                Some(f) => load_environment(
+                    index,
+                    &base_dir.join(f),
+                    scale,
+                    rotation.to_radians(),
+                    scene,
+                )?,
             };
             Light::Environment(Arc::new(env))
         }

@@ -132,9 +132,7 @@ impl Light {
     pub fn is_delta(&self) -> bool {
         match self {
             Light::Point { .. } | Light::Spot(_) | Light::Distant(_) => true,
-            Light::Sphere { .. } | Light::Rect(_) | Light::Mesh(_) | Light::Environment(_) => {
-                false
-            }
+            Light::Sphere { .. } | Light::Rect(_) | Light::Mesh(_) | Light::Environment(_) => false,
         }
     }
 
@@ -620,9 +618,12 @@ impl AreaEmitter {
             return None;
         }
         let power = self.radiance * (cos * self.area / (pdf * n));
-        power
-            .is_finite()
-            .then(|| (Ray::new(leave_surface(self.origin, normal, dir), dir), power))
+        power.is_finite().then(|| {
+            (
+                Ray::new(leave_surface(self.origin, normal, dir), dir),
+                power,
+            )
+        })
     }
 }
 

@@ -38,7 +38,8 @@ pub enum LightSpec {
         /// `photons.caustic` (0: none).
         #[serde(default)]
         caustic_photons: Option<u32>,
-    },    /// A spot light: a point light emitting inside a cone, full intensity within `inner_angle`
+    },
+    /// A spot light: a point light emitting inside a cone, full intensity within `inner_angle`
     /// of `direction`, none beyond `outer_angle`, pbrt-v4's smooth step in cos θ between.
     Spot {
         /// Position.

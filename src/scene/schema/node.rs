@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::{EmissionSpec, Vec3Spec};
 use super::values::{ScaleSpec, exact_floats, one, unique_keys, unit_size, yes};
+use super::{EmissionSpec, Vec3Spec};
 
 /// A node of the scene graph. Transforms apply in list order (the first one first), and a
 /// group's transform applies after its children's.

@@ -143,7 +143,10 @@ impl<'a> Validator<'a> {
         } else if v.iter().any(|c| *c > MAX_LIGHT_POWER) {
             self.err(
                 path,
-                format!("must be at most {MAX_LIGHT_POWER:e} per channel, found {}", fmt3(v)),
+                format!(
+                    "must be at most {MAX_LIGHT_POWER:e} per channel, found {}",
+                    fmt3(v)
+                ),
             );
         }
     }
@@ -158,7 +161,10 @@ impl<'a> Validator<'a> {
             self.out.push(
                 Diagnostic::error(
                     format!("lights[{second}]"),
-                    format!("a scene has at most one environment light, found {} (lights {envs:?})", envs.len()),
+                    format!(
+                        "a scene has at most one environment light, found {} (lights {envs:?})",
+                        envs.len()
+                    ),
                 )
                 .with_help("merge them into one map"),
             );

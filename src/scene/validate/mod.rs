@@ -191,8 +191,9 @@ pub fn fmt3(v: [f32; 3]) -> String {
 fn has_emission(n: &NodeSpec) -> bool {
     match n {
         NodeSpec::Group { children, .. } => children.iter().any(has_emission),
-        NodeSpec::Sphere { .. } | NodeSpec::Cube { .. } | NodeSpec::Quad { .. } | NodeSpec::Mesh { .. } => {
-            n.emission().is_some()
-        }
+        NodeSpec::Sphere { .. }
+        | NodeSpec::Cube { .. }
+        | NodeSpec::Quad { .. }
+        | NodeSpec::Mesh { .. } => n.emission().is_some(),
     }
 }
