@@ -58,6 +58,15 @@ impl SceneOverrides {
                     }
                     | LightSpec::Sphere {
                         caustic_photons, ..
+                    }
+                    | LightSpec::Spot {
+                        caustic_photons, ..
+                    }
+                    | LightSpec::Distant {
+                        caustic_photons, ..
+                    }
+                    | LightSpec::Environment {
+                        caustic_photons, ..
                     } => *caustic_photons = None,
                 }
             }

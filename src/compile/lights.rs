@@ -11,10 +11,24 @@
 //! digit f32 holds. It is kept rather than refused (a radius swept towards 0 keeps rendering the
 //! same image) with a warning, because the point light has no surface a camera ray can hit.
 
+//!
+//! The lights of issue #25 are made here too: spot, distant and environment lights from the
+//! `lights` list ([`spec_light`]), and area lights from the shapes that carry `emission`
+//! ([`node_light`]): a quad becomes a [`RectLight`], a sphere a sphere light, a cube or mesh a
+//! [`MeshLight`] over its triangles.
+
+use std::path::Path;
+use std::sync::Arc;
+
 use glam::Vec3;
 
+use crate::render_scene::Light;
 use crate::render_scene::geometry::GeometryBuilder;
+use crate::render_scene::light::{
+    DistantLight, EnvironmentLight, MeshLight, RectLight, SceneSphere, SpotLight,
+};
 use crate::scene::Diagnostic;
+use crate::scene::schema::{EmissionSpec, LightSpec};
 
 /// Largest radiance, in W/(m²·sr), a sphere light may have: f32 reaches 3.4e38, and this leaves
 /// eight orders of magnitude for the sums of samples and the exposure.
@@ -87,6 +101,232 @@ pub(super) fn reach(builder: &GeometryBuilder, center: Vec3, eye: Vec3) -> f64 {
     tris.chain(spheres)
         .chain(ellipsoids)
         .fold(far(eye), f64::max)
+}
+
+/// How many primitives of each kind the builder holds: a node's primitives are those between
+/// the counts before and after it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct PrimCounts {
+    triangles: usize,
+    spheres: usize,
+    ellipsoids: usize,
+}
+
+impl PrimCounts {
+    pub(super) fn of(b: &GeometryBuilder) -> Self {
+        Self {
+            triangles: b.triangles.len(),
+            spheres: b.spheres.len(),
+            ellipsoids: b.ellipsoids.len(),
+        }
+    }
+}
+
+/// A shape with `emission`, as the flattener found it: its object and its primitives.
+#[derive(Debug, Clone)]
+pub(super) struct NodeEmitter {
+    /// The node's field path (for diagnostics).
+    pub path: String,
+    /// Its object (which gets the light).
+    pub object: u32,
+    /// A `Quad` node (two triangles forming a parallelogram).
+    pub is_quad: bool,
+    /// What it emits.
+    pub emission: EmissionSpec,
+    /// Primitive counts before the node.
+    pub first: PrimCounts,
+    /// Primitive counts after it.
+    pub end: PrimCounts,
+}
+
+/// The area light of an emissive shape: a rectangle for a quad (its corner and edges
+/// recovered from its two triangles, the edges ordered so their cross product is the
+/// triangles' winding normal), a sphere light for a sphere, a mesh light over the triangles
+/// otherwise. An error for a sphere under non-uniform scale (an ellipsoid is not a light
+/// shape) and for a shape with no area left.
+pub(super) fn node_light(b: &GeometryBuilder, e: &NodeEmitter) -> Result<Light, Diagnostic> {
+    let radiance = Vec3::from(e.emission.radiance);
+    let two_sided = e.emission.two_sided;
+    if e.end.ellipsoids > e.first.ellipsoids {
+        return Err(Diagnostic::error(
+            format!("{}.transform", e.path),
+            "an emissive sphere must keep its shape: its transforms scale it unevenly (an ellipsoid cannot be a light)",
+        )
+        .with_help("scale it by the same factor along every axis"));
+    }
+    if e.end.spheres > e.first.spheres {
+        let s = b.spheres[e.first.spheres];
+        return Ok(Light::Sphere {
+            center: s.center,
+            radius: s.radius,
+            radiance,
+        });
+    }
+    let tris = &b.triangles[e.first.triangles..e.end.triangles];
+    if e.is_quad
+        && let [t0, t1] = tris
+        && let Some(r) = quad_rect(t0, t1, radiance, two_sided)
+    {
+        return Ok(Light::Rect(r));
+    }
+    let positions: Vec<Vec3> = tris.iter().flatten().copied().collect();
+    let triangles: Vec<[u32; 3]> = (0..tris.len() as u32)
+        .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .collect();
+    MeshLight::new(positions, triangles, radiance, two_sided)
+        .map(|m| Light::Mesh(Arc::new(m)))
+        .ok_or_else(|| {
+            Diagnostic::error(
+                e.path.clone(),
+                "an emissive shape needs some area, but every triangle of it is degenerate",
+            )
+        })
+}
+
+/// The parallelogram of a quad's two triangles `[p0, b, c]` and `[p0, c', d]` sharing `p0`
+/// and the diagonal's far corner.
+fn quad_rect(t0: &[Vec3; 3], t1: &[Vec3; 3], radiance: Vec3, two_sided: bool) -> Option<RectLight> {
+    let p0 = t0[0];
+    let winding = (t0[1] - t0[0]).cross(t0[2] - t0[0]);
+    let shared = |v: Vec3| t1.contains(&v);
+    let (diag, q) = if shared(t0[2]) {
+        (t0[2], t0[1])
+    } else {
+        (t0[1], t0[2])
+    };
+    let r = *t1.iter().find(|v| **v != p0 && **v != diag)?;
+    let (mut eu, mut ev) = (q - p0, r - p0);
+    if eu.cross(ev).dot(winding) < 0.0 {
+        std::mem::swap(&mut eu, &mut ev);
+    }
+    RectLight::new(p0, eu, ev, radiance, two_sided)
+}
+
+/// The sphere bounding every primitive built so far and the extra spheres `more` (centre,
+/// radius): what lights at infinity cover with their photons.
+pub(super) fn scene_sphere(b: &GeometryBuilder, more: &[(Vec3, f32)]) -> SceneSphere {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for p in b.triangles.iter().flatten() {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let spheres = b.spheres.iter().map(|s| (s.center, s.radius));
+    for (c, r) in spheres.chain(more.iter().copied()) {
+        lo = lo.min(c - Vec3::splat(r));
+        hi = hi.max(c + Vec3::splat(r));
+    }
+    for e in &b.ellipsoids {
+        let m = e.world_from_object.matrix3.transpose();
+        let c = e.world_from_object.translation.as_vec3();
+        let half = Vec3::new(
+            m.x_axis.length() as f32,
+            m.y_axis.length() as f32,
+            m.z_axis.length() as f32,
+        );
+        lo = lo.min(c - half);
+        hi = hi.max(c + half);
+    }
+    if !(lo.cmple(hi).all()) {
+        return SceneSphere::new(Vec3::ZERO, 1.0);
+    }
+    SceneSphere::new((lo + hi) * 0.5, 0.5 * (hi - lo).length())
+}
+
+/// A spot, distant or environment light of the `lights` list (`index`), with the scene's
+/// bounding sphere for lights at infinity; `None` for point and sphere lights (compiled by the
+/// caller, which keeps their code as it was). Errors: an environment map that cannot be read
+/// or holds a negative or non-finite texel, named by file.
+pub(super) fn spec_light(
+    index: usize,
+    l: &LightSpec,
+    scene: SceneSphere,
+    base_dir: &Path,
+) -> Result<Option<Light>, Diagnostic> {
+    let bad = |what: &str| {
+        Diagnostic::error(
+            format!("lights[{index}]"),
+            format!("cannot build this light: {what}"),
+        )
+    };
+    Ok(Some(match l {
+        LightSpec::Point { .. } | LightSpec::Sphere { .. } => return Ok(None),
+        LightSpec::Spot {
+            position,
+            direction,
+            intensity,
+            inner_angle,
+            outer_angle,
+            ..
+        } => Light::Spot(
+            SpotLight::new(
+                Vec3::from(*position),
+                Vec3::from(*direction),
+                Vec3::from(*intensity),
+                inner_angle.to_radians(),
+                outer_angle.to_radians(),
+            )
+            .ok_or_else(|| bad("its direction or cone angles are out of range"))?,
+        ),
+        LightSpec::Distant {
+            direction,
+            irradiance,
+            angular_radius,
+            ..
+        } => Light::Distant(
+            DistantLight::new(
+                Vec3::from(*direction),
+                Vec3::from(*irradiance),
+                angular_radius.to_radians(),
+                scene,
+            )
+            .ok_or_else(|| {
+                bad("its direction is zero or its angular radius too small for single precision")
+            })?,
+        ),
+        LightSpec::Environment {
+            radiance,
+            file,
+            rotation,
+            ..
+        } => {
+            let scale = Vec3::from(*radiance);
+            let env = match file {
+                None => EnvironmentLight::constant(scale, scene),
+                Some(f) => load_environment(
+                    index,
+                    &base_dir.join(f),
+                    scale,
+                    rotation.to_radians(),
+                    scene,
+                )?,
+            };
+            Light::Environment(Arc::new(env))
+        }
+    }))
+}
+
+/// Reads an equirectangular OpenEXR map (linear RGB) and makes the environment light of its
+/// texels times `scale`.
+fn load_environment(
+    index: usize,
+    file: &Path,
+    scale: Vec3,
+    rotation: f32,
+    scene: SceneSphere,
+) -> Result<EnvironmentLight, Diagnostic> {
+    let at = format!("lights[{index}].file");
+    let img = image::open(file).map_err(|e| {
+        Diagnostic::error(&at, format!("cannot read the environment map `{}`: {e}", file.display()))
+            .with_help("give a linear equirectangular OpenEXR image, relative to the scene file (e.g. `assets/sky.exr`)")
+    })?;
+    let rgb = img.to_rgb32f();
+    let (w, h) = (rgb.width() as usize, rgb.height() as usize);
+    let texels: Vec<Vec3> = rgb.pixels().map(|p| Vec3::from(p.0) * scale).collect();
+    EnvironmentLight::image(w, h, texels, rotation, scene).map_err(|e| {
+        Diagnostic::error(&at, format!("`{}`: {e}", file.display()))
+            .with_help("every texel of an environment map must be a finite, non-negative radiance")
+    })
 }
 
 #[cfg(test)]

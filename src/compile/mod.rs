@@ -14,9 +14,10 @@ use std::time::{Duration, Instant};
 use crate::accel::BvhStats;
 use crate::render_scene::PhotonParams;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
+use crate::render_scene::light::escape::EnvironmentRef;
 use crate::render_scene::{Camera, Light, ObjectInfo, RenderParams, RenderScene};
 use crate::scene::Diagnostic;
-use crate::scene::schema::{self, CameraSpec, LightSpec, SceneFile};
+use crate::scene::schema::{self, LightSpec, SceneFile};
 
 /// Counts and timings of a compilation, for `--stats`.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -91,18 +92,55 @@ pub fn compile(
         errors: &mut errors,
         warnings: &mut stats.warnings,
         degenerate: 0,
+        emitters: Vec::new(),
     };
     for (i, node) in scene.nodes.iter().enumerate() {
         flattener.node(&format!("nodes[{i}]"), node, glam::DAffine3::IDENTITY);
     }
     stats.degenerate_triangles = flattener.degenerate;
     stats.meshes_loaded = flattener.meshes.len();
+    let emitters = std::mem::take(&mut flattener.emitters);
     if !errors.is_empty() {
         return Err(errors);
     }
+    // The sphere lights of the list are geometry too: the bounding sphere covers them.
+    let light_spheres: Vec<(glam::Vec3, f32)> = (scene.lights.iter())
+        .filter_map(|l| match *l {
+            LightSpec::Sphere { center, radius, .. } => Some((center.into(), radius)),
+            LightSpec::Point { .. }
+            | LightSpec::Spot { .. }
+            | LightSpec::Distant { .. }
+            | LightSpec::Environment { .. } => None,
+        })
+        .collect();
+    let scene_sphere = lights::scene_sphere(&builder, &light_spheres);
+    let mut environment = None;
 
     let mut lights = Vec::with_capacity(scene.lights.len());
     for (i, l) in scene.lights.iter().enumerate() {
+        match lights::spec_light(i, l, scene_sphere, base_dir) {
+            Ok(None) => {}
+            Ok(Some(light)) => {
+                if matches!(light, Light::Environment(_)) {
+                    let object = objects.len() as u32;
+                    objects.push(ObjectInfo {
+                        name: format!("lights[{i}]"),
+                        material: None,
+                        light: Some(lights.len() as u32),
+                    });
+                    environment = Some(EnvironmentRef {
+                        light: lights.len() as u32,
+                        object,
+                    });
+                }
+                lights.push(light);
+                continue;
+            }
+            Err(d) => {
+                errors.push(d);
+                continue;
+            }
+        }
         match *l {
             LightSpec::Point {
                 position, power, ..
@@ -113,9 +151,7 @@ pub fn compile(
                 power,
                 ..
             } => {
-                let eye = match scene.camera {
-                    CameraSpec::Pinhole { eye, .. } => eye.into(),
-                };
+                let eye = scene.camera.view().0.into();
                 let reach = lights::reach(&builder, center.into(), eye);
                 let min = lights::min_sphere_light_radius(power.into(), reach);
                 if f64::from(radius) < min {
@@ -142,7 +178,21 @@ pub fn compile(
                     object,
                 });
             }
+            LightSpec::Spot { .. } | LightSpec::Distant { .. } | LightSpec::Environment { .. } => {}
         }
+    }
+    // Shapes with `emission` come after the list's lights (whose indices stay the list's).
+    for e in &emitters {
+        match lights::node_light(&builder, e) {
+            Ok(light) => {
+                objects[e.object as usize].light = Some(lights.len() as u32);
+                lights.push(light);
+            }
+            Err(d) => errors.push(d),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(errors);
     }
     stats.flatten_time = t0.elapsed();
     stats.triangles = builder.triangles.len();
@@ -176,12 +226,10 @@ pub fn compile(
         texture_filter: r.texture_filter,
         photons: photon_params(&scene.photons, &scene.lights),
     };
-    let CameraSpec::Pinhole {
-        eye,
-        look_at,
-        up,
-        fov_y,
-    } = scene.camera;
+    let mut params = params;
+    // Emissive shapes have no budget of their own: they share `photons.caustic` by power.
+    params.photons.caustic_per_light.resize(lights.len(), None);
+    let (eye, look_at, up, fov_y) = scene.camera.view();
     let camera = Camera::pinhole(
         eye.into(),
         look_at.into(),
@@ -189,6 +237,10 @@ pub fn compile(
         fov_y,
         r.width as f32 / r.height as f32,
     );
+    let camera = match scene.camera.lens() {
+        Some((radius, focus_distance)) => camera.with_thin_lens(radius, focus_distance),
+        None => camera,
+    };
     let textures = std::mem::take(&mut materials.textures.list);
     let (material_names, materials) = materials.list.into_iter().unzip();
     Ok((
@@ -199,6 +251,7 @@ pub fn compile(
             textures,
             material_names,
             lights,
+            environment,
             objects,
             geometry,
         },

@@ -26,6 +26,8 @@ pub(super) struct Flattener<'a> {
     pub errors: &'a mut Vec<Diagnostic>,
     pub warnings: &'a mut Vec<Diagnostic>,
     pub degenerate: usize,
+    /// The emissive shapes found, in tree order, for `compile::lights` to make lights of.
+    pub emitters: Vec<super::lights::NodeEmitter>,
 }
 
 /// The affine map of a transform list: the first step is applied first.
@@ -62,6 +64,7 @@ impl Flattener<'_> {
                 light: None,
             });
         }
+        let first = super::lights::PrimCounts::of(self.builder);
         match node {
             NodeSpec::Group { children, .. } => {
                 for (i, c) in children.iter().enumerate() {
@@ -135,6 +138,16 @@ impl Flattener<'_> {
                     }
                 }
             }
+        }
+        if let Some(emission) = node.emission() {
+            self.emitters.push(super::lights::NodeEmitter {
+                path: path.to_string(),
+                object,
+                is_quad: matches!(node, NodeSpec::Quad { .. }),
+                emission: emission.clone(),
+                first,
+                end: super::lights::PrimCounts::of(self.builder),
+            });
         }
         if self.builder.triangles.len() > MAX_PRIMS_PER_KIND {
             self.errors.push(Diagnostic::error(

@@ -153,7 +153,8 @@ impl<'a> PathTracer<'a> {
                                     1.0
                                 } else {
                                     let light_pdf = self.lights.pmf(i as usize)
-                                        * scene.lights[i as usize].pdf_li(prev_p, -e.wo);
+                                        * scene.lights[i as usize]
+                                            .pdf_li_hit(prev_p, -e.wo, e.sp.p, e.sp.ng);
                                     power_heuristic(prev_pdf, light_pdf)
                                 };
                                 le * w

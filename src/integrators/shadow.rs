@@ -72,11 +72,14 @@ pub fn connect_light(
     // The light's own surface is skipped: the sampled point is where the segment first meets
     // it (the near side of a sphere light), so it cannot block the segment, and the test would
     // cost a full quadric intersection on every shadow ray.
+    // (A mesh light that is not convex can hide its sample behind itself: its own triangles
+    // are tested, `Light::can_shadow_itself`.)
     let own = Some(light as u32);
+    let self_shadowing = scene.lights[light].can_shadow_itself();
     let occluded = scene
         .geometry
         .occluded_by(&shadow_ray(sp, fr.ng, ls.point), |prim| {
-            scene.objects[scene.geometry.object_of(prim) as usize].light != own
+            self_shadowing || scene.objects[scene.geometry.object_of(prim) as usize].light != own
         });
     Some(LightConnection { ls, f, occluded })
 }

@@ -122,7 +122,9 @@ pub(super) fn render_tile(
 }
 
 /// Starts `sampler` on sample `s` of pixel `(x, y)` and returns its camera ray through the
-/// position in the pixel the sampler's first two dimensions give.
+/// position in the pixel the sampler's first two dimensions give. A thin lens takes its lens
+/// point from the next two (the camera's 2-D lens dimensions, before any integrator draw);
+/// a pinhole draws nothing more, so its images stay what they were.
 pub(super) fn camera_sample(
     scene: &RenderScene,
     sampler: &mut Sampler,
@@ -133,7 +135,11 @@ pub(super) fn camera_sample(
     let p = &scene.params;
     sampler.start_pixel_sample(x, y, s);
     let (jx, jy) = sampler.pixel_2d();
-    scene
-        .camera
-        .ray(x as f32 + jx, y as f32 + jy, p.width, p.height)
+    let (fx, fy) = (x as f32 + jx, y as f32 + jy);
+    if scene.camera.needs_lens_sample() {
+        let u_lens = sampler.next_2d();
+        scene.camera.ray_lens(fx, fy, p.width, p.height, u_lens)
+    } else {
+        scene.camera.ray(fx, fy, p.width, p.height)
+    }
 }

@@ -38,6 +38,7 @@ pub fn photon_key(scene: &RenderScene) -> u64 {
         textures,
         material_names: _,
         lights,
+        environment: _,
         objects,
         geometry,
     } = scene;

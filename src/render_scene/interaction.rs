@@ -12,7 +12,9 @@ use crate::shading::{Bsdf, ShadingFrame};
 /// What a ray found ([`RenderScene::interact`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Interaction {
-    /// The ray left the scene (it sees the background).
+    /// The ray left the scene (it sees the background). With an environment light, unbounded
+    /// rays that leave the scene are [`Interaction::Emitter`] hits on it instead
+    /// ([`RenderScene::escape`]).
     Escaped,
     /// The ray hit an emitter's surface (an object without a material: it absorbs what reaches
     /// it and emits [`EmitterHit::le`]).
@@ -75,7 +77,7 @@ impl RenderScene {
     #[must_use]
     pub fn interact(&self, ray: &Ray, footprint: impl FnOnce(f32) -> f32) -> Interaction {
         let Some(hit) = self.geometry.intersect(ray) else {
-            return Interaction::Escaped;
+            return self.escape(ray);
         };
         let sp = self.geometry.surface(ray, &hit);
         let object = &self.objects[sp.object as usize];

@@ -5,17 +5,35 @@
 //! Sphere lights are sampled by the cone of directions they subtend (uniform in solid angle), not
 //! by their area: the density is constant over the visible cap, so the estimator's only variance
 //! is the cosine and the BSDF (pbrt-v4 §12.2.2 describes the same strategy for spheres).
+//!
+//! The other shapes live in their own files and are wrapped as variants here, so every
+//! integrator and photon pass reaches them through the same methods: rectangles
+//! ([`rect`], spherical rectangles), emissive triangle meshes ([`triangle_mesh`], by area),
+//! spot lights ([`spot`], pbrt-v4's fall-off), distant lights ([`distant`], the sun's cone) and
+//! environment lights ([`environment`], an importance-sampled equirectangular map). Lights at
+//! infinity are reached by rays that escape the scene ([`escape`]); a distant light's cone is
+//! not (it is sampled by next-event estimation only, see [`Light::sample_li`]).
 
 use glam::Vec3;
 use std::f32::consts::{PI, TAU};
+use std::sync::Arc;
 
 use crate::geometry::offset::offset_ray_origin;
 use crate::geometry::{Frame, Ray};
 use crate::sampling::Sampler;
 use crate::sampling::warp::{cosine_hemisphere, uniform_sphere};
 
+pub use distant::DistantLight;
+pub use environment::EnvironmentLight;
+pub use infinite::SceneSphere;
+pub use rect::RectLight;
+pub use spot::SpotLight;
+pub use triangle_mesh::MeshLight;
+
 /// A light source in world space.
-#[derive(Debug, Clone, Copy, PartialEq)]
+///
+/// Cloning is cheap: the variants with large tables (meshes, environment maps) share them.
+#[derive(Debug, Clone, PartialEq)]
 pub enum Light {
     /// Point light with radiant intensity `intensity = Φ/(4π)` (W/sr).
     Point {
@@ -33,6 +51,16 @@ pub enum Light {
         /// Emitted radiance per channel.
         radiance: Vec3,
     },
+    /// A parallelogram (a `Quad` node with `emission`), sampled by solid angle.
+    Rect(RectLight),
+    /// An emissive triangle mesh (a `Cube` or `Mesh` node with `emission`), sampled by area.
+    Mesh(Arc<MeshLight>),
+    /// A spot light (a point light with a cone and pbrt-v4's smooth fall-off).
+    Spot(SpotLight),
+    /// A distant light (the sun), optionally with an angular radius.
+    Distant(DistantLight),
+    /// Radiance from every direction at infinity (constant or an image).
+    Environment(Arc<EnvironmentLight>),
 }
 
 /// One sample of incident light at a point (from [`Light::sample_li`]).
@@ -96,11 +124,48 @@ impl Light {
         }
     }
 
-    /// True for lights that are delta distributions in direction from any point (point lights).
+    /// True for lights whose samples carry no MIS weight because BSDF sampling never reaches
+    /// them: point and spot lights (deltas in position), distant lights (a delta direction, or
+    /// the sun's cone, which escaping rays do not see).
     #[inline]
     #[must_use]
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point { .. })
+        match self {
+            Light::Point { .. } | Light::Spot(_) | Light::Distant(_) => true,
+            Light::Sphere { .. } | Light::Rect(_) | Light::Mesh(_) | Light::Environment(_) => false,
+        }
+    }
+
+    /// True for lights at infinity (distant and environment lights): their shadow rays end
+    /// beyond the scene's bounding sphere and their photons start on a disc of it.
+    #[inline]
+    #[must_use]
+    pub fn is_infinite(&self) -> bool {
+        match self {
+            Light::Distant(_) | Light::Environment(_) => true,
+            Light::Point { .. }
+            | Light::Sphere { .. }
+            | Light::Rect(_)
+            | Light::Mesh(_)
+            | Light::Spot(_) => false,
+        }
+    }
+
+    /// True when the light's own surface can lie between a shaded point and a point sampled
+    /// on it (a mesh that is not convex, seen through itself): shadow rays towards it must test
+    /// its primitives. False for spheres (the sample is on the near side) and flat lights.
+    #[inline]
+    #[must_use]
+    pub fn can_shadow_itself(&self) -> bool {
+        match self {
+            Light::Mesh(_) => true,
+            Light::Point { .. }
+            | Light::Sphere { .. }
+            | Light::Rect(_)
+            | Light::Spot(_)
+            | Light::Distant(_)
+            | Light::Environment(_) => false,
+        }
     }
 
     /// Samples a direction towards the light from `p` with `u ∈ [0, 1)²`.
@@ -191,12 +256,22 @@ impl Light {
                     weight,
                 })
             }
+            Light::Rect(ref r) => r.sample_li(p, u),
+            Light::Mesh(ref m) => m.sample_li(p, u).map(|s| s.light),
+            Light::Spot(ref s) => s.sample_li(p, u),
+            // The sun's cone is sampled here only: escaping rays do not see it, so its samples
+            // stand alone (no MIS weight), as a delta light's do.
+            Light::Distant(ref d) => d.sample_li(p, u).map(|s| LightSample { delta: true, ..s }),
+            Light::Environment(ref e) => e.sample_li(p, u),
         }
     }
 
     /// Solid-angle density with which [`Light::sample_li`] at `p` returns the unit direction
     /// `wi`: 0 for point lights (a delta), 0 outside the cone a sphere subtends or when `p` is
     /// inside it. Used for the MIS weight when a BSDF-sampled ray hits a sphere light.
+    /// Spot and distant lights give 0 (their samples carry no MIS weight); a mesh gives the
+    /// density of the direction (every triangle the line meets, O(triangles): integrators use
+    /// [`Light::pdf_li_hit`], which knows the point hit).
     #[must_use]
     pub fn pdf_li(&self, p: Vec3, wi: Vec3) -> f32 {
         match *self {
@@ -221,12 +296,39 @@ impl Light {
                 let pdf = 1.0 / (TAU * cone_one_minus_cos(r2, dist2));
                 if pdf.is_finite() { pdf } else { 0.0 }
             }
+            Light::Rect(ref r) => r.pdf_li(p, wi),
+            Light::Mesh(ref m) => m.pdf_li(p, wi),
+            Light::Spot(ref s) => s.pdf_li(p, wi),
+            Light::Distant(_) => 0.0,
+            Light::Environment(ref e) => e.pdf_li(p, wi),
+        }
+    }
+
+    /// [`Light::pdf_li`] for a ray from `p` that hit the light at `point` (geometric normal
+    /// `n`, outward by winding): what a BSDF-sampled ray needs for its MIS weight. A mesh's
+    /// density is that of the point hit (the triangles behind it are other paths); every other
+    /// light gives `pdf_li(p, normalize(point − p))` (for lights at infinity `point` is any
+    /// point along the escaping ray).
+    #[inline]
+    #[must_use]
+    pub fn pdf_li_hit(&self, p: Vec3, wi: Vec3, point: Vec3, n: Vec3) -> f32 {
+        match self {
+            Light::Mesh(m) => m.pdf_li_hit(p, point, n),
+            Light::Point { .. }
+            | Light::Sphere { .. }
+            | Light::Rect(_)
+            | Light::Spot(_)
+            | Light::Distant(_)
+            | Light::Environment(_) => self.pdf_li(p, wi),
         }
     }
 
     /// Radiance the light emits from a surface point with outward unit normal `n` in direction
     /// `w` (unit, pointing away from the light): the sphere's radiance on its outer side, zero
-    /// otherwise and for point lights (which rays cannot hit).
+    /// otherwise and for point lights (which rays cannot hit). Rectangles and meshes: their
+    /// radiance on an emitting side (`n` is the triangle's winding normal). Environment: the
+    /// radiance arriving along a ray escaping in direction `−w` (`n` unused). Spot and distant
+    /// lights: zero (rays never reach them).
     #[inline]
     #[must_use]
     pub fn le(&self, n: Vec3, w: Vec3) -> Vec3 {
@@ -239,6 +341,10 @@ impl Light {
                     Vec3::ZERO
                 }
             }
+            Light::Rect(ref r) => r.le(w),
+            Light::Mesh(ref m) => m.le(n, w),
+            Light::Spot(_) | Light::Distant(_) => Vec3::ZERO,
+            Light::Environment(ref e) => e.le(-w),
         }
     }
 
@@ -293,12 +399,18 @@ impl Light {
                     pdf_dir: cos_t / PI,
                 })
             }
+            Light::Rect(ref r) => r.sample_le(u_pos, u_dir),
+            Light::Mesh(ref m) => m.sample_le(u_pos, u_dir),
+            Light::Spot(ref s) => s.sample_le(u_pos, u_dir),
+            Light::Distant(ref d) => d.sample_le(u_pos, u_dir),
+            Light::Environment(ref e) => e.sample_le(u_pos, u_dir),
         }
     }
 
     /// The densities `(pdf_pos, pdf_dir)` with which [`Light::sample_le`] produces a ray leaving
     /// a point with outward normal `normal` in direction `dir` (both unit; `normal` is ignored
-    /// for point lights). `pdf_dir` is 0 for directions below the surface.
+    /// for point, spot and infinite lights, and by a rectangle, which knows its own). `pdf_dir`
+    /// is 0 for directions below the surface (and outside a spot's cone).
     #[must_use]
     pub fn pdf_le(&self, normal: Vec3, dir: Vec3) -> (f32, f32) {
         match *self {
@@ -307,6 +419,11 @@ impl Light {
                 1.0 / (4.0 * PI * radius * radius),
                 normal.dot(dir).max(0.0) / PI,
             ),
+            Light::Rect(ref r) => r.pdf_le(dir),
+            Light::Mesh(ref m) => m.pdf_le(normal, dir),
+            Light::Spot(ref s) => s.pdf_le(dir),
+            Light::Distant(ref d) => d.pdf_le(dir),
+            Light::Environment(ref e) => e.pdf_le(dir),
         }
     }
 
@@ -318,6 +435,11 @@ impl Light {
             Light::Sphere {
                 radius, radiance, ..
             } => radiance * 4.0 * PI * PI * radius * radius,
+            Light::Rect(ref r) => r.power(),
+            Light::Mesh(ref m) => m.power(),
+            Light::Spot(ref s) => s.power(),
+            Light::Distant(ref d) => d.power(),
+            Light::Environment(ref e) => e.power(),
         }
     }
 }
@@ -330,8 +452,13 @@ impl Light {
     #[must_use]
     pub fn shadow_samples(&self, per_area_light: u32) -> u32 {
         match self {
-            Light::Point { .. } => 1,
-            Light::Sphere { .. } => per_area_light,
+            Light::Point { .. } | Light::Spot(_) => 1,
+            Light::Distant(d) if d.is_delta() => 1,
+            Light::Sphere { .. }
+            | Light::Rect(_)
+            | Light::Mesh(_)
+            | Light::Distant(_)
+            | Light::Environment(_) => per_area_light,
         }
     }
 
@@ -355,7 +482,7 @@ impl Light {
                 let power = self.power() / n;
                 (power.max_element() > 0.0).then(|| (Ray::new(position, dir.normalize()), power))
             }
-            Light::Sphere { .. } => {
+            Light::Sphere { .. } | Light::Rect(_) | Light::Mesh(_) => {
                 let u_pos = sampler.next_2d();
                 let u_dir = sampler.next_2d();
                 let e = self.sample_le(u_pos, u_dir)?;
@@ -366,6 +493,16 @@ impl Light {
                     power,
                 ))
             }
+            // No surface to leave: a spot's photons start at its position, those of lights at
+            // infinity on the disc of the scene's bounding sphere; flux le / (pdf_pos pdf_dir).
+            Light::Spot(_) | Light::Distant(_) | Light::Environment(_) => {
+                let u_pos = sampler.next_2d();
+                let u_dir = sampler.next_2d();
+                let e = self.sample_le(u_pos, u_dir)?;
+                let power = e.le / (e.pdf_pos * e.pdf_dir * n);
+                (power.is_finite() && power.max_element() > 0.0)
+                    .then(|| (Ray::new(e.origin, e.dir), power))
+            }
         }
     }
 
@@ -374,7 +511,11 @@ impl Light {
     /// then `aim(point, sampler)` gives a unit direction and its solid-angle density (1/sr);
     /// the flux divides by that density. `None` when `aim` gives nothing, the direction leaves
     /// the surface inwards (no light goes there; the photon still counts as emitted, so the
-    /// estimate stays unbiased) or the flux is not finite.
+    /// estimate stays unbiased) or the flux is not finite. A spot's aimed photon carries the
+    /// intensity along its direction (none outside the cone). Lights at infinity have no
+    /// point to aim from: their caustic photons are emitted as [`Light::emit_spread`] emits
+    /// them (the disc of the scene's bounding sphere), unaimed — unbiased, but only the
+    /// photons that meet a specular object land in the caustic map.
     #[must_use]
     pub fn emit_aimed(
         &self,
@@ -409,7 +550,80 @@ impl Light {
                     .is_finite()
                     .then(|| (Ray::new(leave_surface(origin, normal, dir), dir), power))
             }
+            Light::Rect(ref r) => {
+                let u = sampler.next_2d();
+                let origin = r.corner + r.edge_u * u.0 + r.edge_v * u.1;
+                let surface = AreaEmitter {
+                    origin,
+                    normal: r.normal,
+                    area: r.area,
+                    radiance: r.radiance,
+                    two_sided: r.two_sided,
+                };
+                surface.emit_aimed(sampler, aim, n)
+            }
+            Light::Mesh(ref m) => {
+                let (origin, normal) = m.sample_position(sampler.next_2d())?;
+                let surface = AreaEmitter {
+                    origin,
+                    normal,
+                    area: m.area,
+                    radiance: m.radiance,
+                    two_sided: m.two_sided,
+                };
+                surface.emit_aimed(sampler, aim, n)
+            }
+            Light::Spot(s) => {
+                let (dir, pdf) = aim(s.position, sampler)?;
+                let power = s.intensity_towards(dir) / (pdf * n);
+                (power.is_finite() && power.max_element() > 0.0)
+                    .then(|| (Ray::new(s.position, dir), power))
+            }
+            Light::Distant(_) | Light::Environment(_) => self.emit_spread(|| Vec3::Z, sampler, n),
         }
+    }
+}
+
+/// A uniformly chosen point of a flat-faced area light (rectangle or mesh), for aimed photons.
+struct AreaEmitter {
+    origin: Vec3,
+    /// Unit winding normal of the face `origin` is on.
+    normal: Vec3,
+    /// The light's whole area (m²): the point's density is `1/area`.
+    area: f32,
+    radiance: Vec3,
+    two_sided: bool,
+}
+
+impl AreaEmitter {
+    /// The photon leaving `origin` along `aim`'s direction (density `pdf`): flux
+    /// `L cos θ · area / (pdf · n)`, from the front or (two-sided) the back; `None` behind a
+    /// one-sided light or for a flux that is not finite.
+    fn emit_aimed(
+        &self,
+        sampler: &mut Sampler,
+        aim: impl FnOnce(Vec3, &mut Sampler) -> Option<(Vec3, f32)>,
+        n: f32,
+    ) -> Option<(Ray, Vec3)> {
+        let (dir, pdf) = aim(self.origin, sampler)?;
+        let c = dir.dot(self.normal);
+        let (cos, normal) = if c > 0.0 {
+            (c, self.normal)
+        } else if self.two_sided {
+            (-c, -self.normal)
+        } else {
+            return None;
+        };
+        if !(cos > 0.0) {
+            return None;
+        }
+        let power = self.radiance * (cos * self.area / (pdf * n));
+        power.is_finite().then(|| {
+            (
+                Ray::new(leave_surface(self.origin, normal, dir), dir),
+                power,
+            )
+        })
     }
 }
 
@@ -447,6 +661,7 @@ mod tests;
 // The light shapes of issue #25, standalone until they are wired in as `Light` variants.
 pub mod distant;
 pub mod environment;
+pub mod escape;
 pub mod infinite;
 pub mod rect;
 pub mod spot;

@@ -114,6 +114,9 @@ pub struct RenderScene {
     pub material_names: Vec<String>,
     /// Lights.
     pub lights: Vec<Light>,
+    /// The environment light, if the scene has one (at most one: validation), which rays
+    /// escaping the scene hit ([`RenderScene::escape`]).
+    pub environment: Option<light::escape::EnvironmentRef>,
     /// Objects, indexed by the `object` of each primitive.
     pub objects: Vec<ObjectInfo>,
     /// Primitives and their BVH.

@@ -34,6 +34,29 @@ pub struct SurfacePoint {
     local: Local,
 }
 
+impl SurfacePoint {
+    /// The point `p` at infinity (beyond the scene) that an escaping ray meets on an
+    /// environment light, with unit normal `n` facing the ray and owning object `object`
+    /// (see `render_scene::light::escape`). It has no primitive: nothing shades it.
+    #[must_use]
+    pub fn at_infinity(p: Vec3, n: Vec3, object: u32) -> Self {
+        Self {
+            p,
+            p_error: Vec3::ZERO,
+            ng: n,
+            ns: n,
+            p_outside: p,
+            object,
+            local: Local {
+                prim: super::geometry::PrimRef::new(PrimKind::Triangle, 0),
+                b1: 0.0,
+                b2: 0.0,
+                unit: n,
+            },
+        }
+    }
+}
+
 /// A hit's position on its primitive (see [`SurfacePoint`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Local {

@@ -36,7 +36,7 @@ const PLANE: &str = r#"Scene(
 fn direct_photons(scene: &RenderScene, n: u64) -> (Vec<Photon>, TraceCounts) {
     let p = &scene.params;
     let mut sampler = Sampler::new(p.sampler, p.seed, 1);
-    let emitter = LightEmitter::new(scene.lights[0], n, &mut sampler, 99);
+    let emitter = LightEmitter::new(scene.lights[0].clone(), n, &mut sampler, 99);
     let settings = TraceSettings {
         kind: MapKind::Global,
         min_bounces: 0,

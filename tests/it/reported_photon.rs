@@ -130,7 +130,7 @@ fn a_generous_largest_radius_does_not_change_the_estimate() {
 fn direct_photons(scene: &RenderScene, n: u64) -> Vec<Photon> {
     let p = &scene.params;
     let mut sampler = Sampler::new(p.sampler, p.seed, 1);
-    let emitter = LightEmitter::new(scene.lights[0], n, &mut sampler, 99);
+    let emitter = LightEmitter::new(scene.lights[0].clone(), n, &mut sampler, 99);
     let settings = TraceSettings {
         kind: MapKind::Global,
         min_bounces: 0,

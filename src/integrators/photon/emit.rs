@@ -49,7 +49,7 @@ pub fn split_by_power(total: u64, weights: &[f64]) -> Vec<u64> {
 
 /// The emission of one light for one map: how many photons, and the per-map state (the
 /// lattice rotation) they share.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct LightEmitter {
     /// The light.
     pub light: Light,

@@ -425,7 +425,7 @@ pub fn build_maps_with(
             .zip(counts)
             .enumerate()
             .map(|(l, (light, &n))| {
-                LightEmitter::new(*light, n, sampler, rotation_stream(kind, l, pass))
+                LightEmitter::new(light.clone(), n, sampler, rotation_stream(kind, l, pass))
             })
             .collect()
     };

@@ -161,7 +161,7 @@ fn emission_samples_carry_exactly_the_light_power() {
         Light::point(Vec3::new(-1.0, 0.0, 2.0), power),
     ];
     let mut r = Rng::new(8, 1);
-    for l in lights {
+    for l in &lights {
         let mut dir_sum = Vec3::ZERO;
         for _ in 0..10_000 {
             let s = l.sample_le(r.next_2d(), r.next_2d()).unwrap();
@@ -171,11 +171,13 @@ fn emission_samples_carry_exactly_the_light_power() {
             assert!((pdf_dir / s.pdf_dir - 1.0).abs() < 1e-4);
             let flux = match l {
                 Light::Point { position, .. } => {
+                    let position = *position;
                     assert_eq!(s.origin, position);
                     assert_eq!(s.normal, Vec3::ZERO);
                     s.le / (s.pdf_pos * s.pdf_dir)
                 }
                 Light::Sphere { center, radius, .. } => {
+                    let (center, radius) = (*center, *radius);
                     assert!(((s.origin - center).length() - radius).abs() < 1e-5);
                     assert!(s.normal.distance((s.origin - center) / radius) < 1e-5);
                     let cos = s.dir.dot(s.normal);
@@ -184,6 +186,7 @@ fn emission_samples_carry_exactly_the_light_power() {
                     assert_eq!(l.le(s.normal, -s.dir), Vec3::ZERO);
                     s.le * cos / (s.pdf_pos * s.pdf_dir)
                 }
+                other => panic!("not a case of this test: {other:?}"),
             };
             assert!((flux / power - 1.0).abs().max_element() < 1e-4, "{flux}");
             dir_sum += s.dir;
@@ -275,7 +278,7 @@ fn emission_directions_and_positions_pass_chi2() {
         }
     };
     // Sphere: directions about their own normal are cosine-distributed...
-    let le = sample(sphere);
+    let le = sample(sphere.clone());
     let local = chi2_test(
         200_000,
         1,
@@ -284,7 +287,7 @@ fn emission_directions_and_positions_pass_chi2() {
         |w| w.z.max(0.0) / PI,
     );
     // ...and the points (normals) are uniform over the sphere.
-    let le = sample(sphere);
+    let le = sample(sphere.clone());
     let normals = chi2_test(
         200_000,
         2,
@@ -293,7 +296,7 @@ fn emission_directions_and_positions_pass_chi2() {
         |_| 1.0 / (4.0 * PI),
     );
     // Point: uniform directions.
-    let le = sample(point);
+    let le = sample(point.clone());
     let points = chi2_test(
         200_000,
         3,

@@ -126,6 +126,15 @@ impl MeshLight {
         Some((i, b, p0 * b[0] + p1 * b[1] + p2 * b[2]))
     }
 
+    /// A uniform point of the mesh (area density `1/A`) from `u`, and the unit winding normal
+    /// of its triangle: where aimed photons leave from.
+    #[inline]
+    #[must_use]
+    pub fn sample_position(&self, u: (f32, f32)) -> Option<(Vec3, Vec3)> {
+        let (i, _, p) = self.sample_point(u)?;
+        Some((p, self.normal(i)))
+    }
+
     /// Samples a direction towards the mesh from `p` (uniform by area; solid-angle density `d²
     /// / (A |cos θ_l|)`). `None` for a black light, a point on a triangle's back (one-sided:
     /// no light goes that way; [`MeshLight::pdf_li`] gives such directions density 0), or a

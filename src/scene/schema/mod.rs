@@ -16,7 +16,7 @@ mod material;
 mod node;
 mod values;
 
-pub use light::LightSpec;
+pub use light::{EmissionSpec, LightSpec};
 pub use material::{
     AbsorptionSpec, CONDUCTOR_PRESETS, ColorAtDepth, ColorSpec, ConductorSpec, ConductorTint,
     Mapping, MaterialSpec, RoughnessSpec, TextureSpec,
@@ -199,6 +199,90 @@ pub enum CameraSpec {
         /// Vertical field of view in degrees, in (0, 180).
         fov_y: f32,
     },
+    /// A thin-lens camera (depth of field): the pinhole's view through a lens disc of radius
+    /// `aperture_radius` — or `f / (2 N)` for the f-number `N = f_number`, with the focal
+    /// length `f = (sensor_height / 2) / tan(fov_y / 2)` — focused on the plane
+    /// `focus_distance` along the view direction. Give exactly one of `aperture_radius` and
+    /// `f_number`.
+    ThinLens {
+        /// Eye position (the lens centre).
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
+        eye: Vec3Spec,
+        /// Point the camera looks at.
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
+        look_at: Vec3Spec,
+        /// Approximate up direction.
+        #[serde(default = "default_up")]
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
+        up: Vec3Spec,
+        /// Vertical field of view in degrees, in (0, 180).
+        fov_y: f32,
+        /// Lens radius in scene units (≥ 0; 0 is a pinhole).
+        #[serde(default)]
+        aperture_radius: Option<f32>,
+        /// f-number N (> 0): the aperture radius is `f / (2N)`.
+        #[serde(default)]
+        f_number: Option<f32>,
+        /// Sensor height in scene units for `f_number` (default 0.024: a full-frame sensor in
+        /// metres).
+        #[serde(default = "default_sensor_height")]
+        sensor_height: f32,
+        /// Distance from the lens to the plane in focus, along the view direction (> 0).
+        focus_distance: f32,
+    },
+}
+
+impl CameraSpec {
+    /// The view every camera model shares: `(eye, look_at, up, fov_y)`.
+    #[must_use]
+    pub fn view(&self) -> (Vec3Spec, Vec3Spec, Vec3Spec, f32) {
+        match *self {
+            CameraSpec::Pinhole {
+                eye,
+                look_at,
+                up,
+                fov_y,
+            }
+            | CameraSpec::ThinLens {
+                eye,
+                look_at,
+                up,
+                fov_y,
+                ..
+            } => (eye, look_at, up, fov_y),
+        }
+    }
+
+    /// The lens as `(aperture radius, focus distance)` in scene units: `None` for a pinhole.
+    /// An f-number becomes the radius `f / (2N)` with `f = (sensor_height/2) / tan(fov_y/2)`.
+    #[must_use]
+    pub fn lens(&self) -> Option<(f32, f32)> {
+        match *self {
+            CameraSpec::Pinhole { .. } => None,
+            CameraSpec::ThinLens {
+                fov_y,
+                aperture_radius,
+                f_number,
+                sensor_height,
+                focus_distance,
+                ..
+            } => {
+                let radius = match (aperture_radius, f_number) {
+                    (Some(r), _) => r,
+                    (None, Some(n)) => {
+                        let f = 0.5 * sensor_height / (0.5 * fov_y.to_radians()).tan();
+                        f / (2.0 * n)
+                    }
+                    (None, None) => 0.0,
+                };
+                Some((radius, focus_distance))
+            }
+        }
+    }
+}
+
+fn default_sensor_height() -> f32 {
+    0.024
 }
 
 fn default_up() -> Vec3Spec {

@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::Vec3Spec;
 use super::values::{ScaleSpec, exact_floats, one, unique_keys, unit_size, yes};
+use super::{EmissionSpec, Vec3Spec};
 
 /// A node of the scene graph. Transforms apply in list order (the first one first), and a
 /// group's transform applies after its children's.
@@ -33,8 +33,12 @@ pub enum NodeSpec {
         /// Transform steps.
         #[serde(default)]
         transform: Vec<TransformStep>,
-        /// Material name.
-        material: String,
+        /// Material name (required unless the node has `emission`).
+        #[serde(default)]
+        material: Option<String>,
+        /// Light the shape emits, making it an area light without a material.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        emission: Option<EmissionSpec>,
         /// Centre in object space.
         #[serde(default)]
         #[serde(deserialize_with = "exact_floats::<_, 3>")]
@@ -51,8 +55,12 @@ pub enum NodeSpec {
         /// Transform steps.
         #[serde(default)]
         transform: Vec<TransformStep>,
-        /// Material name.
-        material: String,
+        /// Material name (required unless the node has `emission`).
+        #[serde(default)]
+        material: Option<String>,
+        /// Light the shape emits, making it an area light without a material.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        emission: Option<EmissionSpec>,
         /// Edge length in object space (> 0).
         #[serde(default = "one")]
         size: f32,
@@ -65,8 +73,12 @@ pub enum NodeSpec {
         /// Transform steps.
         #[serde(default)]
         transform: Vec<TransformStep>,
-        /// Material name.
-        material: String,
+        /// Material name (required unless the node has `emission`).
+        #[serde(default)]
+        material: Option<String>,
+        /// Light the shape emits, making it an area light without a material.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        emission: Option<EmissionSpec>,
         /// Width (x) and height (y) in object space (> 0).
         #[serde(default = "unit_size")]
         #[serde(deserialize_with = "exact_floats::<_, 2>")]
@@ -100,6 +112,9 @@ pub enum NodeSpec {
         /// Interpolate the file's vertex normals when it has them.
         #[serde(default = "yes")]
         smooth: bool,
+        /// Light every face emits, making the mesh an area light without a material.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        emission: Option<EmissionSpec>,
     },
 }
 
@@ -155,16 +170,28 @@ impl NodeSpec {
         }
     }
 
-    /// The material a leaf node references (None for groups, and for a mesh that gives only
-    /// `materials`).
+    /// The material a leaf node references (None for groups, emissive shapes, and a mesh that
+    /// gives only `materials`).
     #[must_use]
     pub fn material(&self) -> Option<&str> {
         match self {
             NodeSpec::Group { .. } => None,
             NodeSpec::Sphere { material, .. }
             | NodeSpec::Cube { material, .. }
-            | NodeSpec::Quad { material, .. } => Some(material),
-            NodeSpec::Mesh { material, .. } => material.as_deref(),
+            | NodeSpec::Quad { material, .. }
+            | NodeSpec::Mesh { material, .. } => material.as_deref(),
+        }
+    }
+
+    /// The light a leaf node emits (None for groups and non-emissive shapes).
+    #[must_use]
+    pub fn emission(&self) -> Option<&EmissionSpec> {
+        match self {
+            NodeSpec::Group { .. } => None,
+            NodeSpec::Sphere { emission, .. }
+            | NodeSpec::Cube { emission, .. }
+            | NodeSpec::Quad { emission, .. }
+            | NodeSpec::Mesh { emission, .. } => emission.as_ref(),
         }
     }
 

@@ -21,6 +21,80 @@ impl<'a> Validator<'a> {
                 self.positive(&format!("{path}.radius"), *radius, "radius");
                 (power, format!("{path}.power"))
             }
+            LightSpec::Spot {
+                position,
+                direction,
+                intensity,
+                inner_angle,
+                outer_angle,
+                ..
+            } => {
+                self.finite3(&format!("{path}.position"), *position);
+                self.direction(&format!("{path}.direction"), *direction);
+                let outer_path = format!("{path}.outer_angle");
+                if self.finite(&outer_path, *outer_angle)
+                    && !(*outer_angle > 0.0 && *outer_angle <= 180.0)
+                {
+                    self.out.push(
+                        Diagnostic::error(
+                            &outer_path,
+                            format!("the cone's half-angle must be within (0, 180] degrees, found {outer_angle}"),
+                        )
+                        .with_help("a spot light's `outer_angle` is the half-angle of its cone in degrees, e.g. 30; use a `Point` light to light every direction"),
+                    );
+                }
+                let inner_path = format!("{path}.inner_angle");
+                if self.finite(&inner_path, *inner_angle)
+                    && !(*inner_angle >= 0.0 && *inner_angle <= *outer_angle)
+                {
+                    self.err(
+                        &inner_path,
+                        format!(
+                            "must be within [0, outer_angle = {outer_angle}] degrees, found {inner_angle}"
+                        ),
+                    );
+                }
+                self.radiometric(&format!("{path}.intensity"), *intensity);
+                return;
+            }
+            LightSpec::Distant {
+                direction,
+                irradiance,
+                angular_radius,
+                ..
+            } => {
+                self.direction(&format!("{path}.direction"), *direction);
+                let at = format!("{path}.angular_radius");
+                if self.finite(&at, *angular_radius)
+                    && !(*angular_radius >= 0.0 && *angular_radius < 90.0)
+                {
+                    self.out.push(
+                        Diagnostic::error(
+                            &at,
+                            format!("must be within [0, 90) degrees, found {angular_radius}"),
+                        )
+                        .with_help("the sun's angular radius is 0.2665; 0 is a delta direction"),
+                    );
+                }
+                self.radiometric(&format!("{path}.irradiance"), *irradiance);
+                return;
+            }
+            LightSpec::Environment {
+                radiance,
+                file,
+                rotation,
+                ..
+            } => {
+                self.finite(&format!("{path}.rotation"), *rotation);
+                if file.as_ref().is_some_and(|f| f.trim().is_empty()) {
+                    self.err(
+                        &format!("{path}.file"),
+                        "must name an OpenEXR file, found an empty string".into(),
+                    );
+                }
+                self.radiometric(&format!("{path}.radiance"), *radiance);
+                return;
+            }
         };
         if self.finite3(&power_path, *power) && power.iter().any(|c| *c < 0.0) {
             self.err(
@@ -37,6 +111,74 @@ impl<'a> Validator<'a> {
                     ),
                 )
                 .with_help("divide every light's power by a constant and multiply `render.exposure` by it: the image is the same"),
+            );
+        }
+    }
+
+    /// A direction: finite and not zero.
+    fn direction(&mut self, path: &str, d: [f32; 3]) {
+        if self.finite3(path, d) && d.iter().all(|c| *c == 0.0) {
+            self.err(path, "must not be the zero vector, found (0, 0, 0)".into());
+        }
+    }
+
+    /// An intensity, irradiance or radiance of a new light: finite, not negative, positive in
+    /// some channel (a black light is a mistake; remove it instead), at most
+    /// [`MAX_LIGHT_POWER`].
+    fn radiometric(&mut self, path: &str, v: [f32; 3]) {
+        if !self.finite3(path, v) {
+            return;
+        }
+        if v.iter().any(|c| *c < 0.0) || v.iter().all(|c| *c == 0.0) {
+            self.out.push(
+                Diagnostic::error(
+                    path,
+                    format!(
+                        "must be positive in some channel and negative in none, found {}",
+                        fmt3(v)
+                    ),
+                )
+                .with_help("remove a light that should not shine"),
+            );
+        } else if v.iter().any(|c| *c > MAX_LIGHT_POWER) {
+            self.err(
+                path,
+                format!(
+                    "must be at most {MAX_LIGHT_POWER:e} per channel, found {}",
+                    fmt3(v)
+                ),
+            );
+        }
+    }
+
+    /// At most one environment light, and no background beside it.
+    pub(super) fn environments(&mut self, scene: &SceneFile) {
+        let envs: Vec<usize> = (scene.lights.iter().enumerate())
+            .filter(|(_, l)| matches!(l, LightSpec::Environment { .. }))
+            .map(|(i, _)| i)
+            .collect();
+        if let [_, second, ..] = envs[..] {
+            self.out.push(
+                Diagnostic::error(
+                    format!("lights[{second}]"),
+                    format!(
+                        "a scene has at most one environment light, found {} (lights {envs:?})",
+                        envs.len()
+                    ),
+                )
+                .with_help("merge them into one map"),
+            );
+        }
+        if !envs.is_empty() && scene.render.background.iter().any(|c| *c != 0.0) {
+            self.out.push(
+                Diagnostic::error(
+                    "render.background",
+                    format!(
+                        "must be black with an environment light (which is what escaping rays see), found {}",
+                        fmt3(scene.render.background)
+                    ),
+                )
+                .with_help("remove `background`, or add it to the environment's `radiance`"),
             );
         }
     }

@@ -10,8 +10,8 @@ use std::collections::BTreeSet;
 
 use super::diagnostic::{Diagnostic, did_you_mean, quoted_list};
 use super::schema::{
-    CameraSpec, ColorSpec, LightSpec, MaterialSpec, NodeSpec, PhotonFilter, PhotonSettings,
-    RenderSettings, SceneFile, TextureSpec, TransformStep,
+    CameraSpec, ColorSpec, EmissionSpec, LightSpec, MaterialSpec, NodeSpec, PhotonFilter,
+    PhotonSettings, RenderSettings, SceneFile, TextureSpec, TransformStep,
 };
 
 /// Largest accepted image side, in pixels.
@@ -74,7 +74,7 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
     for (name, m) in &scene.materials {
         v.material(&format!("materials.{name}"), m);
     }
-    if scene.lights.is_empty() {
+    if scene.lights.is_empty() && !scene.nodes.iter().any(has_emission) {
         v.out.push(
             Diagnostic::warning(
                 "lights",
@@ -89,6 +89,7 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
             v.photon_count(&format!("lights[{i}].caustic_photons"), n);
         }
     }
+    v.environments(scene);
     v.caustic_map_total(scene);
     if scene.nodes.is_empty() {
         v.out.push(Diagnostic::error(
@@ -184,4 +185,15 @@ impl<'a> Validator<'a> {
 #[must_use]
 pub fn fmt3(v: [f32; 3]) -> String {
     format!("({}, {}, {})", v[0], v[1], v[2])
+}
+
+/// True when `n` or a node below it carries `emission`.
+fn has_emission(n: &NodeSpec) -> bool {
+    match n {
+        NodeSpec::Group { children, .. } => children.iter().any(has_emission),
+        NodeSpec::Sphere { .. }
+        | NodeSpec::Cube { .. }
+        | NodeSpec::Quad { .. }
+        | NodeSpec::Mesh { .. } => n.emission().is_some(),
+    }
 }

@@ -17,6 +17,9 @@ impl<'a> Validator<'a> {
         if let Some(material) = n.material() {
             self.material_ref(&format!("{path}.material"), material);
         }
+        if let Some(e) = n.emission() {
+            self.emission(path, n, e);
+        }
         match n {
             NodeSpec::Group { children, .. } => {
                 for (i, c) in children.iter().enumerate() {
@@ -24,11 +27,16 @@ impl<'a> Validator<'a> {
                 }
             }
             NodeSpec::Sphere { center, radius, .. } => {
+                self.shape_material(path, n);
                 self.finite3(&format!("{path}.center"), *center);
                 self.positive(&format!("{path}.radius"), *radius, "radius");
             }
-            NodeSpec::Cube { size, .. } => self.positive(&format!("{path}.size"), *size, "size"),
+            NodeSpec::Cube { size, .. } => {
+                self.shape_material(path, n);
+                self.positive(&format!("{path}.size"), *size, "size");
+            }
             NodeSpec::Quad { size, .. } => {
+                self.shape_material(path, n);
                 for (i, s) in size.iter().enumerate() {
                     self.positive(&format!("{path}.size[{i}]"), *s, "size");
                 }
@@ -49,7 +57,16 @@ impl<'a> Validator<'a> {
                     }
                     self.material_ref(&at, m);
                 }
-                if material.is_none() && materials.is_empty() {
+                if n.emission().is_some() && !materials.is_empty() {
+                    self.out.push(
+                        Diagnostic::error(
+                            format!("{path}.materials"),
+                            "an emissive mesh has no materials: `emission` and `materials` exclude each other",
+                        )
+                        .with_help("split the emitting faces into their own Mesh node"),
+                    );
+                }
+                if material.is_none() && materials.is_empty() && n.emission().is_none() {
                     self.out.push(
                         Diagnostic::error(path, "a mesh needs a `material` (or `materials` for its OBJ groups), found neither")
                             .with_help("add `material: \"name\"`, or `materials: {\"group\": \"name\", ...}` mapping each OBJ group or `usemtl` name"),
@@ -62,6 +79,57 @@ impl<'a> Validator<'a> {
                     );
                 }
             }
+        }
+    }
+
+    /// A sphere, cube or quad needs a `material` or an `emission`.
+    fn shape_material(&mut self, path: &str, n: &NodeSpec) {
+        if n.material().is_none() && n.emission().is_none() {
+            self.out.push(
+                Diagnostic::error(
+                    path,
+                    format!(
+                        "a {} needs a `material` (or an `emission` to be a light), found neither",
+                        n.kind()
+                    ),
+                )
+                .with_help("add `material: \"name\"`, or `emission: (radiance: (r, g, b))`"),
+            );
+        }
+    }
+
+    /// A node's `emission`: positive, finite radiance; no material beside it; one-sided
+    /// spheres only.
+    fn emission(&mut self, path: &str, n: &NodeSpec, e: &EmissionSpec) {
+        let at = format!("{path}.emission.radiance");
+        if self.finite3(&at, e.radiance)
+            && (e.radiance.iter().any(|c| *c < 0.0) || e.radiance.iter().all(|c| *c == 0.0))
+        {
+            self.out.push(
+                Diagnostic::error(
+                    &at,
+                    format!(
+                        "must be positive in some channel and negative in none, found {}",
+                        fmt3(e.radiance)
+                    ),
+                )
+                .with_help("radiance is in W/(m²·sr) per channel, e.g. `(5, 5, 5)`; remove `emission` for a shape that does not glow"),
+            );
+        }
+        if n.material().is_some() {
+            self.out.push(
+                Diagnostic::error(
+                    format!("{path}.material"),
+                    "an emissive shape has no material (it absorbs what reaches it): `material` and `emission` exclude each other",
+                )
+                .with_help("remove `material`, or put the emitter and the reflecting surface in two nodes"),
+            );
+        }
+        if e.two_sided && matches!(n, NodeSpec::Sphere { .. }) {
+            self.err(
+                &format!("{path}.emission.two_sided"),
+                "a sphere emits outwards only (its inside is closed); remove `two_sided`".into(),
+            );
         }
     }
 

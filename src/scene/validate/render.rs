@@ -60,12 +60,9 @@ impl<'a> Validator<'a> {
     }
 
     pub(super) fn camera(&mut self, c: &CameraSpec) {
-        let CameraSpec::Pinhole {
-            eye,
-            look_at,
-            up,
-            fov_y,
-        } = c;
+        let (eye, look_at, up, fov_y) = c.view();
+        let (eye, look_at, up, fov_y) = (&eye, &look_at, &up, &fov_y);
+        self.lens(c);
         let ok = self.finite3("camera.eye", *eye)
             & self.finite3("camera.look_at", *look_at)
             & self.finite3("camera.up", *up);
@@ -98,5 +95,40 @@ impl<'a> Validator<'a> {
                 ),
             );
         }
+    }
+
+    /// A thin lens: exactly one of `aperture_radius` (≥ 0) and `f_number` (> 0), a positive
+    /// sensor height and focus distance.
+    fn lens(&mut self, c: &CameraSpec) {
+        let CameraSpec::ThinLens {
+            aperture_radius,
+            f_number,
+            sensor_height,
+            focus_distance,
+            ..
+        } = c
+        else {
+            return;
+        };
+        match (aperture_radius, f_number) {
+            (Some(_), Some(_)) | (None, None) => self.out.push(
+                Diagnostic::error(
+                    "camera",
+                    "a thin lens needs exactly one of `aperture_radius` and `f_number`",
+                )
+                .with_help("e.g. `aperture_radius: 0.05` (scene units) or `f_number: 2.8`"),
+            ),
+            (Some(r), None) => {
+                if self.finite("camera.aperture_radius", *r) && *r < 0.0 {
+                    self.err(
+                        "camera.aperture_radius",
+                        format!("must not be negative, found {r}"),
+                    );
+                }
+            }
+            (None, Some(n)) => self.positive("camera.f_number", *n, "f-number"),
+        }
+        self.positive("camera.sensor_height", *sensor_height, "sensor height");
+        self.positive("camera.focus_distance", *focus_distance, "focus distance");
     }
 }
