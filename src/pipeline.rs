@@ -47,7 +47,7 @@ impl SceneOverrides {
         r.samples_per_pixel = self.samples_per_pixel.unwrap_or(r.samples_per_pixel);
         r.max_depth = self.max_depth.unwrap_or(r.max_depth);
         r.seed = self.seed.unwrap_or(r.seed);
-        r.integrator = self.integrator.unwrap_or(r.integrator);
+        r.integrator = self.integrator.or(r.integrator);
         r.sampler = self.sampler.unwrap_or(r.sampler);
         if let Some(n) = self.caustic_photons {
             s.photons.caustic = n;
@@ -134,8 +134,9 @@ pub fn check(
 /// Reads, overrides, validates and compiles a scene file.
 pub fn prepare(path: &Path, overrides: &SceneOverrides) -> Result<Prepared, Error> {
     let (source, scene, warnings) = check(path, overrides)?;
-    let (render_scene, mut stats) = compile(&scene, &source.base_dir())
+    let (mut render_scene, mut stats) = compile(&scene, &source.base_dir())
         .map_err(|errs| SceneError::Invalid(locate(&source, errs, overrides)))?;
+    keep_stated_photons(&mut render_scene, &scene, overrides);
     let mut warnings = warnings;
     warnings.extend(locate(
         &source,
@@ -149,6 +150,40 @@ pub fn prepare(path: &Path, overrides: &SceneOverrides) -> Result<Prepared, Erro
         stats,
         warnings,
     })
+}
+
+/// The default estimator chooses its per-pass photon counts itself, but counts stated on the
+/// command line (`--set photons.caustic=…`, `--caustic-photons`, `--photons`, `--gather`) are
+/// per pass and win: they replace the chosen ones, and the summary says so.
+fn keep_stated_photons(rs: &mut RenderScene, scene: &SceneFile, overrides: &SceneOverrides) {
+    let Some(choice) = rs.params.default_estimator.as_mut() else {
+        return;
+    };
+    if choice.photons.is_none() {
+        return;
+    }
+    let stated = overrides.paths();
+    let is_stated = |field: &str| stated.iter().any(|p| p == &format!("photons.{field}"));
+    let p = &mut rs.params.photons;
+    let mut any = false;
+    for (field, value, from) in [
+        ("caustic", &mut p.caustic, scene.photons.caustic),
+        ("global", &mut p.global, scene.photons.global),
+        (
+            "caustic_gather",
+            &mut p.caustic_gather,
+            scene.photons.caustic_gather,
+        ),
+        ("gather", &mut p.gather, scene.photons.gather),
+    ] {
+        if is_stated(field) {
+            *value = from;
+            any = true;
+        }
+    }
+    if any {
+        choice.photons = None;
+    }
 }
 
 fn locate(

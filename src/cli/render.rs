@@ -346,6 +346,15 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         }
         other => other?,
     };
+    if !args.quiet
+        && let Some(why) = &prepared.render_scene.params.default_estimator
+    {
+        // The scene and the command line named no integrator: which one, and why.
+        eprintln!(
+            "default estimator {}",
+            why.describe(prepared.render_scene.params.integrator)
+        );
+    }
     let maps = job.integrator().photon_maps();
     if !args.quiet
         && let Some(maps) = maps
@@ -444,12 +453,17 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     };
     let p = &prepared.render_scene.params;
     println!(
-        "{}: {}×{}, {} spp{range}, {:?} integrator, {:?} sampler, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
+        "{}: {}×{}, {} spp{range}, {:?} integrator{}, {:?} sampler, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
         output.display(),
         out.film.width,
         out.film.height,
         reached,
         p.integrator,
+        if p.default_estimator.is_some() {
+            " (default)"
+        } else {
+            ""
+        },
         p.sampler,
         st.rays,
         secs,

@@ -15,7 +15,7 @@ use crate::accel::BvhStats;
 use crate::render_scene::PhotonParams;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::render_scene::light::escape::EnvironmentRef;
-use crate::render_scene::{Camera, Light, ObjectInfo, RenderParams, RenderScene};
+use crate::render_scene::{Camera, DefaultEstimator, Light, ObjectInfo, RenderParams, RenderScene};
 use crate::scene::Diagnostic;
 use crate::scene::schema::{self, LightSpec, SceneFile};
 
@@ -210,6 +210,26 @@ pub fn compile(
     stats.bvh = geometry.bvh.stats();
 
     let r = &scene.render;
+    let (integrator, default_estimator) = match r.integrator {
+        Some(kind) => (kind, None),
+        None => {
+            let (kind, why) = DefaultEstimator::choose(
+                &objects,
+                |m| materials.list.get(m).map(|(_, m)| m),
+                r.width,
+                r.height,
+            );
+            (kind, Some(why))
+        }
+    };
+    let mut photons = photon_params(&scene.photons, &scene.lights);
+    if let Some(p) = default_estimator.and_then(|d| d.photons) {
+        // The default estimator's own per-pass budget (the scene's counts are per render).
+        photons.caustic = p.caustic;
+        photons.caustic_gather = p.caustic_gather;
+        photons.global = p.global;
+        photons.caustic_per_light.iter_mut().for_each(|c| *c = None);
+    }
     let params = RenderParams {
         width: r.width,
         height: r.height,
@@ -220,11 +240,12 @@ pub fn compile(
         seed: r.seed,
         background: r.background.into(),
         exposure: r.exposure,
-        integrator: r.integrator,
+        integrator,
+        default_estimator,
         sampler: r.sampler,
         diffuse_depth: r.diffuse_depth.unwrap_or(u32::MAX),
         texture_filter: r.texture_filter,
-        photons: photon_params(&scene.photons, &scene.lights),
+        photons,
     };
     let mut params = params;
     // Emissive shapes have no budget of their own: they share `photons.caustic` by power.

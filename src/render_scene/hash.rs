@@ -79,6 +79,7 @@ fn hash_params(h: &mut Fnv, params: &RenderParams) {
         background: _,
         exposure: _,
         integrator: _,
+        default_estimator: _,
         sampler,
         diffuse_depth: _,
         texture_filter,

@@ -1,6 +1,7 @@
 //! The flat, world-space, immutable scene that integrators render: produced only by `compile`.
 
 pub mod camera;
+pub mod default_estimator;
 pub mod geometry;
 pub mod hash;
 pub mod interaction;
@@ -12,6 +13,7 @@ pub mod surface;
 pub mod texture;
 
 pub use camera::Camera;
+pub use default_estimator::{DefaultEstimator, PassPhotons};
 pub use geometry::{Geometry, Hit, PrimRef};
 pub use interaction::{EmitterHit, Interaction, SurfaceHit};
 pub use light::{EmissionSample, Light, LightSample};
@@ -48,8 +50,11 @@ pub struct RenderParams {
     pub background: Vec3,
     /// Radiance scale applied when writing 8-bit images.
     pub exposure: f32,
-    /// Which integrator renders the image.
+    /// Which integrator renders the image (the scene's or the command line's, else the default
+    /// estimator's choice).
     pub integrator: IntegratorKind,
+    /// Why `integrator` was chosen when the scene and command line named none (`None`: named).
+    pub default_estimator: Option<DefaultEstimator>,
     /// Where integrators draw random numbers from.
     pub sampler: SamplerKind,
     /// Path tracing: most non-delta bounces per path (`u32::MAX`: only `max_depth` limits).

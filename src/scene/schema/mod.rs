@@ -78,8 +78,13 @@ pub struct RenderSettings {
     pub background: Rgb,
     /// Linear scale applied to radiance before writing 8-bit images.
     pub exposure: f32,
-    /// Light-transport algorithm.
-    pub integrator: IntegratorKind,
+    /// Light-transport algorithm. Unset: the default estimator, chosen per scene — `PathPpm`
+    /// (path tracing with a progressive caustic photon map, per-pass photon counts and gather
+    /// sizes chosen from the image size; see docs/progressive.md) when some object's material
+    /// has a mirror or glass part that could focus light onto a diffuse surface, else `Path`
+    /// (no photon pass at all). Naming an integrator here or with `--integrator` picks it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<IntegratorKind>,
     /// Where the integrators' random numbers come from.
     pub sampler: SamplerKind,
     /// Path tracing: most diffuse or glossy bounces a path may make (unset: up to `max_depth`);
@@ -102,7 +107,7 @@ impl Default for RenderSettings {
             seed: 0,
             background: [0.0; 3],
             exposure: 1.0,
-            integrator: IntegratorKind::Whitted,
+            integrator: None,
             sampler: SamplerKind::Sobol,
             diffuse_depth: None,
             texture_filter: TextureFilter::Anisotropic,
