@@ -192,4 +192,29 @@ mod tests {
         assert_eq!(parse_value("(1, 2, 3)"), serde_json::json!([1, 2, 3]));
         assert_eq!(parse_value("glass"), serde_json::json!("glass"));
     }
+
+    #[test]
+    fn optional_fields_a_scene_leaves_unset_can_be_set() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
+        let scene = crate::scene::source::SourceFile::read(&path)
+            .and_then(|s| s.parse())
+            .unwrap();
+        assert_eq!(scene.render.integrator, None);
+        let set = apply_overrides(
+            &scene,
+            &[
+                "render.integrator=Path".into(),
+                r#"nodes[1].emission={"radiance": [1, 2, 3]}"#.into(),
+            ],
+        )
+        .unwrap();
+        assert_eq!(
+            set.render.integrator,
+            Some(crate::settings::IntegratorKind::Path)
+        );
+        let crate::scene::schema::NodeSpec::Sphere { emission, .. } = &set.nodes[1] else {
+            panic!("still a sphere");
+        };
+        assert!(emission.is_some());
+    }
 }

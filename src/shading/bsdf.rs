@@ -264,7 +264,11 @@ impl Bsdf {
                 tinted: c.is_none(),
             }),
         };
-        if let Some(m) = mirror {
+        // A part of weight 0 is never chosen: leave it as it is, so that a BSDF without a
+        // mirror part equals itself with or without microfacets.
+        if let Some(m) = mirror
+            && self.parts[1].weight > 0.0
+        {
             self.parts[1].lobes = [Some(m), None];
         }
         if let Some(g) = distribution {

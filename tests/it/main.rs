@@ -9,6 +9,7 @@ mod common;
 mod compare;
 mod converge;
 mod determinism;
+mod doc_commands;
 mod doc_images;
 mod doc_snippets;
 mod farm;

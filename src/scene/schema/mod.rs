@@ -83,7 +83,7 @@ pub struct RenderSettings {
     /// sizes chosen from the image size; see docs/progressive.md) when some object's material
     /// has a mirror or glass part that could focus light onto a diffuse surface, else `Path`
     /// (no photon pass at all). Naming an integrator here or with `--integrator` picks it.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub integrator: Option<IntegratorKind>,
     /// Where the integrators' random numbers come from.
     pub sampler: SamplerKind,

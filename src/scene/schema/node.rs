@@ -37,7 +37,7 @@ pub enum NodeSpec {
         #[serde(default)]
         material: Option<String>,
         /// Light the shape emits, making it an area light without a material.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(default)]
         emission: Option<EmissionSpec>,
         /// Centre in object space.
         #[serde(default)]
@@ -59,7 +59,7 @@ pub enum NodeSpec {
         #[serde(default)]
         material: Option<String>,
         /// Light the shape emits, making it an area light without a material.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(default)]
         emission: Option<EmissionSpec>,
         /// Edge length in object space (> 0).
         #[serde(default = "one")]
@@ -77,7 +77,7 @@ pub enum NodeSpec {
         #[serde(default)]
         material: Option<String>,
         /// Light the shape emits, making it an area light without a material.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(default)]
         emission: Option<EmissionSpec>,
         /// Width (x) and height (y) in object space (> 0).
         #[serde(default = "unit_size")]
@@ -113,7 +113,7 @@ pub enum NodeSpec {
         #[serde(default = "yes")]
         smooth: bool,
         /// Light every face emits, making the mesh an area light without a material.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(default)]
         emission: Option<EmissionSpec>,
     },
 }
