@@ -5,8 +5,9 @@
 
 use glam::Vec3;
 
-use super::Counters;
+use super::splat::FilmSplats;
 use super::trace_log::{RayKind, ShadowRecord, TraceHit, TraceLog};
+use super::{Counters, LightPath};
 use crate::geometry::Ray;
 use crate::render_scene::{Hit, RenderScene, SurfacePoint};
 use crate::sampling::Sampler;
@@ -149,7 +150,8 @@ impl PathObserver for TraceLog {
 }
 
 /// The context an estimator runs in for one camera sample: the sampler (already started on
-/// this pixel sample), the worker's ray counters, and the path observer.
+/// this pixel sample), the worker's ray counters, the path observer, and the job's splat
+/// buffers for contributions to other pixels than the one sampled.
 #[derive(Debug)]
 pub struct Context<'c, O: PathObserver> {
     /// Where random numbers come from.
@@ -158,6 +160,9 @@ pub struct Context<'c, O: PathObserver> {
     pub counters: &'c mut Counters,
     /// Who watches the paths ([`NoTrace`] in renders, a [`TraceLog`] in `debug-pixel`).
     pub observer: &'c mut O,
+    /// Where contributions to other pixels go ([`Context::splat`]): `Some` in a render job of
+    /// an estimator that declares [`Estimator::splats`](super::Estimator::splats).
+    pub splats: Option<&'c FilmSplats>,
 }
 
 impl<'c, O: PathObserver> Context<'c, O> {
@@ -168,6 +173,28 @@ impl<'c, O: PathObserver> Context<'c, O> {
             sampler,
             counters,
             observer,
+            splats: None,
+        }
+    }
+
+    /// The context with the job's splat buffers (`None`: splats are not kept).
+    #[inline]
+    #[must_use]
+    pub fn with_splats(mut self, splats: Option<&'c FilmSplats>) -> Self {
+        self.splats = splats;
+        self
+    }
+
+    /// Adds `value` (W·m⁻²·sr⁻¹ per channel) of light-path kind `kind` to image pixel `(x, y)`
+    /// as a contribution of this camera sample — light tracing's camera connections, BDPT's
+    /// t = 1 strategy (Veach 1997, §10.2). The pixel's value becomes (Σ samples + Σ splats) /
+    /// spp: the contract of [`super::splat`]. Without splat buffers (an estimator that does not
+    /// declare [`Estimator::splats`](super::Estimator::splats), or `debug-pixel`) the value is
+    /// not kept.
+    #[inline]
+    pub fn splat(&self, x: u32, y: u32, kind: LightPath, value: Vec3) {
+        if let Some(s) = self.splats {
+            s.add(x, y, kind, value);
         }
     }
 }

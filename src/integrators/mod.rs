@@ -145,6 +145,12 @@ pub trait Estimator<'a> {
         None
     }
 
+    /// True if it adds to other pixels than the one sampled ([`Context::splat`]): the render
+    /// job then keeps splat buffers and merges them into the film after every sweep.
+    fn splats(&self) -> bool {
+        false
+    }
+
     /// The per-pass photon maps of a progressive integrator.
     fn progressive(&self) -> Option<&photon::ProgressivePhotons<'a>> {
         None
@@ -204,6 +210,14 @@ macro_rules! integrators {
             pub fn photon_maps(&self) -> Option<&photon::PhotonMaps> {
                 match self {
                     $(Integrator::$variant(x) => x.photon_maps(),)*
+                }
+            }
+
+            /// True if the integrator splats to other pixels ([`Estimator::splats`]).
+            #[must_use]
+            pub fn splats(&self) -> bool {
+                match self {
+                    $(Integrator::$variant(x) => x.splats(),)*
                 }
             }
 

@@ -23,6 +23,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec3, Vec3};
 
+use super::LightPath;
+
 /// Fixed-point scale of the film's sums and of splats: values are rounded to multiples of
 /// 2⁻⁶⁴ (about 5.4e-20) before summing.
 pub const SUM_SCALE: f64 = 18_446_744_073_709_551_616.0;
@@ -112,6 +114,13 @@ impl SplatBuffer {
         }
     }
 
+    /// Sets every sum to zero (the dropped count stays).
+    pub fn clear(&mut self) {
+        for w in self.lo.iter_mut().chain(self.hi.iter_mut()) {
+            *w.get_mut() = 0;
+        }
+    }
+
     /// Splats dropped so far (non-finite values, pixels outside the film).
     #[must_use]
     pub fn dropped(&self) -> u64 {
@@ -163,6 +172,61 @@ impl SplatBuffer {
         }
         *self.dropped.get_mut() += *other.dropped.get_mut();
         Ok(())
+    }
+}
+
+/// The splats of one render job: a buffer over the job's region for the beauty image and, when
+/// the job keeps the light-path layers (`--layers`), one per [`LightPath`], so that the layers
+/// still sum to the image. Estimators add to it through
+/// [`Context::splat`](super::context::Context::splat) in image pixel coordinates (from the
+/// top-left of the whole image); the job merges it into its film after each sweep
+/// (`RenderJob`'s sweep, through `PixelSums::add_splats`), exactly, so splatting estimators keep the film's determinism
+/// and its mergeability (passes, `.part` shards). A splat onto a pixel outside the job's region
+/// is dropped and counted (a region render holds only its own pixels).
+#[derive(Debug)]
+pub struct FilmSplats {
+    /// Top-left pixel of the region, in image coordinates.
+    origin: (u32, u32),
+    /// The beauty image's splats.
+    total: SplatBuffer,
+    /// Per light-path layer, in [`LightPath`] order, when the job keeps layers.
+    parts: Option<[SplatBuffer; 4]>,
+}
+
+impl FilmSplats {
+    /// Empty buffers for the `width × height` region whose top-left pixel is `origin`, with
+    /// per-layer buffers when `layers`.
+    #[must_use]
+    pub fn new(origin: (u32, u32), width: u32, height: u32, layers: bool) -> Self {
+        Self {
+            origin,
+            total: SplatBuffer::new(width, height),
+            parts: layers.then(|| std::array::from_fn(|_| SplatBuffer::new(width, height))),
+        }
+    }
+
+    /// Adds `value` (W·m⁻²·sr⁻¹ per channel, a camera sample's contribution) of light-path
+    /// kind `kind` to image pixel `(x, y)`. Safe from any number of workers at once.
+    #[inline]
+    pub fn add(&self, x: u32, y: u32, kind: LightPath, value: Vec3) {
+        // Left of or above the region wraps to a huge index, which `add` drops as outside.
+        let (rx, ry) = (x.wrapping_sub(self.origin.0), y.wrapping_sub(self.origin.1));
+        self.total.add(rx, ry, value);
+        if let Some(parts) = &self.parts {
+            parts[kind as usize].add(rx, ry, value);
+        }
+    }
+
+    /// Splats dropped so far (non-finite, or outside the region).
+    #[must_use]
+    pub fn dropped(&self) -> u64 {
+        self.total.dropped()
+    }
+
+    /// The beauty buffer and the per-layer buffers (for the job's merge into its films; see
+    /// `PixelSums::add_splats` and [`SplatBuffer::clear`]).
+    pub fn buffers_mut(&mut self) -> (&mut SplatBuffer, Option<&mut [SplatBuffer; 4]>) {
+        (&mut self.total, self.parts.as_mut())
     }
 }
 
@@ -292,5 +356,42 @@ mod tests {
         assert_eq!(other.sum(1, 1), Vec3::ZERO);
         assert_eq!(other.sum(0, 1), v);
         assert_eq!(other.fixed_sum(5), [0; 3]);
+    }
+
+    #[test]
+    fn film_splats_land_in_region_coordinates_and_in_their_layer() {
+        // A 3 × 2 region whose top-left is image pixel (10, 20).
+        let mut f = FilmSplats::new((10, 20), 3, 2, true);
+        let v = Vec3::new(0.5, 0.25, 2.0);
+        f.add(12, 21, LightPath::Caustic, v); // region pixel (2, 1)
+        f.add(10, 20, LightPath::Direct, v); // region pixel (0, 0)
+        f.add(12, 21, LightPath::Caustic, v);
+        // Left of, above, right of and below the region: dropped, not wrapped onto it.
+        f.add(9, 20, LightPath::Direct, v);
+        f.add(10, 19, LightPath::Direct, v);
+        f.add(13, 20, LightPath::Direct, v);
+        f.add(10, 22, LightPath::Direct, v);
+        assert_eq!(f.dropped(), 4);
+        let (total, layers) = f.buffers_mut();
+        assert_eq!(total.sum(2, 1), 2.0 * v);
+        assert_eq!(total.sum(0, 0), v);
+        assert_eq!(total.sum(1, 0), Vec3::ZERO);
+        let layers = layers.expect("layers kept");
+        assert_eq!(layers[LightPath::Caustic as usize].sum(2, 1), 2.0 * v);
+        assert_eq!(layers[LightPath::Caustic as usize].sum(0, 0), Vec3::ZERO);
+        assert_eq!(layers[LightPath::Direct as usize].sum(0, 0), v);
+        // The layers sum to the beauty at every pixel.
+        for (x, y) in [(0, 0), (1, 0), (2, 0), (0, 1), (1, 1), (2, 1)] {
+            let sum: Vec3 = layers.iter_mut().map(|b| b.sum(x, y)).sum();
+            assert_eq!(sum, total.sum(x, y));
+        }
+        total.clear();
+        assert_eq!(total.sum(2, 1), Vec3::ZERO);
+        assert!(
+            FilmSplats::new((0, 0), 3, 2, false)
+                .buffers_mut()
+                .1
+                .is_none()
+        );
     }
 }

@@ -15,8 +15,9 @@ use super::options::{
     ProgressiveStats, Region, RenderError, RenderOptions, RenderOutput, RenderStats, check_region,
 };
 use super::pixel_sums::PixelSums;
-use super::tiles::{TileResult, new_parts, pixel_index, render_tile, tile_grid};
+use super::tiles::{Sweep, TileResult, new_parts, pixel_index, render_tile, tile_grid};
 use crate::integrators::Integrator;
+use crate::integrators::splat::FilmSplats;
 use crate::render_scene::RenderScene;
 
 /// Renders `scene` (or a region of it) in one pass of all its samples per pixel.
@@ -42,6 +43,8 @@ pub struct RenderJob<'a> {
     progress: ProgressBar,
     /// Per-pixel sample statistics over the samples done, row-major over the region.
     sums: PixelSums,
+    /// Contributions to other pixels than the one sampled, for an estimator that splats.
+    splats: Option<FilmSplats>,
     /// The same per kind of light path, when kept.
     parts: Option<Vec<PixelSums>>,
     /// First sample index this job takes.
@@ -117,6 +120,10 @@ impl<'a> RenderJob<'a> {
                 scene.params.samples_per_pixel,
             ));
         }
+        let splats = integrator.splats().then(|| {
+            let layers = options.light_paths;
+            FilmSplats::new((region.x, region.y), region.width, region.height, layers)
+        });
         let spp = u64::from(range.end - range.start);
         let progress = progress_bar(options.progress, tiles.len() as u64 * spp);
         Ok(Self {
@@ -128,6 +135,7 @@ impl<'a> RenderJob<'a> {
             cancel: options.cancel.clone(),
             progress,
             sums: PixelSums::new(region.width, region.height),
+            splats,
             parts: options
                 .light_paths
                 .then(|| new_parts(region.width, region.height)),
@@ -190,16 +198,19 @@ impl<'a> RenderJob<'a> {
         if end == self.done {
             return Ok(());
         }
-        let (integrator, region, samples) = (&self.integrator, self.region, self.done..end);
-        let (progress, cancel) = (&self.progress, self.cancel.as_deref());
+        let (region, samples) = (self.region, self.done..end);
+        let sweep = Sweep {
+            scene: self.scene,
+            integrator: &self.integrator,
+            keep_parts: self.parts.is_some(),
+            splats: self.splats.as_ref(),
+            cancel: self.cancel.as_deref(),
+            progress: &self.progress,
+        };
         let results: Option<Vec<TileResult>> = self.pool.install(|| {
             self.tiles
                 .par_iter()
-                .map(|t| {
-                    let samples = samples.clone();
-                    let parts = self.parts.is_some();
-                    render_tile(self.scene, integrator, t, samples, parts, cancel, progress)
-                })
+                .map(|t| render_tile(&sweep, t, samples.clone()))
                 .collect()
         });
         let Some(results) = results else {
@@ -219,6 +230,10 @@ impl<'a> RenderJob<'a> {
             self.stats.photon_estimates += r.counters.photon_estimates;
             self.stats.photon_radius_cut += r.counters.photon_radius_cut;
             self.stats.nan_samples += r.nan;
+        }
+        if let Some(splats) = self.splats.as_mut() {
+            // Exact fixed-point sums: the order of splats and tiles never shows in the bytes.
+            merge_splats(splats, &mut self.sums, self.parts.as_mut());
         }
         self.done = end;
         Ok(())
@@ -262,6 +277,11 @@ impl<'a> RenderJob<'a> {
         self.region = region;
         self.tiles = tile_grid(region);
         self.sums = PixelSums::new(region.width, region.height);
+        if self.splats.is_some() {
+            let layers = self.parts.is_some();
+            let origin = (region.x, region.y);
+            self.splats = Some(FilmSplats::new(origin, region.width, region.height, layers));
+        }
         if self.parts.is_some() {
             self.parts = Some(new_parts(region.width, region.height));
         }
@@ -331,6 +351,22 @@ impl Drop for RenderJob<'_> {
 }
 
 /// The tile progress bar on stderr (hidden unless `enabled`), counting tile-samples.
+/// Adds the sweep's splats into the film (and its layers) and empties the buffers. The
+/// buffers are made for the job's region, as the films are: the sizes always match.
+fn merge_splats(splats: &mut FilmSplats, sums: &mut PixelSums, parts: Option<&mut Vec<PixelSums>>) {
+    let (total, layers) = splats.buffers_mut();
+    let merged = sums.add_splats(total);
+    debug_assert!(merged.is_ok(), "splat buffers are the region's size");
+    total.clear();
+    if let (Some(films), Some(buffers)) = (parts, layers) {
+        for (film, buffer) in films.iter_mut().zip(buffers.iter_mut()) {
+            let merged = film.add_splats(buffer);
+            debug_assert!(merged.is_ok(), "splat buffers are the region's size");
+            buffer.clear();
+        }
+    }
+}
+
 fn progress_bar(enabled: bool, tiles: u64) -> ProgressBar {
     if !enabled {
         return ProgressBar::hidden();

@@ -10,6 +10,7 @@ use indicatif::ProgressBar;
 use super::options::Region;
 use super::pixel_sums::PixelSums;
 use crate::geometry::Ray;
+use crate::integrators::splat::FilmSplats;
 use crate::integrators::{Context, Counters, Integrator, LightPath, NoTrace};
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
@@ -65,17 +66,32 @@ pub(super) struct TileResult {
     pub(super) nan: u64,
 }
 
-/// Takes samples `samples` of each pixel of `tile`. `None` when `cancel` is raised: it is
-/// checked before each pixel, never per ray.
+/// What every tile of one sweep shares: the scene, the prepared integrator, whether the
+/// light-path layers are kept, the job's splat buffers, the cancel flag and the progress bar.
+pub(super) struct Sweep<'s, 'a> {
+    pub(super) scene: &'s RenderScene,
+    pub(super) integrator: &'s Integrator<'a>,
+    pub(super) keep_parts: bool,
+    pub(super) splats: Option<&'s FilmSplats>,
+    pub(super) cancel: Option<&'s AtomicBool>,
+    pub(super) progress: &'s ProgressBar,
+}
+
+/// Takes samples `samples` of each pixel of `tile`. `None` when `sweep.cancel` is raised: it
+/// is checked before each pixel, never per ray.
 pub(super) fn render_tile(
-    scene: &RenderScene,
-    integrator: &Integrator,
+    sweep: &Sweep<'_, '_>,
     tile: &Region,
     samples: Range<u32>,
-    keep_parts: bool,
-    cancel: Option<&AtomicBool>,
-    progress: &ProgressBar,
 ) -> Option<TileResult> {
+    let Sweep {
+        scene,
+        integrator,
+        keep_parts,
+        splats,
+        cancel,
+        progress,
+    } = *sweep;
     let mut sampler = Sampler::new(
         scene.params.sampler,
         scene.params.seed,
@@ -97,7 +113,7 @@ pub(super) fn render_tile(
             let ray = camera_sample(scene, &mut sampler, x, y, s);
             let r = integrator.li_parts(
                 ray,
-                &mut Context::new(&mut sampler, &mut counters, &mut NoTrace),
+                &mut Context::new(&mut sampler, &mut counters, &mut NoTrace).with_splats(splats),
             );
             let l = r.total();
             if l.is_finite() {

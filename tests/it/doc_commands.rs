@@ -155,7 +155,13 @@ fn reduce_invocation(cmd: &str) -> String {
     let words: Vec<&str> = cmd.split_whitespace().collect();
     let sub = words.get(1).copied().unwrap_or("");
     let renders = matches!(sub, "render" | "converge" | "photons" | "golden" | "farm");
-    let on_job = cmd.contains("job/scene.ron");
+    // A farm job folder's scene (`job/scene.ron`, `local/scene.ron`): written by `farm plan`.
+    let on_job = words.iter().any(|w| w.ends_with("/scene.ron"));
+    if on_job && sub == "render" && !cmd.contains("--time") {
+        // A shard of a time-budgeted plan has millions of samples per pixel and ends by its
+        // job script's `--time`: give the rerun a budget (not a setting: the hash still holds).
+        return format!("{cmd} --time 1s");
+    }
     if !renders || on_job || (sub == "farm" && words.get(2) != Some(&"plan")) {
         return cmd.to_string();
     }
@@ -184,7 +190,10 @@ fn reduce_invocation(cmd: &str) -> String {
         let budget = if sub == "converge" { "3s" } else { "1s" };
         c = replace_flag(&c, "--time", |_| Some(budget.into()));
     }
-    for (flag, value) in PHOTON_FLAGS {
+    // Goldens keep the scene's photon counts: the check's statistics see the camera samples'
+    // noise, not a tiny photon map's (whose error is shared by every pixel it lights).
+    let photons: &[(&str, &str)] = if sub == "golden" { &[] } else { PHOTON_FLAGS };
+    for (flag, value) in photons {
         if c.contains(&format!("{flag} ")) {
             c = replace_flag(&c, flag, |_| Some((*value).into()));
         } else {

@@ -8,7 +8,7 @@ fn scene(s: f64, t: f64) -> String {
     let p =
         |x: f64, y: f64, z: f64| format!("({}, {}, {})", f(x * s + t), f(y * s + t), f(z * s + t));
     format!(
-        "Scene(render: (width: 64, height: 64, samples_per_pixel: 1, max_depth: 2, seed: 1),
+        "Scene(render: (integrator: Whitted, width: 64, height: 64, samples_per_pixel: 1, max_depth: 2, seed: 1),
           camera: Pinhole(eye: {eye}, look_at: {at}, fov_y: 40),
           materials: {{ \"floor\": (color: (0.7, 0.7, 0.7)), \"ball\": (color: (0.8, 0.3, 0.2), diffuse: 0.7, reflect: 0.3),
                         \"mesh\": (color: (0.3, 0.6, 0.8)) }},

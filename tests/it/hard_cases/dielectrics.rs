@@ -95,7 +95,7 @@ fn grazing_and_index_matched_incidence_stay_finite() {
 fn camera_inside_a_glass_sphere_sees_out() {
     // Rays start inside: they must exit (refract or reflect internally) and never go NaN.
     let s = scene(
-        "Scene(render: (width: 24, height: 24, samples_per_pixel: 1, max_depth: 6),
+        "Scene(render: (integrator: Whitted, width: 24, height: 24, samples_per_pixel: 1, max_depth: 6),
            camera: Pinhole(eye: (0, 0, 0), look_at: (0, 0, -1), fov_y: 90),
            materials: { \"glass\": (transmit: 1, ior: 1.5), \"wall\": (color: (0.8, 0.8, 0.8)) },
            lights: [Point(position: (0, 0, 1.5), power: (100, 100, 100))],
@@ -130,7 +130,7 @@ fn still_life(extra: &str, materials: &str) -> caustic::render::Film {
 fn still_life_with(extra: &str, materials: &str, ball: &str) -> caustic::render::Film {
     let s = scene(&format!(
         r#"Scene(
-            render: (width: 80, height: 60, samples_per_pixel: 4, seed: 5, background: (0.2, 0.25, 0.3)),
+            render: (integrator: Whitted, width: 80, height: 60, samples_per_pixel: 4, seed: 5, background: (0.2, 0.25, 0.3)),
             camera: Pinhole(eye: (0, 1.5, 5), look_at: (0, 0.5, 0), fov_y: 40),
             materials: {{ "floor": (color: (0.7, 0.7, 0.7)), "ball": (color: {ball}) {materials} }},
             lights: [Point(position: (2, 5, 3), power: (800, 800, 800))],
@@ -195,7 +195,7 @@ fn a_ball_half_under_water_is_lit_and_seen_through_the_surface() {
     );
     let s = scene(
         r#"Scene(
-            render: (width: 80, height: 60),
+            render: (integrator: Whitted, width: 80, height: 60),
             camera: Pinhole(eye: (0, 1.5, 5), look_at: (0, 0.5, 0), fov_y: 40),
             materials: { "m": () }, lights: [],
             nodes: [Cube(material: "m", size: 1, transform: [Scale((3, 0.5, 3)), Translate(0, 0.25, 0)])],
@@ -231,7 +231,7 @@ fn pane_transmission(angle: f32) -> f32 {
     let render = |pane: &str| {
         let sc = scene(&format!(
             r#"Scene(
-                render: (width: 16, height: 16, samples_per_pixel: 1),
+                render: (integrator: Whitted, width: 16, height: 16, samples_per_pixel: 1),
                 camera: Pinhole(eye: (0, 0.5, 0.001), look_at: (0, 0, 0), fov_y: 10),
                 materials: {{ "floor": (color: (0.5, 0.5, 0.5)), "glass": (color: (1, 1, 1), diffuse: 0, transmit: 1, ior: 1.5) }},
                 lights: [Point(position: ({}, {}, {}), power: (1000, 1000, 1000))],

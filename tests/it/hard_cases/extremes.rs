@@ -11,7 +11,7 @@ fn cornell_like(power: &str, extra: &str) -> String {
         extra.to_string()
     };
     format!(
-        "Scene(render: ({render}, seed: 9),
+        "Scene(render: (integrator: Whitted, {render}, seed: 9),
           camera: Pinhole(eye: (0, 1, 3.5), look_at: (0, 1, 0), fov_y: 45),
           materials: {{ \"white\": (color: (0.75, 0.75, 0.75)), \"mirror\": (reflect: 1, color: (0.9, 0.9, 0.9)),
                         \"glass\": (transmit: 1, ior: 1.5, color: (1, 1, 1)) }},
@@ -104,7 +104,7 @@ fn albedo_one_mirrors_do_not_create_energy() {
     // The light's mirror images lie at z = -2, -6, … on the line x = y = 0.5; the one at z = -6
     // (three reflections) is seen 0.5 / 6.9 = tan 4.1° off-axis, 1.3 pixels in radius, so at
     // least one pixel sees nothing but the light through the mirrors: exactly its radiance.
-    let text = "Scene(render: (width: 16, height: 16, samples_per_pixel: 1, max_depth: 40),
+    let text = "Scene(render: (integrator: Whitted, width: 16, height: 16, samples_per_pixel: 1, max_depth: 40),
         camera: Pinhole(eye: (0, 0, 0.9), look_at: (0, 0, -1), fov_y: 20),
         materials: { \"m\": (reflect: 1, color: (1, 1, 1)) },
         lights: [Sphere(center: (0.5, 0.5, 0), radius: 0.2, power: (1, 1, 1))],
