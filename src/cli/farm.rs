@@ -17,6 +17,7 @@ use caustic::Error;
 use caustic::farm::Shard;
 use caustic::farm::part_meta::settings_hash;
 use caustic::pipeline::{SceneOverrides, prepare};
+use caustic::render_scene::RenderParams;
 use caustic::scene::SceneFile;
 
 use self::manifest::{FORMAT, LOGS, Manifest, PHOTONS, SCENE, SHARDS};
@@ -168,7 +169,12 @@ fn absolute_assets(v: &mut Value, base: &Path) {
 }
 
 /// The scene as RON with asset paths absolute, so it renders the same from the job folder.
-fn resolved_scene(scene: &SceneFile, base: &Path, from: &Path) -> Result<String, Error> {
+fn resolved_scene(
+    scene: &SceneFile,
+    params: &RenderParams,
+    base: &Path,
+    from: &Path,
+) -> Result<String, Error> {
     let fail = |e: String| {
         usage(format!(
             "cannot write the resolved scene of `{}`: {e}",
@@ -177,6 +183,7 @@ fn resolved_scene(scene: &SceneFile, base: &Path, from: &Path) -> Result<String,
     };
     let mut tree = serde_json::to_value(scene).map_err(|e| fail(e.to_string()))?;
     absolute_assets(&mut tree, base);
+    pin_default_estimator(&mut tree, params);
     let scene: SceneFile = serde_json::from_value(tree).map_err(|e| fail(e.to_string()))?;
     let body = ron::ser::to_string_pretty(&scene, ron::ser::PrettyConfig::default())
         .map_err(|e| fail(e.to_string()))?;
@@ -184,6 +191,38 @@ fn resolved_scene(scene: &SceneFile, base: &Path, from: &Path) -> Result<String,
         "// Written by `caustic farm plan` from `{}` with its overrides applied and asset paths\n// made absolute; the farm's shards render this file.\n{body}\n",
         from.display()
     ))
+}
+
+/// A scene that names no integrator renders with the default estimator, which picks its own
+/// per-pass photon counts unless the command line states them: the resolved scene names the
+/// integrator chosen and the photon counts in effect (each light's own budget too), so the
+/// shards render it without the command line and get the very same settings.
+fn pin_default_estimator(tree: &mut Value, params: &RenderParams) {
+    if params.default_estimator.is_none() {
+        return;
+    }
+    if let Ok(kind) = serde_json::to_value(params.integrator) {
+        tree["render"]["integrator"] = kind;
+    }
+    let p = &params.photons;
+    for (field, value) in [
+        ("caustic", p.caustic),
+        ("global", p.global),
+        ("caustic_gather", p.caustic_gather),
+        ("gather", p.gather),
+    ] {
+        tree["photons"][field] = Value::from(value);
+    }
+    if let Some(lights) = tree["lights"].as_array_mut() {
+        for (light, budget) in lights.iter_mut().zip(&p.caustic_per_light) {
+            // Externally tagged: `{ "Point": { … } }`.
+            if let Some(fields) = light.as_object_mut().and_then(|m| m.values_mut().next()) {
+                if fields.get("caustic_photons").is_some() {
+                    fields["caustic_photons"] = budget.map_or(Value::Null, Value::from);
+                }
+            }
+        }
+    }
 }
 
 /// Samples per pixel each shard's range holds in a plan in time (`--time` without `--spp`):
@@ -268,7 +307,8 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
         &base
     })
     .map_err(|e| io(&base, &e))?;
-    let scene_text = resolved_scene(&prepared.scene, &base, source_path)?;
+    let params = &prepared.render_scene.params;
+    let scene_text = resolved_scene(&prepared.scene, params, &base, source_path)?;
     let scene_path = dir.join(SCENE);
     caustic::render::output::write_atomic(&scene_path, scene_text.as_bytes())?;
     // The shards render the resolved scene: it must be the very scene that was planned.

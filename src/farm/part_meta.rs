@@ -60,11 +60,15 @@ pub struct PartMeta {
 /// and disjoint sample ranges merge into the render of their union.
 #[must_use]
 pub fn settings_hash(scene: &RenderScene) -> u64 {
+    // Why the default estimator chose the integrator is not a setting: a scene that names the
+    // chosen integrator and photon counts renders the same bytes and hashes the same.
+    let mut params = scene.params.clone();
+    params.default_estimator = None;
     let text = format!(
         "{HEADER}\n{}\n{:016x}\n{:?}\n{:?}",
         env!("CARGO_PKG_VERSION"),
         photon_key(scene),
-        scene.params,
+        params,
         scene.camera
     );
     fnv1a(text.as_bytes())

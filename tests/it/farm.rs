@@ -404,3 +404,42 @@ fn a_planned_scene_keeps_its_assets_and_its_hash() {
     ]));
     assert!(merged.contains("2 of 2 samples per pixel"), "{merged}");
 }
+
+/// A scene that names no integrator gets the default estimator, whose per-pass photon counts
+/// are chosen unless the command line states them: the planned scene pins the integrator and
+/// the counts in effect, so its shards render what a render of the original with the same
+/// flags renders (same settings hash, mergeable parts, same bytes).
+#[test]
+fn a_planned_default_estimator_scene_renders_like_the_original() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cornell = crate::common::root().join(CORNELL);
+    let small = ["--width", "24", "--height", "20", "--spp", "2"];
+    for (name, photons) in [
+        ("chosen", &[][..]),
+        (
+            "stated",
+            &["--caustic-photons", "3000", "--photons", "500"][..],
+        ),
+    ] {
+        let job = dir.path().join(name);
+        let mut args = vec!["farm", "plan", s(&cornell), "--shards", "2", "-o", s(&job)];
+        args.extend_from_slice(&small);
+        args.extend_from_slice(photons);
+        ok(&caustic(&args));
+        let scene = std::fs::read_to_string(job.join("scene.ron")).expect("scene.ron");
+        assert!(scene.contains("integrator: Some(PathPpm)"), "{scene}");
+        let (planned, original) = (dir.path().join("p.exr"), dir.path().join("o.exr"));
+        ok(&caustic(&[
+            "render",
+            s(&job.join("scene.ron")),
+            "-q",
+            "-o",
+            s(&planned),
+        ]));
+        let mut b = vec!["render", s(&cornell), "-q", "-o", s(&original)];
+        b.extend_from_slice(&small);
+        b.extend_from_slice(photons);
+        ok(&caustic(&b));
+        assert_eq!(bytes(&planned), bytes(&original), "{name}");
+    }
+}
