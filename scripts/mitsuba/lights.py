@@ -5,16 +5,16 @@ Use:  /root/.cache/mitsuba3-venv/bin/python scripts/mitsuba/lights.py SCENE [--s
 
 Every scene: 96×72 pixels, a floor y = 0 (Lambert 0.5), a grey sphere (Lambert 0.7, radius 0.5
 at (0, 0.5, 0)), camera at (0, 2, 5) looking at (0, 0.5, 0), fov_y 40°, path tracing with
-max_depth 6 (caustic: 5 bounces). Caustic's side (phase 2) builds the same scenes in
-`scenes/compare/lights_*.ron`.
+max_depth 6 (caustic: 5 bounces). Caustic's twins are `scripts/mitsuba/scenes/lights_*.ron`;
+`scripts/mitsuba/lights_compare.py` renders both and compares them.
 
 Convention differences and how each scene neutralises them:
   quad         Mitsuba's `rectangle` + `area` emitter is one-sided along its +z normal, radiance
                L; caustic's one-sided quad emits along edge_u × edge_v with the same L. The
                mapping is common.rect_to_world (no difference left).
   mesh         A triangle fan (32 triangles, a disc of radius 0.4 at y = 2.2 facing down),
-               written as an OBJ under the temp folder and loaded with face normals; one-sided
-               by winding in both.
+               scripts/mitsuba/scenes/fan.obj (both renderers read it), loaded with face
+               normals; one-sided by winding in both.
   spot         Mitsuba's `spot` falls off LINEARLY IN ANGLE from beam_width to cutoff_angle;
                caustic (pbrt-v4) uses smoothstep in COSINE between the outer and inner cones.
                The two agree inside the inner cone and outside the outer one, so the scene uses
@@ -79,13 +79,9 @@ def scene_quad(mi, spp, seed):
 
 def scene_mesh(mi, spp, seed):
     """An emissive triangle fan (a disc of radius 0.4 at y = 2.2, facing down, L = 10)."""
-    import tempfile
-    n, r, h = 32, 0.4, 2.2
-    verts = [(0, h, 0)] + [(r * math.cos(2 * math.pi * k / n), h, r * math.sin(2 * math.pi * k / n)) for k in range(n)]
-    faces = [(1, 2 + k, 2 + (k + 1) % n) for k in range(n)]  # 1-based; winding normal −y, as caustic's
-    obj = Path(tempfile.gettempdir()) / "caustic_mitsuba_fan.obj"
-    obj.write_text("".join(f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in verts)
-                   + "".join(f"f {a} {b} {c}\n" for a, b, c in faces))
+    # scenes/fan.obj, shared with caustic's twin: 32 triangles (centre, v_k, v_k+1) with
+    # v_k = (r cos 2πk/n, h, r sin 2πk/n), winding normal −y.
+    obj = Path(__file__).resolve().parent / "scenes" / "fan.obj"
     d = base(mi, spp, seed)
     d["fan"] = {"type": "obj", "filename": str(obj), "face_normals": True, "bsdf": common.black(),
                 "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [10, 10, 10]}}}
