@@ -5,16 +5,16 @@ Use:  /root/.cache/mitsuba3-venv/bin/python scripts/mitsuba/lights.py SCENE [--s
 
 Every scene: 96×72 pixels, a floor y = 0 (Lambert 0.5), a grey sphere (Lambert 0.7, radius 0.5
 at (0, 0.5, 0)), camera at (0, 2, 5) looking at (0, 0.5, 0), fov_y 40°, path tracing with
-max_depth 6 (caustic: 5 bounces). Caustic's side (phase 2) builds the same scenes in
-`scenes/compare/lights_*.ron`.
+max_depth 6 (caustic: 5 bounces). Caustic's twins are `scripts/mitsuba/scenes/lights_*.ron`;
+`scripts/mitsuba/lights_compare.py` renders both and compares them.
 
 Convention differences and how each scene neutralises them:
   quad         Mitsuba's `rectangle` + `area` emitter is one-sided along its +z normal, radiance
                L; caustic's one-sided quad emits along edge_u × edge_v with the same L. The
                mapping is common.rect_to_world (no difference left).
   mesh         A triangle fan (32 triangles, a disc of radius 0.4 at y = 2.2 facing down),
-               written as an OBJ under the temp folder and loaded with face normals; one-sided
-               by winding in both.
+               scripts/mitsuba/scenes/fan.obj (both renderers read it), loaded with face
+               normals; one-sided by winding in both.
   spot         Mitsuba's `spot` falls off LINEARLY IN ANGLE from beam_width to cutoff_angle;
                caustic (pbrt-v4) uses smoothstep in COSINE between the outer and inner cones.
                The two agree inside the inner cone and outside the outer one, so the scene uses
@@ -22,7 +22,7 @@ Convention differences and how each scene neutralises them:
                remaining difference is far below the 1 % mean tolerance) — or compare only
                the pixels inside the inner cone. Mitsuba's `intensity` is caustic's I (W/sr).
   sun          Mitsuba's `directional` has no angular radius, so the sun of angular radius α is
-               an `area`-emitting sphere of radius r = D sin α at distance D = 1000 in the sun's
+               an `area`-emitting sphere of radius r = D sin α at distance D = 1e5 in the sun's
                direction, radiance L = E / (π sin²α) (caustic's relation E = π L sin²α). For
                α = 0 use `directional` with `irradiance` = E (same meaning as caustic's).
                The sphere is sampled by Mitsuba as a sphere emitter, not as a cone; only noise
@@ -31,10 +31,10 @@ Convention differences and how each scene neutralises them:
   env_image    Mitsuba's `envmap`: same equirectangular convention (u = atan2(x, −z)/2π,
                v = acos(y)/π, +y up, row 0 at the zenith); a rotation about +y is
                to_world = rotate([0, 1, 0], degrees), the same direction as caustic's rotation.
-               Mitsuba stores an extra wrapped column and interpolates bilinearly; whether its
-               texel centres sit at (i + ½)/w as caustic's do is to be checked in phase 2 with a
-               one-hot test map (a half-texel shift is invisible on the smooth sky except at
-               the sun). Mitsuba's envmap `scale` = 1. The map is assets/sky.exr.
+               Texel positions differ in v (measured with a one-hot map): caustic's texel
+               (i, j) is centred at ((i + ½)/w, (j + ½)/h), Mitsuba's at ((i + ½)/w, j/(h − 1))
+               (rows from pole to pole). mitsuba_sky() resamples assets/sky.exr so that
+               Mitsuba's lookup is caustic's map. Mitsuba's envmap `scale` = 1.
   thin_lens    Mitsuba's `thinlens` takes aperture_radius and focus_distance (distance along
                the view axis to the plane of focus) with the same meaning as caustic's lens
                radius and focus distance; the lens is a disc in both (sampling patterns differ:
@@ -79,13 +79,9 @@ def scene_quad(mi, spp, seed):
 
 def scene_mesh(mi, spp, seed):
     """An emissive triangle fan (a disc of radius 0.4 at y = 2.2, facing down, L = 10)."""
-    import tempfile
-    n, r, h = 32, 0.4, 2.2
-    verts = [(0, h, 0)] + [(r * math.cos(2 * math.pi * k / n), h, r * math.sin(2 * math.pi * k / n)) for k in range(n)]
-    faces = [(1, 2 + k, 2 + (k + 1) % n) for k in range(n)]  # 1-based; winding normal −y, as caustic's
-    obj = Path(tempfile.gettempdir()) / "caustic_mitsuba_fan.obj"
-    obj.write_text("".join(f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in verts)
-                   + "".join(f"f {a} {b} {c}\n" for a, b, c in faces))
+    # scenes/fan.obj, shared with caustic's twin: 32 triangles (centre, v_k, v_k+1) with
+    # v_k = (r cos 2πk/n, h, r sin 2πk/n), winding normal −y.
+    obj = Path(__file__).resolve().parent / "scenes" / "fan.obj"
     d = base(mi, spp, seed)
     d["fan"] = {"type": "obj", "filename": str(obj), "face_normals": True, "bsdf": common.black(),
                 "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [10, 10, 10]}}}
@@ -104,6 +100,11 @@ def scene_spot(mi, spp, seed):
 SUN_DIR = [0.4, 0.8, 0.3]   # towards the sun (normalised below)
 SUN_E = 5.0                 # W/m² on a surface facing it
 SUN_ALPHA = math.radians(0.2665)
+SUN_WIDE_ALPHA = math.radians(3.0)  # `sun_wide`: Mitsuba samples the far sphere's cone in f32,
+                            # where 1 − cos α = 1.1e-5 for the real sun carries a ~0.3 % error;
+                            # at 3° it is 1.4e-3 and the error ~5e-5
+SUN_DISTANCE = 1e5          # the far sphere's distance: the ±4 m scene shifts its direction by
+                            # 4e-5 rad (0.9 % of α) and its irradiance by 1e-4
 
 
 def scene_sun(mi, spp, seed, alpha=SUN_ALPHA):
@@ -114,7 +115,7 @@ def scene_sun(mi, spp, seed, alpha=SUN_ALPHA):
         d["sun"] = {"type": "directional", "direction": [-c for c in s],
                     "irradiance": {"type": "rgb", "value": [SUN_E] * 3}}
         return d
-    dist = 1000.0
+    dist = SUN_DISTANCE
     radiance = SUN_E / (math.pi * math.sin(alpha) ** 2)
     d["sun"] = {"type": "sphere", "center": [c * dist for c in s], "radius": dist * math.sin(alpha),
                 "bsdf": common.black(),
@@ -129,10 +130,32 @@ def scene_env_constant(mi, spp, seed):
     return d
 
 
+def mitsuba_sky(mi, oversample=8):
+    """assets/sky.exr resampled for Mitsuba's `envmap`, whose rows sit at v = j/(h − 1) (row 0
+    exactly at the zenith, the last row at the nadir; measured with a one-hot map), where
+    caustic's sit at texel centres v = (j + ½)/h and clamp beyond the first and last centre
+    (columns agree: u = (i + ½)/w in both). Row k of the result, at v_k = k/(h' − 1) with
+    h' = oversample·h + 1, holds caustic's interpolant at v_k, so Mitsuba's bilinear lookup
+    reproduces caustic's map up to the knots' offsets inside one fine row. Written under the
+    temp folder; returns its path."""
+    import tempfile
+    import numpy as np
+    src = np.array(mi.Bitmap(str(ROOT / "assets" / "sky.exr")), dtype=np.float64)[..., :3]
+    h = src.shape[0]
+    rows = oversample * h + 1
+    t = np.clip(np.arange(rows) / (rows - 1) * h - 0.5, 0.0, h - 1.0)
+    j0 = np.minimum(np.floor(t).astype(int), h - 2)
+    f = (t - j0)[:, None, None]
+    out = (1.0 - f) * src[j0] + f * src[j0 + 1]
+    path = Path(tempfile.gettempdir()) / "caustic_mitsuba_sky.exr"
+    mi.Bitmap(out.astype(np.float32)).write(str(path))
+    return path
+
+
 def scene_env_image(mi, spp, seed, rotation_deg=30.0):
     """assets/sky.exr as an environment, rotated 30° about +y."""
     d = base(mi, spp, seed)
-    d["sky"] = {"type": "envmap", "filename": str(ROOT / "assets" / "sky.exr"),
+    d["sky"] = {"type": "envmap", "filename": str(mitsuba_sky(mi)),
                 "to_world": mi.ScalarTransform4f().rotate([0, 1, 0], rotation_deg)}
     return d
 
@@ -147,6 +170,7 @@ def scene_thin_lens(mi, spp, seed):
 
 SCENES = {
     "quad": scene_quad, "mesh": scene_mesh, "spot": scene_spot, "sun": scene_sun,
+    "sun_wide": lambda mi, spp, seed: scene_sun(mi, spp, seed, alpha=SUN_WIDE_ALPHA),
     "env_constant": scene_env_constant, "env_image": scene_env_image, "thin_lens": scene_thin_lens,
 }
 

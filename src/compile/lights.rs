@@ -144,6 +144,10 @@ pub(super) struct NodeEmitter {
 /// triangles' winding normal), a sphere light for a sphere, a mesh light over the triangles
 /// otherwise. An error for a sphere under non-uniform scale (an ellipsoid is not a light
 /// shape) and for a shape with no area left.
+#[allow(
+    clippy::result_large_err,
+    reason = "a Diagnostic is built once per bad light on a cold path and joins the compile's list of diagnostics by value"
+)]
 pub(super) fn node_light(b: &GeometryBuilder, e: &NodeEmitter) -> Result<Light, Diagnostic> {
     let radiance = Vec3::from(e.emission.radiance);
     let two_sided = e.emission.two_sided;
@@ -237,6 +241,10 @@ pub(super) fn scene_sphere(b: &GeometryBuilder, more: &[(Vec3, f32)]) -> SceneSp
 /// bounding sphere for lights at infinity; `None` for point and sphere lights (compiled by the
 /// caller, which keeps their code as it was). Errors: an environment map that cannot be read
 /// or holds a negative or non-finite texel, named by file.
+#[allow(
+    clippy::result_large_err,
+    reason = "a Diagnostic is built once per bad light on a cold path and joins the compile's list of diagnostics by value"
+)]
 pub(super) fn spec_light(
     index: usize,
     l: &LightSpec,
@@ -308,6 +316,10 @@ pub(super) fn spec_light(
 
 /// Reads an equirectangular OpenEXR map (linear RGB) and makes the environment light of its
 /// texels times `scale`.
+#[allow(
+    clippy::result_large_err,
+    reason = "a Diagnostic is built once per bad light on a cold path and joins the compile's list of diagnostics by value"
+)]
 fn load_environment(
     index: usize,
     file: &Path,

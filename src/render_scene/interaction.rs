@@ -11,6 +11,10 @@ use crate::shading::{Bsdf, ShadingFrame};
 
 /// What a ray found ([`RenderScene::interact`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "one per path vertex, on the stack and matched at once: never stored in arrays, so boxing would only add an allocation per hit"
+)]
 pub enum Interaction {
     /// The ray left the scene (it sees the background). With an environment light, unbounded
     /// rays that leave the scene are [`Interaction::Emitter`] hits on it instead

@@ -19,6 +19,7 @@ mod interrupt;
 mod kdtree;
 mod layers;
 mod light_transport;
+mod lights;
 mod models;
 mod mutated_scenes;
 mod passes;

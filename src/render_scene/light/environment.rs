@@ -3,11 +3,13 @@
 //! sampled by a piecewise-constant 2-D distribution over the map (the idea of pbrt-v4's
 //! `ImageInfiniteLight`, on an equirectangular map as in pbrt-v3).
 //!
-//! Map convention (Mitsuba 3's `envmap`, so comparisons need no remapping): in the map's frame
+//! Map convention (Mitsuba 3's `envmap` directions; only its rows differ, see below): in the map's frame
 //! +y is up, a direction `(x, y, z)` has `θ = acos y` (0 at the zenith) and `φ = atan2(x, −z)`
 //! in `[0, 2π)`; image coordinates are `u = φ / 2π` (column, left to right) and `v = θ / π`
 //! (row 0 at the top = zenith). Texel `(i, j)` is centred at `((i + ½)/w, (j + ½)/h)` and the
-//! map is bilinearly interpolated between centres, wrapping in u and clamping in v. The map is
+//! map is bilinearly interpolated between centres, wrapping in u and clamping in v.
+//! (Mitsuba 3 puts row `j` at `v = j/(h − 1)`, pole to pole, measured with a one-hot map; the
+//! comparison in `scripts/mitsuba/lights.py` resamples the map for it.) The map is
 //! turned into the world by a rotation of `rotation` radians about +y (right-handed: +x towards
 //! −z), i.e. `world = R_y(rotation) · map`.
 //!

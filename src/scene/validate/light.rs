@@ -47,11 +47,14 @@ impl<'a> Validator<'a> {
                 if self.finite(&inner_path, *inner_angle)
                     && !(*inner_angle >= 0.0 && *inner_angle <= *outer_angle)
                 {
-                    self.err(
-                        &inner_path,
-                        format!(
-                            "must be within [0, outer_angle = {outer_angle}] degrees, found {inner_angle}"
-                        ),
+                    self.out.push(
+                        Diagnostic::error(
+                            &inner_path,
+                            format!(
+                                "must be within [0, outer_angle = {outer_angle}] degrees, found {inner_angle}"
+                            ),
+                        )
+                        .with_help("`inner_angle` is the half-angle of the full-intensity cone, inside the `outer_angle` cone; equal angles give a hard edge"),
                     );
                 }
                 self.radiometric(&format!("{path}.intensity"), *intensity);
@@ -118,7 +121,10 @@ impl<'a> Validator<'a> {
     /// A direction: finite and not zero.
     fn direction(&mut self, path: &str, d: [f32; 3]) {
         if self.finite3(path, d) && d.iter().all(|c| *c == 0.0) {
-            self.err(path, "must not be the zero vector, found (0, 0, 0)".into());
+            self.out.push(
+                Diagnostic::error(path, "must not be the zero vector, found (0, 0, 0)")
+                    .with_help("give any non-zero vector along the direction, e.g. `(0, 1, 0)` (its length does not matter)"),
+            );
         }
     }
 
