@@ -1,5 +1,6 @@
 //! The integration tests, as one binary (one link of the library instead of one per file).
 
+mod absorption;
 mod architecture;
 mod assets;
 mod bad_scenes;
