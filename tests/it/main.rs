@@ -8,6 +8,7 @@ mod cli;
 mod common;
 mod compare;
 mod converge;
+mod default_estimator;
 mod determinism;
 mod doc_commands;
 mod doc_images;
