@@ -38,13 +38,19 @@ fn scene(glass: bool, integrator: Option<IntegratorKind>) -> String {
 fn a_scene_without_integrator_gets_path_ppm_with_a_specular_caster_and_path_without() {
     let with = scene_from_text(&scene(true, None));
     assert_eq!(with.params.integrator, IntegratorKind::PathPpm);
-    let choice = with.default_estimator.expect("the default was chosen");
+    let choice = with
+        .params
+        .default_estimator
+        .expect("the default was chosen");
     assert_eq!(choice.specular_casters, 1);
     // 16 × 12 pixels: the per-pass budget's lower bound.
     assert_eq!(choice.photons.map(|p| p.caustic), Some(1000));
     let without = scene_from_text(&scene(false, None));
     assert_eq!(without.params.integrator, IntegratorKind::Path);
-    let choice = without.default_estimator.expect("the default was chosen");
+    let choice = without
+        .params
+        .default_estimator
+        .expect("the default was chosen");
     assert_eq!((choice.specular_casters, choice.photons), (0, None));
 }
 
@@ -54,7 +60,10 @@ fn a_scene_naming_an_integrator_gets_that_one_with_or_without_a_caster() {
         for glass in [false, true] {
             let s = scene_from_text(&scene(glass, Some(kind)));
             assert_eq!(s.params.integrator, kind, "glass: {glass}");
-            assert!(s.default_estimator.is_none(), "{kind:?}: no default chosen");
+            assert!(
+                s.params.default_estimator.is_none(),
+                "{kind:?}: no default chosen"
+            );
             let it = caustic::integrators::Integrator::prepare(&s);
             let progressive = matches!(kind, IntegratorKind::Ppm | IntegratorKind::PathPpm);
             assert_eq!(it.is_progressive(), progressive, "{kind:?}");
@@ -75,7 +84,7 @@ fn the_command_lines_integrator_wins_over_the_scene_and_the_default() {
             };
             let p = prepare(&path, &overrides).expect("prepares");
             assert_eq!(p.render_scene.params.integrator, kind, "{file}");
-            assert!(p.render_scene.default_estimator.is_none(), "{file}");
+            assert!(p.render_scene.params.default_estimator.is_none(), "{file}");
         }
         let p = prepare(&path, &SceneOverrides::default()).expect("prepares");
         let expected = if file.contains("pool") {

@@ -13,6 +13,7 @@ mod determinism;
 mod doc_commands;
 mod doc_images;
 mod doc_snippets;
+mod estimator_agreement;
 mod farm;
 mod golden;
 mod hard_cases;
