@@ -39,6 +39,40 @@ pub struct PathTracer<'a> {
     scene: &'a RenderScene,
     lights: LightSampler,
     pixel_spread: f32,
+    specular_splits: u32,
+}
+
+/// Most branches waiting while one is followed ([`PathTracer::with_specular_splits`]); with
+/// splits at most at the first 2 specular vertices no more than 2 ever wait.
+const MAX_PENDING: usize = 4;
+
+/// The state of one camera path (or one branch of it after a split at a specular vertex).
+#[derive(Debug, Clone, Copy)]
+struct Branch {
+    ray: Ray,
+    cone: RayCone,
+    beta: Vec3,
+    /// Radiance scale from refraction so far, undone for Russian roulette (pbrt's etaScale).
+    eta_scale: f32,
+    /// The last bounce was a delta lobe (or the camera): emitters hit next count fully.
+    specular: bool,
+    prev_pdf: f32,
+    prev_p: Vec3,
+    diffuse_bounces: u32,
+    /// Delta bounces since the last non-delta one (`None` before any): an emitter hit with at
+    /// least one is a caustic path, which `caustics` accounts for when it was read at that
+    /// non-delta vertex (`map_read`).
+    since_local: Option<u32>,
+    map_read: bool,
+    /// After a non-delta bounce from a vertex that read the global map, the emitters' light is
+    /// accounted for: only the background still counts.
+    background_only: bool,
+    kind: RayKind,
+    parent: Option<usize>,
+    depth: u32,
+    medium: Medium,
+    /// Specular vertices this branch was split at.
+    splits: u32,
 }
 
 /// The power heuristic with β = 2 for one sample from each of two strategies.
@@ -62,7 +96,26 @@ impl<'a> PathTracer<'a> {
             scene,
             lights: LightSampler::new(&scene.lights),
             pixel_spread: scene.pixel_spread(),
+            specular_splits: 0,
         }
+    }
+
+    /// The same tracer splitting camera paths at their first `n` specular vertices: where a
+    /// path that has made no diffuse or glossy bounce yet meets a purely specular surface
+    /// (smooth glass or water, whose BSDF has only delta parts), it follows both the
+    /// reflected and the refracted branch, weighted by the BSDF's delta weights (F and
+    /// (1 − F)·(ηₒ/ηᵢ)², from [`Bsdf::delta_lobes`]), instead of choosing one with those
+    /// probabilities. The expected value is unchanged (the sum of the two weighted branches is
+    /// the expectation of the choice), so the estimator stays unbiased; the variance of light
+    /// seen through specular chains (the light's image in water or glass, at F ≈ 0.04 chosen
+    /// once in ~25 samples by the random choice) is removed at those vertices. Ray budget: at
+    /// most 2ⁿ branches per camera sample, and only on pixels that see a specular surface. After
+    /// `n` splits, or after a non-delta bounce, the branch chooses as before. 0 (the default):
+    /// no splitting.
+    #[must_use]
+    pub fn with_specular_splits(mut self, n: u32) -> Self {
+        self.specular_splits = n;
+        self
     }
 
     /// Radiance arriving along camera ray `ray`. Paths have at most `render.max_depth` bounces
@@ -94,189 +147,267 @@ impl<'a> PathTracer<'a> {
     ) -> Radiance {
         let scene = self.scene;
         let params = &scene.params;
-        let mut ray = ray;
-        let mut cone = RayCone::camera(self.pixel_spread);
         let mut l = Radiance::default();
-        let mut beta = Vec3::ONE;
-        // Radiance scale from refraction so far, undone for Russian roulette (pbrt's etaScale).
-        let mut eta_scale = 1.0f32;
-        // The last bounce was a delta lobe (or the camera): emitters hit next count fully.
-        let mut specular = true;
-        let mut prev_pdf = 0.0f32;
-        let mut prev_p = ray.origin;
-        let mut diffuse_bounces = 0u32;
-        // Delta bounces since the last non-delta one (`None` before any): an emitter hit with
-        // at least one is a caustic path, which `caustics` accounts for when it was read at
-        // that non-delta vertex (`map_read`).
-        let mut since_local: Option<u32> = None;
-        let mut map_read = false;
-        // After a non-delta bounce from a vertex that read the global map, the emitters' light
-        // is accounted for: only the background still counts.
-        let mut background_only = false;
-        let mut kind = RayKind::Camera;
-        let mut parent: Option<usize> = None;
-        let mut depth = 0u32;
-        let mut medium = Medium::OUTSIDE;
         // Debug logs only: each node holds the radiance gathered before it until the path ends.
         let mut root: Option<usize> = None;
-        loop {
-            cx.counters.rays += 1;
-            let node = cx.observer.ray(depth, kind, &ray, beta, parent);
-            if O::ACTIVE {
-                cx.observer.set_radiance(node, l.total());
-            }
-            root = root.or(node);
-            let it = scene.interact(&ray, |t| cone.width_at(&ray, t));
-            // Beer–Lambert absorption along the segment just travelled (1 outside media).
-            beta *= medium.transmittance(&ray, &it);
-            let v = match it {
-                Interaction::Escaped => {
-                    let via = since_local.is_some_and(|n| n > 0);
-                    l.add(
-                        LightPath::classify(diffuse_bounces, via),
-                        beta * params.background,
-                    );
-                    break;
+        let mut pending = [None::<Branch>; MAX_PENDING];
+        let mut waiting = 0usize;
+        let mut next = Some(Branch {
+            ray,
+            cone: RayCone::camera(self.pixel_spread),
+            beta: Vec3::ONE,
+            eta_scale: 1.0,
+            specular: true,
+            prev_pdf: 0.0,
+            prev_p: ray.origin,
+            diffuse_bounces: 0,
+            since_local: None,
+            map_read: false,
+            background_only: false,
+            kind: RayKind::Camera,
+            parent: None,
+            depth: 0,
+            medium: Medium::OUTSIDE,
+            splits: 0,
+        });
+        while let Some(b) = next.take().or_else(|| {
+            waiting = waiting.checked_sub(1)?;
+            pending[waiting].take()
+        }) {
+            let Branch {
+                mut ray,
+                mut cone,
+                mut beta,
+                mut eta_scale,
+                mut specular,
+                mut prev_pdf,
+                mut prev_p,
+                mut diffuse_bounces,
+                mut since_local,
+                mut map_read,
+                mut background_only,
+                mut kind,
+                mut parent,
+                mut depth,
+                mut medium,
+                splits,
+            } = b;
+            loop {
+                cx.counters.rays += 1;
+                let node = cx.observer.ray(depth, kind, &ray, beta, parent);
+                if O::ACTIVE {
+                    cx.observer.set_radiance(node, l.total());
                 }
-                Interaction::Emitter(e) => {
-                    // An emitter (seen from outside only); it absorbs what reaches it.
-                    let le = match e.light {
-                        None => Vec3::ZERO,
-                        Some(_) if background_only => Vec3::ZERO,
-                        Some(_) if map_read && since_local.is_some_and(|n| n > 0) => Vec3::ZERO,
-                        Some(i) => {
-                            let le = e.le(scene);
-                            if le == Vec3::ZERO {
-                                le
-                            } else {
-                                let w = if specular {
-                                    1.0
-                                } else {
-                                    let light_pdf = self.lights.pmf(i as usize)
-                                        * scene.lights[i as usize]
-                                            .pdf_li_hit(prev_p, -e.wo, e.sp.p, e.sp.ng);
-                                    power_heuristic(prev_pdf, light_pdf)
-                                };
-                                le * w
-                            }
-                        }
-                    };
-                    let via = since_local.is_some_and(|n| n > 0);
-                    l.add(LightPath::classify(diffuse_bounces, via), beta * le);
-                    cx.observer.hit(node, scene, &e.hit, &e.sp, "light");
-                    break;
-                }
-                Interaction::Surface(v) => v,
-            };
-            let (hit, sp, wo) = (v.hit, v.sp, v.wo);
-            let name = &scene.material_names[v.material as usize];
-            cx.observer.hit(node, scene, &hit, &sp, name);
-            if depth >= params.max_depth {
-                cx.observer.note(node, "max depth reached");
-                break;
-            }
-            let fr = v.frame;
-            let bsdf = v.bsdf;
-            let may_scatter = diffuse_bounces < params.diffuse_depth;
-            let local = bsdf.has_local() && !background_only;
-            let read_global =
-                local && may_scatter && maps.global.is_some() && diffuse_bounces == maps.global_at;
-            // Next-event estimation through the non-delta part. Every bounce reserves the same
-            // dimensions, whether or not it uses them, and computes only those it uses.
-            let u_light = cx.sampler.defer_1d();
-            let u_point = cx.sampler.defer_2d();
-            if local && let Some((index, pmf)) = self.lights.choose(|| cx.sampler.get_1d(u_light)) {
-                let u = cx.sampler.get_2d(u_point);
-                let scatter = may_scatter && !read_global;
-                let c = self.direct(&sp, wo, &fr, &bsdf, index, pmf, u, scatter, cx, node);
-                l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
-            }
-            let read_caustic = local
-                && may_scatter
-                && maps.caustic.is_some()
-                && !(read_global && maps.global_has_caustics);
-            if read_caustic || read_global {
-                let caustic = maps.caustic.filter(|_| read_caustic);
-                let global = maps.global.filter(|_| read_global);
-                let first = LightPath::classify(diffuse_bounces + 1, true);
-                for (name, map, kind) in [
-                    ("caustic", caustic, first),
-                    ("global", global, LightPath::Indirect),
-                ] {
-                    let Some(map) = map else { continue };
-                    let e = map.estimate(sp.p, wo, &fr, &bsdf);
-                    cx.counters.photon_estimates += 1;
-                    l.add(kind, beta * e.radiance);
-                    if O::ACTIVE {
-                        let text = format!(
-                            "{name} map: {} photons within r = {:.4} → ({:.4}, {:.4}, {:.4})",
-                            e.found, e.radius, e.radiance.x, e.radiance.y, e.radiance.z
+                root = root.or(node);
+                let it = scene.interact(&ray, |t| cone.width_at(&ray, t));
+                // Beer–Lambert absorption along the segment just travelled (1 outside media).
+                beta *= medium.transmittance(&ray, &it);
+                let v = match it {
+                    Interaction::Escaped => {
+                        let via = since_local.is_some_and(|n| n > 0);
+                        l.add(
+                            LightPath::classify(diffuse_bounces, via),
+                            beta * params.background,
                         );
-                        cx.observer.note(node, &text);
+                        break;
+                    }
+                    Interaction::Emitter(e) => {
+                        // An emitter (seen from outside only); it absorbs what reaches it.
+                        let le = match e.light {
+                            None => Vec3::ZERO,
+                            Some(_) if background_only => Vec3::ZERO,
+                            Some(_) if map_read && since_local.is_some_and(|n| n > 0) => Vec3::ZERO,
+                            Some(i) => {
+                                let le = e.le(scene);
+                                if le == Vec3::ZERO {
+                                    le
+                                } else {
+                                    let w = if specular {
+                                        1.0
+                                    } else {
+                                        let light_pdf = self.lights.pmf(i as usize)
+                                            * scene.lights[i as usize]
+                                                .pdf_li_hit(prev_p, -e.wo, e.sp.p, e.sp.ng);
+                                        power_heuristic(prev_pdf, light_pdf)
+                                    };
+                                    le * w
+                                }
+                            }
+                        };
+                        let via = since_local.is_some_and(|n| n > 0);
+                        l.add(LightPath::classify(diffuse_bounces, via), beta * le);
+                        cx.observer.hit(node, scene, &e.hit, &e.sp, "light");
+                        break;
+                    }
+                    Interaction::Surface(v) => v,
+                };
+                let (hit, sp, wo) = (v.hit, v.sp, v.wo);
+                let name = &scene.material_names[v.material as usize];
+                cx.observer.hit(node, scene, &hit, &sp, name);
+                if depth >= params.max_depth {
+                    cx.observer.note(node, "max depth reached");
+                    break;
+                }
+                let fr = v.frame;
+                let bsdf = v.bsdf;
+                let may_scatter = diffuse_bounces < params.diffuse_depth;
+                let local = bsdf.has_local() && !background_only;
+                let read_global = local
+                    && may_scatter
+                    && maps.global.is_some()
+                    && diffuse_bounces == maps.global_at;
+                // Next-event estimation through the non-delta part. Every bounce reserves the same
+                // dimensions, whether or not it uses them, and computes only those it uses.
+                let u_light = cx.sampler.defer_1d();
+                let u_point = cx.sampler.defer_2d();
+                if local
+                    && let Some((index, pmf)) = self.lights.choose(|| cx.sampler.get_1d(u_light))
+                {
+                    let u = cx.sampler.get_2d(u_point);
+                    let scatter = may_scatter && !read_global;
+                    let c = self.direct(&sp, wo, &fr, &bsdf, index, pmf, u, scatter, cx, node);
+                    l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
+                }
+                let read_caustic = local
+                    && may_scatter
+                    && maps.caustic.is_some()
+                    && !(read_global && maps.global_has_caustics);
+                if read_caustic || read_global {
+                    let caustic = maps.caustic.filter(|_| read_caustic);
+                    let global = maps.global.filter(|_| read_global);
+                    let first = LightPath::classify(diffuse_bounces + 1, true);
+                    for (name, map, kind) in [
+                        ("caustic", caustic, first),
+                        ("global", global, LightPath::Indirect),
+                    ] {
+                        let Some(map) = map else { continue };
+                        let e = map.estimate(sp.p, wo, &fr, &bsdf);
+                        cx.counters.photon_estimates += 1;
+                        l.add(kind, beta * e.radiance);
+                        if O::ACTIVE {
+                            let text = format!(
+                                "{name} map: {} photons within r = {:.4} → ({:.4}, {:.4}, {:.4})",
+                                e.found, e.radius, e.radiance.x, e.radiance.y, e.radiance.z
+                            );
+                            cx.observer.note(node, &text);
+                        }
                     }
                 }
-            }
-            // Continue the path by sampling the BSDF.
-            let u_lobe = cx.sampler.defer_1d();
-            let u_dir = cx.sampler.next_2d();
-            let u_rr = cx.sampler.defer_1d();
-            let u_lobe = bsdf.lobe_number(|| cx.sampler.get_1d(u_lobe));
-            let Some(s) = bsdf.sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance) else {
-                break;
-            };
-            if !s.delta {
-                if !may_scatter {
-                    cx.observer.note(node, "diffuse depth reached");
+                // Split at the first specular vertices of a camera path (see
+                // `with_specular_splits`): both delta branches wait on the stack with their weights.
+                if splits < self.specular_splits
+                    && diffuse_bounces == 0
+                    && !bsdf.has_local()
+                    && waiting + 2 <= MAX_PENDING
+                {
+                    let lobes = bsdf.delta_lobes(wo, fr.ns, fr.ng, fr.entering);
+                    if let Some((t_dir, t_weight)) = lobes.refract
+                        && t_weight.max_element() > 0.0
+                        && lobes.reflect_weight.max_element() > 0.0
+                    {
+                        let curvature = scene.geometry.curvature(&hit);
+                        let branch = |dir: Vec3, weight: Vec3, transmitted: bool| Branch {
+                            ray: Ray::new(offset_ray_origin(sp.p, sp.p_error, fr.ng, dir), dir),
+                            cone: cone.bounce(
+                                &ray,
+                                hit.t,
+                                curvature,
+                                if transmitted { 1.0 } else { 2.0 },
+                            ),
+                            beta: beta * weight,
+                            eta_scale: if transmitted {
+                                eta_scale * lobes.eta_scale
+                            } else {
+                                eta_scale
+                            },
+                            specular: true,
+                            prev_pdf: 0.0,
+                            prev_p: sp.p,
+                            diffuse_bounces,
+                            since_local: since_local.map(|n| n + 1),
+                            map_read,
+                            background_only,
+                            kind: if transmitted {
+                                RayKind::Refract
+                            } else {
+                                RayKind::Reflect
+                            },
+                            parent: node,
+                            depth: depth + 1,
+                            medium: medium.after(scene, &v, dir),
+                            splits: splits + 1,
+                        };
+                        // Russian roulette is not applied at a split vertex (optional per vertex,
+                        // so the estimate stays unbiased); the branches' own later vertices apply it.
+                        pending[waiting] = Some(branch(t_dir, t_weight, true));
+                        pending[waiting + 1] =
+                            Some(branch(lobes.reflect_dir, lobes.reflect_weight, false));
+                        waiting += 2;
+                        break;
+                    }
+                }
+                // Continue the path by sampling the BSDF.
+                let u_lobe = cx.sampler.defer_1d();
+                let u_dir = cx.sampler.next_2d();
+                let u_rr = cx.sampler.defer_1d();
+                let u_lobe = bsdf.lobe_number(|| cx.sampler.get_1d(u_lobe));
+                let Some(s) = bsdf.sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance) else {
+                    break;
+                };
+                if !s.delta {
+                    if !may_scatter {
+                        cx.observer.note(node, "diffuse depth reached");
+                        break;
+                    }
+                    diffuse_bounces += 1;
+                }
+                beta *= s.weight;
+                if s.transmitted {
+                    eta_scale *= s.eta_scale;
+                }
+                if !beta.is_finite() || beta.max_element() <= 0.0 {
                     break;
                 }
-                diffuse_bounces += 1;
-            }
-            beta *= s.weight;
-            if s.transmitted {
-                eta_scale *= s.eta_scale;
-            }
-            if !beta.is_finite() || beta.max_element() <= 0.0 {
-                break;
-            }
-            depth += 1;
-            if depth > ROULETTE_DEPTH {
-                let q = (beta / eta_scale).max_element().min(1.0);
-                if cx.sampler.get_1d(u_rr) >= q {
-                    cx.observer.note(node, "ended by Russian roulette");
-                    break;
+                depth += 1;
+                if depth > ROULETTE_DEPTH {
+                    let q = (beta / eta_scale).max_element().min(1.0);
+                    if cx.sampler.get_1d(u_rr) >= q {
+                        cx.observer.note(node, "ended by Russian roulette");
+                        break;
+                    }
+                    beta /= q;
                 }
-                beta /= q;
+                let curvature = scene.geometry.curvature(&hit);
+                cone = if s.delta {
+                    cone.bounce(
+                        &ray,
+                        hit.t,
+                        curvature,
+                        if s.transmitted { 1.0 } else { 2.0 },
+                    )
+                } else {
+                    cone.scatter(&ray, hit.t, s.pdf)
+                };
+                specular = s.delta;
+                since_local = if s.delta {
+                    since_local.map(|n| n + 1)
+                } else {
+                    map_read = read_caustic;
+                    background_only |= read_global;
+                    Some(0)
+                };
+                prev_pdf = s.pdf;
+                prev_p = sp.p;
+                kind = match (s.delta, s.transmitted) {
+                    (_, true) => RayKind::Refract,
+                    (true, false) => RayKind::Reflect,
+                    (false, false) => RayKind::Scatter,
+                };
+                parent = node;
+                medium = medium.after(scene, &v, s.wi);
+                let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
+                ray = Ray::new(origin, s.wi);
             }
-            let curvature = scene.geometry.curvature(&hit);
-            cone = if s.delta {
-                cone.bounce(
-                    &ray,
-                    hit.t,
-                    curvature,
-                    if s.transmitted { 1.0 } else { 2.0 },
-                )
-            } else {
-                cone.scatter(&ray, hit.t, s.pdf)
-            };
-            specular = s.delta;
-            since_local = if s.delta {
-                since_local.map(|n| n + 1)
-            } else {
-                map_read = read_caustic;
-                background_only |= read_global;
-                Some(0)
-            };
-            prev_pdf = s.pdf;
-            prev_p = sp.p;
-            kind = match (s.delta, s.transmitted) {
-                (_, true) => RayKind::Refract,
-                (true, false) => RayKind::Reflect,
-                (false, false) => RayKind::Scatter,
-            };
-            parent = node;
-            medium = medium.after(scene, &v, s.wi);
-            let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
-            ray = Ray::new(origin, s.wi);
         }
         if O::ACTIVE {
             // The radiance each logged ray brought back: what the path gathered from it on,

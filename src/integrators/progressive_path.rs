@@ -26,6 +26,12 @@ use super::{PathTracer, Radiance};
 use crate::geometry::Ray;
 use crate::render_scene::RenderScene;
 
+/// Specular vertices at which the progressive integrators split their camera paths
+/// ([`PathTracer::with_specular_splits`]): at most 4 branches per camera sample. Light reaching
+/// the camera through water or glass (the light's image in it) is then followed along both
+/// Fresnel branches instead of being found by one sample in ~1/F, the fireflies of issue #24.
+pub const SPECULAR_SPLITS: u32 = 2;
+
 /// A progressive integrator: the current pass's maps and the camera paths that read them.
 #[derive(Debug)]
 pub struct ProgressivePath<'a> {
@@ -65,7 +71,7 @@ impl<'a> ProgressivePath<'a> {
     fn new(scene: &'a RenderScene, set: MapSet, global_at: u32) -> Self {
         Self {
             photons: ProgressivePhotons::new(scene, set),
-            path: PathTracer::new(scene),
+            path: PathTracer::new(scene).with_specular_splits(SPECULAR_SPLITS),
             global_at,
             global_has_caustics: set.global_any_bounce,
         }
