@@ -1,7 +1,7 @@
 //! The default estimator (issue #24): which integrator a scene gets when it names none, when it
 //! names one and when the command line names one; a scene without a specular caster renders
 //! the path tracer's bytes without a photon pass; and the light's image in rippled water
-//! converges without single-sample glints (`scenes/pool.ron`, small).
+//! converges without single-sample glints (`benches/scenes/pool.ron`, small).
 
 use caustic::pipeline::{SceneOverrides, prepare};
 use caustic::render::{Film, RenderOptions, render};
@@ -75,7 +75,7 @@ fn a_scene_naming_an_integrator_gets_that_one_with_or_without_a_caster() {
 fn the_command_lines_integrator_wins_over_the_scene_and_the_default() {
     // pool.ron names no integrator (default: path-ppm, the water is a caster); refraction.ron
     // names Whitted.
-    for file in ["scenes/pool.ron", "scenes/refraction.ron"] {
+    for file in ["benches/scenes/pool.ron", "scenes/refraction.ron"] {
         let path = root().join(file);
         for &kind in IntegratorKind::ALL {
             let overrides = SceneOverrides {
@@ -119,7 +119,7 @@ fn brightest(f: &Film) -> f32 {
     f.pixels.iter().map(|p| p.max_element()).fold(0.0, f32::max)
 }
 
-/// `scenes/pool.ron` at 64 × 48, `spp` samples per pixel, with `integrator` (the default when
+/// `benches/scenes/pool.ron` at 64 × 48, `spp` samples per pixel, with `integrator` (the default when
 /// `None`) and `seed`.
 fn pool(integrator: Option<IntegratorKind>, spp: u32, seed: u64) -> Film {
     let overrides = SceneOverrides {
@@ -130,7 +130,8 @@ fn pool(integrator: Option<IntegratorKind>, spp: u32, seed: u64) -> Film {
         integrator,
         ..SceneOverrides::default()
     };
-    let p = prepare(&root().join("scenes/pool.ron"), &overrides).expect("pool.ron prepares");
+    let p =
+        prepare(&root().join("benches/scenes/pool.ron"), &overrides).expect("pool.ron prepares");
     render(&p.render_scene, &RenderOptions::default())
         .expect("renders")
         .film

@@ -32,13 +32,7 @@ use crate::common::scene_files;
 
 /// Scenes where the test does not hold today, each with what was measured (issue #24, open):
 /// they are rendered and their figures printed, but not asserted. Every other scene must agree.
-const KNOWN_DISAGREEMENTS: [(&str, &str); 3] = [
-    (
-        "pool.ron",
-        "the statistic does not apply: `path` finds the light's image in the water once in \
-         ~30 samples, so its per-pixel variance estimate is far too small (0 where no sample \
-         found it); image z ≈ 1. Covered by default_estimator.rs's glint test instead",
-    ),
+const KNOWN_DISAGREEMENTS: [(&str, &str); 2] = [
     (
         "blob.ron",
         "path-ppm's image mean is ~2.4 % below path's (image z ≈ −4) with 1 000 caustic photons \
