@@ -11,8 +11,8 @@ use glam::{DVec2, DVec3};
 
 use super::mesher::{self, Part, PartSpec};
 use super::sdf::{
-    capsule, cylinder_y, cylinder_z, ellipsoid, rotate_z, round_box, smooth_intersection, smooth_union, sphere,
-    triangle_2d,
+    capsule, cylinder_y, cylinder_z, ellipsoid, rotate_z, round_box, smooth_intersection,
+    smooth_union, sphere, triangle_2d,
 };
 
 fn v(x: f64, y: f64, z: f64) -> DVec3 {
@@ -220,7 +220,11 @@ fn faucet_handle(p: DVec3, x: f64) -> f64 {
     let hub = cylinder_z(p, x, 0.0, 0.23, 0.38, 0.62, 0.07);
     let lever = capsule(p, v(x, 0.0, 0.52), v(x, 0.72, 0.62), 0.08);
     let tip = sphere(p, v(x, 0.76, 0.62), 0.11);
-    smooth_union(smooth_union(smooth_union(stem, hub, 0.05), lever, 0.06), tip, 0.05)
+    smooth_union(
+        smooth_union(smooth_union(stem, hub, 0.05), lever, 0.06),
+        tip,
+        0.05,
+    )
 }
 
 /// Both handles, either side of the spout.

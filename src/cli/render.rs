@@ -15,8 +15,8 @@ use caustic::farm::part_meta::settings_hash;
 use caustic::farm::{PartMeta, Shard};
 use caustic::pipeline::prepare;
 use caustic::render::output::{OutputFormat, write_image};
-use caustic::render::tonemap::Display;
 use caustic::render::passes::{CheckpointPlan, PassPlan, render_in_passes};
+use caustic::render::tonemap::Display;
 use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, write_layers};
 
 use super::{SceneArgs, count, print_warnings};

@@ -321,7 +321,11 @@ mod tests {
                 .iter()
                 .flat_map(|v| {
                     (*v * exposure).to_array().map(|c| {
-                        let c = if c.is_finite() { c.clamp(0.0, 1.0) } else { 0.0 };
+                        let c = if c.is_finite() {
+                            c.clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
                         (srgb_encode(c) * 255.0 + 0.5) as u8
                     })
                 })
