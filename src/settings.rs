@@ -220,6 +220,19 @@ settings_enum! {
     }
 }
 
+settings_enum! {
+    /// How linear radiance (after `exposure`) becomes display values in [0, 1] for 8-bit images
+    /// (PNG). EXR files are always written linear, without it.
+    pub enum Tonemap ("a tone-mapping curve") {
+        /// Clip each channel to [0, 1]: radiance above 1 saturates to white.
+        Linear = "linear",
+        /// Narkowicz's (2015) rational fit of the ACES filmic reference rendering transform,
+        /// per channel: x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), clipped to [0, 1]. Rolls
+        /// highlights off smoothly; a channel clips only above 7.24.
+        Aces = "aces",
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,4 +1,5 @@
-//! Regenerates the bath scene's models, `assets/duck.obj` and `assets/boat.obj`, from the
+//! Regenerates the bath scene's models, `assets/duck.obj`, `assets/boat.obj` and
+//! `assets/faucet.obj`, from the
 //! implicit surfaces in `models.rs` (nothing is downloaded): `scripts/make_models.sh`, or
 //! `cargo run --release --example make_models`.
 //!
@@ -29,6 +30,7 @@ fn main() -> ExitCode {
             models::duck_obj as fn() -> Result<String, Vec<String>>,
         ),
         ("boat.obj", models::boat_obj),
+        ("faucet.obj", models::faucet_obj),
     ] {
         let t = std::time::Instant::now();
         match make() {

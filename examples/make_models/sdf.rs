@@ -37,6 +37,19 @@ pub fn cylinder_y(p: DVec3, x: f64, z: f64, r: f64, y0: f64, y1: f64, round: f64
     d.max(DVec2::ZERO).length() + d.max_element().min(0.0) - round
 }
 
+/// Capsule: the points within `r` of the segment from `a` to `b`.
+pub fn capsule(p: DVec3, a: DVec3, b: DVec3, r: f64) -> f64 {
+    let (pa, ba) = (p - a, b - a);
+    let h = (pa.dot(ba) / ba.dot(ba)).clamp(0.0, 1.0);
+    (pa - ba * h).length() - r
+}
+
+/// Capped cylinder along z, radius `r`, from `z0` to `z1` on the axis through `(x, y)`, edges
+/// rounded by `round`: [`cylinder_y`] with the y and z axes exchanged.
+pub fn cylinder_z(p: DVec3, x: f64, y: f64, r: f64, z0: f64, z1: f64, round: f64) -> f64 {
+    cylinder_y(DVec3::new(p.x, p.z, p.y), x, y, r, z0, z1, round)
+}
+
 /// Signed distance to a 2D triangle `a, b, c` (Quilez).
 pub fn triangle_2d(p: DVec2, a: DVec2, b: DVec2, c: DVec2) -> f64 {
     let (e0, e1, e2) = (b - a, c - b, a - c);

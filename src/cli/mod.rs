@@ -24,7 +24,7 @@ use clap::{Args, Parser, Subcommand};
 use caustic::Error;
 use caustic::pipeline::SceneOverrides;
 use caustic::scene::Diagnostic;
-use caustic::settings::{IntegratorKind, SamplerKind};
+use caustic::settings::{IntegratorKind, SamplerKind, Tonemap};
 
 /// caustic: a ray tracer driven by RON/TOML scene files.
 #[derive(Parser)]
@@ -140,6 +140,10 @@ pub struct SceneArgs {
     /// Final-gather rays per camera hit (`photons.final_gather`; 0: read the global map).
     #[arg(long, value_name = "N")]
     final_gather: Option<u32>,
+    /// Tone-mapping curve for 8-bit images, after the exposure (`render.tonemap`): `linear`
+    /// clips, `aces` rolls highlights off (Narkowicz's ACES fit). EXR output stays linear.
+    #[arg(long, value_enum)]
+    tonemap: Option<Tonemap>,
 }
 
 impl SceneArgs {
@@ -153,6 +157,9 @@ impl SceneArgs {
             if let Some(v) = v {
                 sets.push(format!("{field}={v}"));
             }
+        }
+        if let Some(t) = self.tonemap {
+            sets.push(format!("render.tonemap={}", t.name()));
         }
         if let Some(r) = self.max_radius {
             sets.push(format!("photons.max_radius={r:?}"));

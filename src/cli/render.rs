@@ -16,6 +16,7 @@ use caustic::farm::{PartMeta, Shard};
 use caustic::pipeline::prepare;
 use caustic::render::output::{OutputFormat, write_image};
 use caustic::render::passes::{CheckpointPlan, PassPlan, render_in_passes};
+use caustic::render::tonemap::Display;
 use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, write_layers};
 
 use super::{SceneArgs, count, print_warnings};
@@ -310,6 +311,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         super::max_rmse::check_size(reference, p.width, p.height, region)?;
     }
     let exposure = prepared.render_scene.params.exposure;
+    let display = Display {
+        exposure,
+        tonemap: prepared.render_scene.params.tonemap,
+    };
     let spp = prepared.render_scene.params.samples_per_pixel;
     let samples = match &args.samples {
         Some(r) if r.end > spp => {
@@ -375,7 +380,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         checkpoint: args.checkpoint.as_deref().map(|path| CheckpointPlan {
             path,
             every: args.checkpoint_every,
-            exposure,
+            display,
         }),
         time_budget: args.time,
         progress: terminal,
@@ -427,7 +432,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     } else if !layers.is_empty() {
         write_layers(&out.sums, out.parts.as_deref(), &layers, &output)?;
     } else {
-        write_image(&out.film, &output, exposure)?;
+        write_image(&out.film, &output, display)?;
     }
     if let (Some(cp), Some(_)) = (&args.checkpoint, saved)
         && let Err(e) = std::fs::remove_file(cp)

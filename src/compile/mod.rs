@@ -240,6 +240,7 @@ pub fn compile(
         seed: r.seed,
         background: r.background.into(),
         exposure: r.exposure,
+        tonemap: r.tonemap,
         integrator,
         default_estimator,
         sampler: r.sampler,

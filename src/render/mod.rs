@@ -10,6 +10,7 @@ pub mod output;
 pub mod passes;
 pub mod pixel_sums;
 pub mod tiles;
+pub mod tonemap;
 pub mod trace_pixel;
 
 pub use film::Film;

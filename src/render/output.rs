@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use image::{ImageFormat, RgbImage};
 
 use super::Film;
+use super::tonemap::Display;
 use crate::binfile::{AtomicWrite, parent_dir};
 
 /// How images (and the other files the commands write) are written: hidden `.caustic-*.tmp`
@@ -99,30 +100,33 @@ pub fn srgb_encode(v: f32) -> f32 {
     }
 }
 
-/// The film as 8-bit sRGB: radiance × `exposure`, clamped to [0, 1], encoded, rounded.
+/// The film as 8-bit sRGB: radiance × exposure, mapped to [0, 1] by the display's tone curve
+/// ([`Display::map`]; a bare `f32` is an exposure with the linear clip), encoded, rounded.
+/// NaN, infinite and negative channels encode as 0.
 #[must_use]
-pub fn to_srgb8(film: &Film, exposure: f32) -> RgbImage {
+pub fn to_srgb8(film: &Film, display: impl Into<Display>) -> RgbImage {
+    let display = display.into();
     let mut img = RgbImage::new(film.width, film.height);
     for (px, v) in img.pixels_mut().zip(&film.pixels) {
-        let c = (*v * exposure).to_array().map(|c| {
-            let c = if c.is_finite() {
-                c.clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (srgb_encode(c) * 255.0 + 0.5) as u8
-        });
+        let c = v
+            .to_array()
+            .map(|c| (srgb_encode(display.map(c)) * 255.0 + 0.5) as u8);
         *px = image::Rgb(c);
     }
     img
 }
 
-/// Encodes the film for `path`'s format into bytes.
-pub fn encode(film: &Film, path: &Path, exposure: f32) -> Result<Vec<u8>, OutputError> {
+/// Encodes the film for `path`'s format into bytes: PNG through `display` (exposure and tone
+/// curve), EXR linear and unscaled.
+pub fn encode(
+    film: &Film,
+    path: &Path,
+    display: impl Into<Display>,
+) -> Result<Vec<u8>, OutputError> {
     let format = OutputFormat::for_path(path)?;
     let mut bytes = std::io::Cursor::new(Vec::new());
     let result = match format {
-        OutputFormat::Png => to_srgb8(film, exposure).write_to(&mut bytes, ImageFormat::Png),
+        OutputFormat::Png => to_srgb8(film, display).write_to(&mut bytes, ImageFormat::Png),
         OutputFormat::Exr => {
             return super::exr::encode_rgb_exr(film.width as usize, film.height as usize, &|i| {
                 film.pixels[i]
@@ -140,9 +144,14 @@ pub fn encode(film: &Film, path: &Path, exposure: f32) -> Result<Vec<u8>, Output
     Ok(bytes.into_inner())
 }
 
-/// Writes the film to `path` atomically; an existing file is replaced only on success.
-pub fn write_image(film: &Film, path: &Path, exposure: f32) -> Result<(), OutputError> {
-    let bytes = encode(film, path, exposure)?;
+/// Writes the film to `path` atomically; an existing file is replaced only on success. PNG goes
+/// through `display` (an `f32` is an exposure with the linear clip), EXR stays linear.
+pub fn write_image(
+    film: &Film,
+    path: &Path,
+    display: impl Into<Display>,
+) -> Result<(), OutputError> {
+    let bytes = encode(film, path, display)?;
     write_atomic(path, &bytes)
 }
 
@@ -293,6 +302,47 @@ mod tests {
         assert!(e.starts_with("error: cannot write `"), "{e}");
         assert!(e.contains(&path.display().to_string()), "{e}");
         assert!(!e.contains(".caustic-") && !e.contains("at path"), "{e}");
+    }
+
+    /// The linear curve (the default) encodes exactly as the clip-then-encode writer before tone
+    /// mapping existed, written out again here, over values spanning black to far over white.
+    #[test]
+    fn linear_tonemap_is_byte_identical_to_the_plain_clip() {
+        use crate::render::tonemap::{Display, Tonemap};
+        let n = 4096u32;
+        let mut f = Film::new(n, 1);
+        for (i, p) in f.pixels.iter_mut().enumerate() {
+            let x = (i as f32 / n as f32).powi(3) * 3.0;
+            *p = glam::Vec3::new(x, x * 0.37, 1.0 - x);
+        }
+        for exposure in [1.0, 0.7, 2.5] {
+            let old: Vec<u8> = f
+                .pixels
+                .iter()
+                .flat_map(|v| {
+                    (*v * exposure).to_array().map(|c| {
+                        let c = if c.is_finite() {
+                            c.clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        (srgb_encode(c) * 255.0 + 0.5) as u8
+                    })
+                })
+                .collect();
+            let display = Display {
+                exposure,
+                tonemap: Tonemap::Linear,
+            };
+            assert_eq!(to_srgb8(&f, display).into_raw(), old);
+            assert_eq!(to_srgb8(&f, exposure).into_raw(), old);
+            // The filmic curve differs (darker mid-tones are lifted, highlights kept).
+            let aces = Display {
+                exposure,
+                tonemap: Tonemap::Aces,
+            };
+            assert_ne!(to_srgb8(&f, aces).into_raw(), old);
+        }
     }
 
     #[test]

@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::output::write_image;
+use super::tonemap::Display;
 use super::{RenderError, RenderJob, RenderOutput};
 
 /// Where and how often the image so far is saved.
@@ -19,8 +20,8 @@ pub struct CheckpointPlan<'a> {
     pub path: &'a Path,
     /// Least time between saves (zero: after every pass).
     pub every: Duration,
-    /// Exposure for 8-bit checkpoints.
-    pub exposure: f32,
+    /// Exposure and tone curve for 8-bit checkpoints.
+    pub display: Display,
 }
 
 /// How to split a render into passes.
@@ -93,7 +94,7 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
         }
         if let Some(cp) = &plan.checkpoint {
             if last_save.elapsed() >= cp.every {
-                match write_image(&job.snapshot(), cp.path, cp.exposure) {
+                match write_image(&job.snapshot(), cp.path, cp.display) {
                     Ok(()) => saved = Some(done),
                     Err(e) => eprintln!("warning: checkpoint not saved: {e}"),
                 }

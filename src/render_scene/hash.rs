@@ -78,6 +78,7 @@ fn hash_params(h: &mut Fnv, params: &RenderParams) {
         seed,
         background: _,
         exposure: _,
+        tonemap: _,
         integrator: _,
         default_estimator: _,
         sampler,

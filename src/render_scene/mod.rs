@@ -26,7 +26,7 @@ pub use texture::Texture;
 use glam::Vec3;
 
 use crate::sampling::SamplerKind;
-pub use crate::settings::{IntegratorKind, TextureFilter};
+pub use crate::settings::{IntegratorKind, TextureFilter, Tonemap};
 use crate::shading::LobeFlags;
 
 /// Rendering parameters after command-line overrides.
@@ -50,6 +50,8 @@ pub struct RenderParams {
     pub background: Vec3,
     /// Radiance scale applied when writing 8-bit images.
     pub exposure: f32,
+    /// Tone-mapping curve for 8-bit images, after `exposure`.
+    pub tonemap: Tonemap,
     /// Which integrator renders the image (the scene's or the command line's, else the default
     /// estimator's choice).
     pub integrator: IntegratorKind,

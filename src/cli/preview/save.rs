@@ -49,7 +49,14 @@ pub fn save(
     } else if !s.layers.is_empty() {
         write_layers(sums, job.parts(), &s.layers, output)
     } else {
-        write_image(&job.snapshot(), output, p.exposure)
+        write_image(
+            &job.snapshot(),
+            output,
+            caustic::render::tonemap::Display {
+                exposure: p.exposure,
+                tonemap: p.tonemap,
+            },
+        )
     };
     written.map_err(|e| format!("not saved: {e}"))?;
     let mut message = format!(

@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-pub use crate::settings::{IntegratorKind, SamplerKind, TextureFilter};
+pub use crate::settings::{IntegratorKind, SamplerKind, TextureFilter, Tonemap};
 
 mod light;
 mod material;
@@ -78,6 +78,9 @@ pub struct RenderSettings {
     pub background: Rgb,
     /// Linear scale applied to radiance before writing 8-bit images.
     pub exposure: f32,
+    /// Tone-mapping curve for 8-bit images, applied after `exposure`: `Linear` (clip, the
+    /// default) or `Aces` (a filmic curve). EXR output stays linear.
+    pub tonemap: Tonemap,
     /// Light-transport algorithm. Unset: the default estimator, chosen per scene — `PathPpm`
     /// (path tracing with a progressive caustic photon map, per-pass photon counts and gather
     /// sizes chosen from the image size; see docs/progressive.md) when some object's material
@@ -107,6 +110,7 @@ impl Default for RenderSettings {
             seed: 0,
             background: [0.0; 3],
             exposure: 1.0,
+            tonemap: Tonemap::Linear,
             integrator: None,
             sampler: SamplerKind::Sobol,
             diffuse_depth: None,
