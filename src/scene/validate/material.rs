@@ -78,13 +78,17 @@ impl<'a> Validator<'a> {
 
     /// Roughness in [0, 1], a known conductor or tint colours in [0, 1], and a valid
     /// absorption (the rules of `shading::absorption`, whose error text is reported).
-    fn microfacets(&mut self, path: &str, m: &MaterialSpec) {
-        let rough = match m.roughness {
-            RoughnessSpec::Isotropic(r) => vec![(format!("{path}.roughness"), r)],
+    fn microfacets(&mut self, path: &str, m: &'a MaterialSpec) {
+        let rough = match &m.roughness {
+            RoughnessSpec::Isotropic(r) => vec![(format!("{path}.roughness"), *r)],
             RoughnessSpec::Anisotropic([x, y]) => vec![
-                (format!("{path}.roughness[0]"), x),
-                (format!("{path}.roughness[1]"), y),
+                (format!("{path}.roughness[0]"), *x),
+                (format!("{path}.roughness[1]"), *y),
             ],
+            RoughnessSpec::Texture(name) => {
+                self.texture_ref(&format!("{path}.roughness"), name, TextureUse::Color);
+                Vec::new()
+            }
         };
         for (p, r) in rough {
             if self.finite(&p, r) && !(0.0..=1.0).contains(&r) {
