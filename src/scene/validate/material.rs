@@ -100,23 +100,24 @@ impl<'a> Validator<'a> {
         }
         match &m.conductor {
             None => {}
-            Some(ConductorSpec::Preset(name)) => {
-                if !CONDUCTOR_PRESETS.contains(&name.as_str()) {
-                    let p = format!("{path}.conductor");
-                    let mut d = Diagnostic::error(
-                        &p,
-                        format!(
-                            "unknown conductor `{name}`; the presets are {}",
-                            quoted_list(CONDUCTOR_PRESETS)
-                        ),
-                    );
-                    d = match did_you_mean(name, CONDUCTOR_PRESETS) {
-                        Some(s) => d.with_help(format!("did you mean `{s}`?")),
-                        None => d.with_help("or give an artist's colours: `conductor: (f0: (r, g, b), tint: (r, g, b))`"),
-                    };
-                    self.out.push(d);
-                }
+            Some(ConductorSpec::Preset(name)) if !CONDUCTOR_PRESETS.contains(&name.as_str()) => {
+                let p = format!("{path}.conductor");
+                let mut d = Diagnostic::error(
+                    &p,
+                    format!(
+                        "unknown conductor `{name}`; the presets are {}",
+                        quoted_list(CONDUCTOR_PRESETS)
+                    ),
+                );
+                d = match did_you_mean(name, CONDUCTOR_PRESETS) {
+                    Some(s) => d.with_help(format!("did you mean `{s}`?")),
+                    None => d.with_help(
+                        "or give an artist's colours: `conductor: (f0: (r, g, b), tint: (r, g, b))`",
+                    ),
+                };
+                self.out.push(d);
             }
+            Some(ConductorSpec::Preset(_)) => {}
             Some(ConductorSpec::Tint(t)) => {
                 self.unit_rgb(&format!("{path}.conductor.f0"), t.f0, "f0");
                 self.unit_rgb(&format!("{path}.conductor.tint"), t.tint, "tint");
