@@ -66,9 +66,19 @@ impl MaterialTable {
                 errors,
             )
         });
-        let [rx, ry] = m.roughness.pair();
-        // Perceptual roughness r to the GGX width α = r² (docs/material.md); 0 is smooth.
+        let [rx, ry] = m.roughness.pair().unwrap_or([0.0, 0.0]);
+        // Perceptual roughness r to the GGX width α = r² (docs/material.md); 0 is smooth. A
+        // roughness texture leaves the BSDF smooth here and roughens it at each hit.
         let distribution = (rx > 0.0 || ry > 0.0).then(|| Ggx::new(rx * rx, ry * ry));
+        let roughness_texture = m.roughness.texture().and_then(|t| {
+            self.textures.resolve(
+                scene,
+                base_dir,
+                t,
+                &format!("materials.{name}.roughness"),
+                errors,
+            )
+        });
         let conductor = match &m.conductor {
             None => None,
             Some(ConductorSpec::Preset(p)) => {
@@ -108,7 +118,7 @@ impl MaterialTable {
             m.ior,
         )
         .with_microfacets(distribution, conductor);
-        let filtered = [color_texture, bump]
+        let filtered = [color_texture, bump, roughness_texture]
             .into_iter()
             .flatten()
             .any(|t| self.textures.list[t as usize].filtered());
@@ -119,6 +129,8 @@ impl MaterialTable {
                 bsdf,
                 color_texture,
                 bump,
+                roughness_texture,
+                conductor,
                 filtered,
                 absorption,
             },

@@ -7,6 +7,8 @@ use super::texture::Lookup;
 use super::{RenderScene, SurfacePoint, TextureFilter};
 use crate::geometry::Frame;
 use crate::shading::absorption::Absorption;
+use crate::shading::conductor::ConductorFresnel;
+use crate::shading::microfacet::Ggx;
 use crate::shading::{Bsdf, usable_shading_normal};
 use crate::texture::Footprint;
 
@@ -26,6 +28,13 @@ pub struct SurfaceMaterial {
     pub color_texture: Option<u32>,
     /// Texture perturbing the shading normal, as an index into `RenderScene::textures`.
     pub bump: Option<u32>,
+    /// Texture giving the isotropic roughness r (mean channel, clamped to [0, 1]; GGX α = r²)
+    /// of the mirror and dielectric parts at each hit, as an index into
+    /// `RenderScene::textures`; `bsdf` is then the smooth BSDF it roughens.
+    pub roughness_texture: Option<u32>,
+    /// The metal Fresnel of the mirror part (kept to rebuild the rough lobes at each hit when
+    /// the roughness is a texture).
+    pub conductor: Option<ConductorFresnel>,
     /// Some texture of this material is an image, so lookups need the pixel's footprint.
     pub filtered: bool,
     /// Beer–Lambert absorption inside the object (the side its geometric normal points away
@@ -40,6 +49,10 @@ impl std::fmt::Debug for SurfaceMaterial {
             .field("color_texture", &self.color_texture)
             .field("bump", &self.bump)
             .field("filtered", &self.filtered);
+        if let Some(t) = self.roughness_texture {
+            d.field("roughness_texture", &t)
+                .field("conductor", &self.conductor);
+        }
         if !self.absorption.is_clear() {
             d.field("absorption", &self.absorption.sigma());
         }
@@ -77,7 +90,10 @@ impl RenderScene {
         let entering = wo.dot(sp.ng) > 0.0;
         let mut bsdf = material.bsdf;
         let mut ns = sp.ns;
-        if material.color_texture.is_some() || material.bump.is_some() {
+        if material.color_texture.is_some()
+            || material.bump.is_some()
+            || material.roughness_texture.is_some()
+        {
             let sps = self.geometry.surface_params(sp);
             let footprint = match self.params.texture_filter {
                 _ if !material.filtered => Footprint::POINT,
@@ -103,6 +119,10 @@ impl RenderScene {
             if let Some(t) = material.color_texture {
                 bsdf = bsdf.with_color(self.textures[t as usize].color(&lookup));
             }
+            if let Some(t) = material.roughness_texture {
+                let c = self.textures[t as usize].color(&lookup);
+                bsdf = bsdf.with_microfacets(textured_ggx(c), material.conductor);
+            }
         }
         let (ng, ns) = if entering { (sp.ng, ns) } else { (-sp.ng, -ns) };
         ShadingPoint {
@@ -112,6 +132,20 @@ impl RenderScene {
             entering,
         }
     }
+}
+
+/// The GGX distribution of a roughness texture's value `c`: r = its mean channel (a grey
+/// texel's value exactly) clamped to [0, 1], α = r² as for constant roughness; `None`
+/// (smooth) at 0 or for a NaN texel.
+#[inline]
+fn textured_ggx(c: Vec3) -> Option<Ggx> {
+    let mean = if c.x == c.y && c.y == c.z {
+        c.x
+    } else {
+        (c.x + c.y + c.z) / 3.0
+    };
+    let r = mean.clamp(0.0, 1.0);
+    (r > 0.0).then(|| Ggx::isotropic(r * r))
 }
 
 /// The footprint in uv of a ray cone `width` wide arriving along `dir` at a surface with

@@ -36,5 +36,6 @@ mod queries;
 mod render_snapshots;
 mod reported;
 mod reported_photon;
+mod rough_textures;
 mod textures;
 mod watertight;

@@ -39,8 +39,10 @@ pub struct MaterialSpec {
     #[serde(default)]
     pub bump: Option<String>,
     /// Microfacet roughness of the mirror and dielectric parts, in [0, 1]: `r`, or `(r_x, r_y)`
-    /// along the shading frame's two tangents (anisotropic). GGX with α = r² (docs/material.md).
-    /// 0 (the default) is the perfect mirror and the smooth dielectric.
+    /// along the shading frame's two tangents (anisotropic), or the name of a colour texture
+    /// whose mean channel (clamped to [0, 1]) is the isotropic roughness at each hit. GGX with
+    /// α = r² (docs/material.md). 0 (the default) is the perfect mirror and the smooth
+    /// dielectric.
     #[serde(default)]
     pub roughness: RoughnessSpec,
     /// Makes the mirror part a metal: a preset name (`"chrome"`, `"aluminium"`, `"gold"`,
@@ -57,13 +59,17 @@ pub struct MaterialSpec {
 }
 
 /// A microfacet roughness: isotropic, or one value per tangent axis.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(untagged)]
 pub enum RoughnessSpec {
     /// The same roughness in every direction, in [0, 1].
     Isotropic(f32),
     /// Roughness along the first and the second tangent, each in [0, 1].
     Anisotropic([f32; 2]),
+    /// The name of a colour texture (a greyscale `Bitmap`, `Marble` or `Noise`): the mean of
+    /// its three channels at a hit, clamped to [0, 1], is the isotropic roughness there (looked
+    /// up with the same footprint filtering as the colour).
+    Texture(String),
 }
 
 impl Default for RoughnessSpec {
@@ -73,12 +79,22 @@ impl Default for RoughnessSpec {
 }
 
 impl RoughnessSpec {
-    /// The roughness per tangent axis.
+    /// The constant roughness per tangent axis (`None` for a texture).
     #[must_use]
-    pub fn pair(&self) -> [f32; 2] {
-        match *self {
-            RoughnessSpec::Isotropic(r) => [r, r],
-            RoughnessSpec::Anisotropic(p) => p,
+    pub fn pair(&self) -> Option<[f32; 2]> {
+        match self {
+            RoughnessSpec::Isotropic(r) => Some([*r, *r]),
+            RoughnessSpec::Anisotropic(p) => Some(*p),
+            RoughnessSpec::Texture(_) => None,
+        }
+    }
+
+    /// The name of the roughness texture, if the roughness is one.
+    #[must_use]
+    pub fn texture(&self) -> Option<&str> {
+        match self {
+            RoughnessSpec::Texture(t) => Some(t),
+            RoughnessSpec::Isotropic(_) | RoughnessSpec::Anisotropic(_) => None,
         }
     }
 }

@@ -78,13 +78,17 @@ impl<'a> Validator<'a> {
 
     /// Roughness in [0, 1], a known conductor or tint colours in [0, 1], and a valid
     /// absorption (the rules of `shading::absorption`, whose error text is reported).
-    fn microfacets(&mut self, path: &str, m: &MaterialSpec) {
-        let rough = match m.roughness {
-            RoughnessSpec::Isotropic(r) => vec![(format!("{path}.roughness"), r)],
+    fn microfacets(&mut self, path: &str, m: &'a MaterialSpec) {
+        let rough = match &m.roughness {
+            RoughnessSpec::Isotropic(r) => vec![(format!("{path}.roughness"), *r)],
             RoughnessSpec::Anisotropic([x, y]) => vec![
-                (format!("{path}.roughness[0]"), x),
-                (format!("{path}.roughness[1]"), y),
+                (format!("{path}.roughness[0]"), *x),
+                (format!("{path}.roughness[1]"), *y),
             ],
+            RoughnessSpec::Texture(name) => {
+                self.texture_ref(&format!("{path}.roughness"), name, TextureUse::Color);
+                Vec::new()
+            }
         };
         for (p, r) in rough {
             if self.finite(&p, r) && !(0.0..=1.0).contains(&r) {
@@ -96,23 +100,24 @@ impl<'a> Validator<'a> {
         }
         match &m.conductor {
             None => {}
-            Some(ConductorSpec::Preset(name)) => {
-                if !CONDUCTOR_PRESETS.contains(&name.as_str()) {
-                    let p = format!("{path}.conductor");
-                    let mut d = Diagnostic::error(
-                        &p,
-                        format!(
-                            "unknown conductor `{name}`; the presets are {}",
-                            quoted_list(CONDUCTOR_PRESETS)
-                        ),
-                    );
-                    d = match did_you_mean(name, CONDUCTOR_PRESETS) {
-                        Some(s) => d.with_help(format!("did you mean `{s}`?")),
-                        None => d.with_help("or give an artist's colours: `conductor: (f0: (r, g, b), tint: (r, g, b))`"),
-                    };
-                    self.out.push(d);
-                }
+            Some(ConductorSpec::Preset(name)) if !CONDUCTOR_PRESETS.contains(&name.as_str()) => {
+                let p = format!("{path}.conductor");
+                let mut d = Diagnostic::error(
+                    &p,
+                    format!(
+                        "unknown conductor `{name}`; the presets are {}",
+                        quoted_list(CONDUCTOR_PRESETS)
+                    ),
+                );
+                d = match did_you_mean(name, CONDUCTOR_PRESETS) {
+                    Some(s) => d.with_help(format!("did you mean `{s}`?")),
+                    None => d.with_help(
+                        "or give an artist's colours: `conductor: (f0: (r, g, b), tint: (r, g, b))`",
+                    ),
+                };
+                self.out.push(d);
             }
+            Some(ConductorSpec::Preset(_)) => {}
             Some(ConductorSpec::Tint(t)) => {
                 self.unit_rgb(&format!("{path}.conductor.f0"), t.f0, "f0");
                 self.unit_rgb(&format!("{path}.conductor.tint"), t.tint, "tint");
