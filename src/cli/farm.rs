@@ -216,10 +216,10 @@ fn pin_default_estimator(tree: &mut Value, params: &RenderParams) {
     if let Some(lights) = tree["lights"].as_array_mut() {
         for (light, budget) in lights.iter_mut().zip(&p.caustic_per_light) {
             // Externally tagged: `{ "Point": { … } }`.
-            if let Some(fields) = light.as_object_mut().and_then(|m| m.values_mut().next()) {
-                if fields.get("caustic_photons").is_some() {
-                    fields["caustic_photons"] = budget.map_or(Value::Null, Value::from);
-                }
+            if let Some(fields) = light.as_object_mut().and_then(|m| m.values_mut().next())
+                && fields.get("caustic_photons").is_some()
+            {
+                fields["caustic_photons"] = budget.map_or(Value::Null, Value::from);
             }
         }
     }

@@ -10,8 +10,6 @@ use crate::geometry::Ray;
 use crate::shading::{Bsdf, ShadingFrame};
 
 /// What a ray found ([`RenderScene::interact`]).
-// The surface variant carries the BSDF by value on purpose: boxing it would allocate per ray.
-#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[allow(
     clippy::large_enum_variant,
