@@ -182,7 +182,10 @@ fn compare_rows(e: &Entry, image: &RgbImage) -> Comparison {
          `scripts/doc_images.sh {}`)",
         e.file
     );
-    let exposure = prepared.render_scene.params.exposure;
+    let display = caustic::render::tonemap::Display {
+        exposure: prepared.render_scene.params.exposure,
+        tonemap: prepared.render_scene.params.tonemap,
+    };
     let mut c = Comparison::default();
     // One job for all strips: the integrator (photon maps) is prepared once.
     let first = Region {
@@ -205,7 +208,7 @@ fn compare_rows(e: &Entry, image: &RgbImage) -> Comparison {
         let out = job
             .render_region(region)
             .unwrap_or_else(|err| panic!("{at}: {err}"));
-        let fresh = to_srgb8(&out.film, exposure);
+        let fresh = to_srgb8(&out.film, display);
         for (x, y, p) in fresh.enumerate_pixels() {
             let q = image.get_pixel(x, y0 + y);
             let step =
