@@ -52,7 +52,7 @@ impl From<f32> for Display {
 pub fn aces_narkowicz(x: f32) -> f32 {
     // Past x ≈ 7.24 the curve is above 1 (its asymptote is 2.51 / 2.43), so capping the input
     // changes nothing but keeps x² finite (1e30 would give ∞ / ∞ = NaN).
-    let x = x.max(0.0).min(1.0e6);
+    let x = if x > 0.0 { x.min(1.0e6) } else { 0.0 };
     let y = x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14);
     y.clamp(0.0, 1.0)
 }
