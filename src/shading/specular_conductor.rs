@@ -6,10 +6,8 @@
 use glam::Vec3;
 
 use super::conductor::ConductorFresnel;
-use super::scattering::{
-    BsdfSample, LobeFlags, ShadingFrame, TransportMode, mean, mode_correction,
-};
-use super::specular_reflection::mirror_above;
+use super::scattering::{BsdfSample, LobeFlags, ShadingFrame, TransportMode, mean};
+use super::specular_reflection::SpecularReflection;
 
 /// A polished metal: the Fresnel reflectance of its perfect mirror.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,18 +47,8 @@ impl SpecularConductor {
         weight: f32,
         prob: f32,
     ) -> Option<BsdfSample> {
-        if prob == 0.0 {
-            return None;
-        }
-        let wi = mirror_above(wo, fr.ns, fr.ng);
-        Some(BsdfSample {
-            wi,
-            weight: self.reflectance(wo, fr) * (weight / prob * mode_correction(mode, wo, wi, fr)),
-            pdf: prob,
-            delta: true,
-            transmitted: false,
-            eta_scale: 1.0,
-        })
+        // The mirror lobe's sample with the Fresnel reflectance as its tint.
+        SpecularReflection.sample(wo, fr, mode, weight, prob, self.reflectance(wo, fr))
     }
 }
 

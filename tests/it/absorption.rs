@@ -6,7 +6,6 @@ use glam::{DVec3, Vec3};
 
 use caustic::geometry::Ray;
 use caustic::integrators::photon::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
-use caustic::integrators::{Context, Counters, Integrator, NoTrace};
 use caustic::render_scene::RenderScene;
 use caustic::sampling::Sampler;
 
@@ -20,27 +19,7 @@ const SIGMA: [f64; 3] = [0.5, 1.0, 2.0];
 /// Mean and standard error of `n` radiance estimates along `ray` (the renderer's own streams:
 /// sample indices 0..n of pixel (0, 0)).
 fn estimate(scene: &RenderScene, ray: Ray, n: u32) -> (DVec3, DVec3) {
-    let integrator = Integrator::prepare(scene);
-    let p = &scene.params;
-    let mut sampler = Sampler::new(p.sampler, p.seed, n);
-    let mut counters = Counters::default();
-    let (mut sum, mut sq) = (DVec3::ZERO, DVec3::ZERO);
-    for i in 0..n {
-        sampler.start_pixel_sample(0, 0, i);
-        let _ = sampler.pixel_2d();
-        let l = integrator
-            .li(
-                ray,
-                &mut Context::new(&mut sampler, &mut counters, &mut NoTrace),
-            )
-            .as_dvec3();
-        assert!(l.is_finite(), "sample {i}: {l}");
-        sum += l;
-        sq += l * l;
-    }
-    let mean = sum / f64::from(n);
-    let var = (sq / f64::from(n) - mean * mean).max(DVec3::ZERO);
-    (mean, (var / f64::from(n)).sqrt())
+    crate::common::estimate_along(scene, ray, n)
 }
 
 /// Unpolarised Fresnel reflectance of a smooth boundary, cosine `ci` on the side of index 1,

@@ -5,10 +5,9 @@
 use glam::Vec3;
 
 use caustic::geometry::Ray;
-use caustic::integrators::{Context, Counters, Integrator, NoTrace};
+use caustic::integrators::Counters;
 use caustic::render::{RenderOptions, render};
 use caustic::render_scene::RenderScene;
-use caustic::sampling::Sampler;
 
 use crate::common::scene_from_text;
 
@@ -17,27 +16,8 @@ const PI: f64 = std::f64::consts::PI;
 /// Mean and standard error of `n` estimates of the radiance along `ray` (sample indices
 /// 0..n of pixel (0, 0), so the numbers are the renderer's own streams).
 fn estimate(scene: &RenderScene, ray: Ray, n: u32) -> (Vec3, Vec3) {
-    let integrator = Integrator::prepare(scene);
-    let p = &scene.params;
-    let mut sampler = Sampler::new(p.sampler, p.seed, n);
-    let mut counters = Counters::default();
-    let (mut sum, mut sq) = (glam::DVec3::ZERO, glam::DVec3::ZERO);
-    for i in 0..n {
-        sampler.start_pixel_sample(0, 0, i);
-        let _ = sampler.pixel_2d();
-        let l = integrator
-            .li(
-                ray,
-                &mut Context::new(&mut sampler, &mut counters, &mut NoTrace),
-            )
-            .as_dvec3();
-        assert!(l.is_finite(), "sample {i}: {l}");
-        sum += l;
-        sq += l * l;
-    }
-    let mean = sum / f64::from(n);
-    let var = (sq / f64::from(n) - mean * mean).max(glam::DVec3::ZERO);
-    (mean.as_vec3(), (var / f64::from(n)).sqrt().as_vec3())
+    let (mean, err) = crate::common::estimate_along(scene, ray, n);
+    (mean.as_vec3(), err.as_vec3())
 }
 
 fn with_integrator(text: &str, integrator: &str) -> RenderScene {

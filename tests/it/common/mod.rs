@@ -67,3 +67,35 @@ pub fn scene_from_text(text: &str) -> RenderScene {
     assert!(!diags.iter().any(|d| d.is_error()), "{diags:?}");
     compile(&file, Path::new(".")).expect("compiles").0
 }
+
+/// Mean and standard error of the mean of `n` radiance estimates along `ray` by the scene's
+/// integrator, drawn from the renderer's own streams (sample indices 0..n of pixel (0, 0));
+/// every sample must be finite.
+pub fn estimate_along(
+    scene: &caustic::render_scene::RenderScene,
+    ray: caustic::geometry::Ray,
+    n: u32,
+) -> (glam::DVec3, glam::DVec3) {
+    use caustic::integrators::{Context, Counters, Integrator, NoTrace};
+    let integrator = Integrator::prepare(scene);
+    let p = &scene.params;
+    let mut sampler = caustic::sampling::Sampler::new(p.sampler, p.seed, n);
+    let mut counters = Counters::default();
+    let (mut sum, mut sq) = (glam::DVec3::ZERO, glam::DVec3::ZERO);
+    for i in 0..n {
+        sampler.start_pixel_sample(0, 0, i);
+        let _ = sampler.pixel_2d();
+        let l = integrator
+            .li(
+                ray,
+                &mut Context::new(&mut sampler, &mut counters, &mut NoTrace),
+            )
+            .as_dvec3();
+        assert!(l.is_finite(), "sample {i}: {l}");
+        sum += l;
+        sq += l * l;
+    }
+    let mean = sum / f64::from(n);
+    let var = (sq / f64::from(n) - mean * mean).max(glam::DVec3::ZERO);
+    (mean, (var / f64::from(n)).sqrt())
+}
