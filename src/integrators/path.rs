@@ -13,7 +13,7 @@ use super::{LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{Interaction, LightSampler, Medium, RenderScene, SurfacePoint};
-use crate::shading::{Bsdf, ShadingFrame, TransportMode};
+use crate::shading::{BsdfAt, TransportMode};
 
 /// Bounces after which Russian roulette may end a path.
 const ROULETTE_DEPTH: u32 = 3;
@@ -104,7 +104,7 @@ impl<'a> PathTracer<'a> {
     /// path that has made no diffuse or glossy bounce yet meets a purely specular surface
     /// (smooth glass or water, whose BSDF has only delta parts), it follows both the
     /// reflected and the refracted branch, weighted by the BSDF's delta weights (F and
-    /// (1 − F)·(ηₒ/ηᵢ)², from [`Bsdf::delta_lobes`]), instead of choosing one with those
+    /// (1 − F)·(ηₒ/ηᵢ)², from [`crate::shading::Bsdf::delta_lobes`]), instead of choosing one with those
     /// probabilities. The expected value is unchanged (the sum of the two weighted branches is
     /// the expectation of the choice), so the estimator stays unbiased; the variance of light
     /// seen through specular chains (the light's image in water or glass, at F ≈ 0.04 chosen
@@ -202,7 +202,7 @@ impl<'a> PathTracer<'a> {
                 let it = scene.interact(&ray, |t| cone.width_at(&ray, t));
                 // Beer–Lambert absorption along the segment just travelled (1 outside media).
                 beta *= medium.transmittance(&ray, &it);
-                let v = match it {
+                let v = match &it {
                     Interaction::Escaped => {
                         let via = since_local.is_some_and(|n| n > 0);
                         l.add(
@@ -249,7 +249,9 @@ impl<'a> PathTracer<'a> {
                     break;
                 }
                 let fr = v.frame;
-                let bsdf = v.bsdf;
+                let bsdf = &v.bsdf;
+                // The mixture worked out once for this vertex's light sample and next direction.
+                let at = bsdf.at(wo, &fr);
                 let may_scatter = diffuse_bounces < params.diffuse_depth;
                 let local = bsdf.has_local() && !background_only;
                 let read_global = local
@@ -265,7 +267,7 @@ impl<'a> PathTracer<'a> {
                 {
                     let u = cx.sampler.get_2d(u_point);
                     let scatter = may_scatter && !read_global;
-                    let c = self.direct(&sp, wo, &fr, &bsdf, index, pmf, u, scatter, cx, node);
+                    let c = self.direct(&sp, &at, index, pmf, u, scatter, cx, node);
                     l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
                 }
                 let read_caustic = local
@@ -281,7 +283,7 @@ impl<'a> PathTracer<'a> {
                         ("global", global, LightPath::Indirect),
                     ] {
                         let Some(map) = map else { continue };
-                        let e = map.estimate(sp.p, wo, &fr, &bsdf);
+                        let e = map.estimate(sp.p, wo, &fr, bsdf);
                         cx.counters.photon_estimates += 1;
                         l.add(kind, beta * e.radiance);
                         if O::ACTIVE {
@@ -334,7 +336,7 @@ impl<'a> PathTracer<'a> {
                             },
                             parent: node,
                             depth: depth + 1,
-                            medium: medium.after(scene, &v, dir),
+                            medium: medium.after(scene, v, dir),
                             splits: splits + 1,
                         };
                         // Russian roulette is not applied at a split vertex (optional per vertex,
@@ -350,8 +352,8 @@ impl<'a> PathTracer<'a> {
                 let u_lobe = cx.sampler.defer_1d();
                 let u_dir = cx.sampler.next_2d();
                 let u_rr = cx.sampler.defer_1d();
-                let u_lobe = bsdf.lobe_number(|| cx.sampler.get_1d(u_lobe));
-                let Some(s) = bsdf.sample(wo, u_lobe, u_dir, &fr, TransportMode::Radiance) else {
+                let u_lobe = at.lobe_number(|| cx.sampler.get_1d(u_lobe));
+                let Some(s) = at.sample(u_lobe, u_dir, TransportMode::Radiance) else {
                     break;
                 };
                 if !s.delta {
@@ -404,7 +406,7 @@ impl<'a> PathTracer<'a> {
                     (false, false) => RayKind::Scatter,
                 };
                 parent = node;
-                medium = medium.after(scene, &v, s.wi);
+                medium = medium.after(scene, v, s.wi);
                 let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
                 ray = Ray::new(origin, s.wi);
             }
@@ -427,9 +429,7 @@ impl PathTracer<'_> {
     fn direct<O: PathObserver>(
         &self,
         sp: &SurfacePoint,
-        wo: Vec3,
-        fr: &ShadingFrame,
-        bsdf: &Bsdf,
+        at: &BsdfAt<'_>,
         index: usize,
         pmf: f32,
         u: (f32, f32),
@@ -441,19 +441,19 @@ impl PathTracer<'_> {
             ls,
             f,
             occluded: blocked,
-        }) = connect_light(self.scene, index, sp, wo, fr, bsdf, u, cx.counters)
+        }) = connect_light(self.scene, index, sp, at, u, cx.counters)
         else {
             return Vec3::ZERO;
         };
         let w = if ls.delta || !may_scatter {
             1.0
         } else {
-            power_heuristic(ls.pdf * pmf, bsdf.pdf(wo, ls.wi, fr))
+            power_heuristic(ls.pdf * pmf, at.pdf(ls.wi))
         };
         let c = if blocked {
             Vec3::ZERO
         } else {
-            f * (fr.ns.dot(ls.wi) * w / (ls.pdf * pmf)) * ls.radiance
+            f * (at.frame().ns.dot(ls.wi) * w / (ls.pdf * pmf)) * ls.radiance
         };
         if O::ACTIVE {
             let record = ShadowRecord {

@@ -6,7 +6,7 @@ use super::Counters;
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{LightSample, RenderScene, SurfacePoint};
-use crate::shading::{Bsdf, ShadingFrame, TransportMode};
+use crate::shading::{BsdfAt, TransportMode};
 
 /// Fraction of a shadow ray's length left unchecked at the light end (so the light's own
 /// surface never occludes the point sampled on it).
@@ -47,8 +47,8 @@ pub struct LightConnection {
 }
 
 /// Next-event estimation's shared step, for every integrator: samples light `light` of the
-/// scene from surface point `sp` with `u`, evaluates `bsdf` (frame `fr`, outgoing `wo`) towards
-/// it and, when that is non-zero, traces the shadow ray (counted in `counters`). `None` when the
+/// scene from surface point `sp` with `u`, evaluates the BSDF prepared at the point (`at`: its
+/// frame and outgoing direction) towards it and, when that is non-zero, traces the shadow ray (counted in `counters`). `None` when the
 /// light gives no sample or the BSDF is zero there (no ray is traced). The estimate itself
 /// (`f · L · cos θ / pdf`, with or without an MIS weight) is the caller's.
 #[allow(clippy::too_many_arguments)]
@@ -57,14 +57,13 @@ pub fn connect_light(
     scene: &RenderScene,
     light: usize,
     sp: &SurfacePoint,
-    wo: Vec3,
-    fr: &ShadingFrame,
-    bsdf: &Bsdf,
+    at: &BsdfAt<'_>,
     u: (f32, f32),
     counters: &mut Counters,
 ) -> Option<LightConnection> {
     let ls = scene.lights[light].sample_li(sp.p, u)?;
-    let f = bsdf.eval(wo, ls.wi, fr, TransportMode::Radiance);
+    let f = at.eval(ls.wi, TransportMode::Radiance);
+    let fr = at.frame();
     if f == Vec3::ZERO || !(ls.pdf > 0.0) {
         return None;
     }

@@ -18,15 +18,16 @@
 
 use glam::Vec3;
 
+use super::bsdf_at::{BsdfAt, eval_value, non_delta_value};
 use super::conductor::ConductorFresnel;
 use super::dielectric::Dielectric;
 use super::lambert::Lambert;
-use super::lobe::{Lobe, Prepared};
+use super::lobe::Lobe;
 use super::microfacet::Ggx;
+use super::part::{Part, PartUse};
 use super::phong::Phong;
 use super::rough_conductor::RoughConductor;
 use super::rough_dielectric::RoughDielectric;
-use super::scattering::mean;
 pub use super::scattering::{
     BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction,
 };
@@ -34,102 +35,7 @@ use super::specular_conductor::SpecularConductor;
 use super::specular_reflection::{SpecularReflection, mirror_above};
 
 /// Parts of the mixture (each a weight and its lobes).
-const PARTS: usize = 3;
-/// Most lobes in one part.
-const LOBES_PER_PART: usize = 2;
-
-/// One weighted part of the mixture: lobes that share one weight (all non-delta, or one delta
-/// lobe).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Part {
-    weight: f32,
-    lobes: [Option<Lobe>; LOBES_PER_PART],
-}
-
-impl Part {
-    fn new(weight: f32, first: Lobe, second: Option<Lobe>) -> Self {
-        Self {
-            weight,
-            lobes: [Some(first), second],
-        }
-    }
-
-    /// The lobes present.
-    #[inline]
-    fn lobes(&self) -> impl Iterator<Item = &Lobe> {
-        self.lobes.iter().flatten()
-    }
-
-    /// Whether the part is a delta lobe (by its first lobe; parts never mix).
-    #[inline]
-    fn is_delta(&self) -> bool {
-        self.lobes().next().is_some_and(|l| l.flags().is_delta())
-    }
-
-    /// The union of the lobes' flags.
-    #[inline]
-    fn flags(&self) -> LobeFlags {
-        self.lobes().fold(LobeFlags::NONE, |f, l| f | l.flags())
-    }
-
-    /// Whether the part has a non-delta lobe that transmits (the rough dielectric), so that
-    /// directions below the surface have a value and a density.
-    #[inline]
-    fn transmits_glossy(&self) -> bool {
-        !self.is_delta() && self.flags().contains(LobeFlags::TRANSMISSION)
-    }
-
-    /// The per-direction state of the part's (first) lobe.
-    #[inline]
-    fn prepare(&self, wo: Vec3, fr: &ShadingFrame) -> Prepared {
-        self.lobes()
-            .next()
-            .map_or(Prepared::Nothing, |l| l.prepare(wo, fr))
-    }
-
-    /// The lobes' sampling weights and each lobe's share of the part: `aⱼ / Σa` for all but the
-    /// last, which takes the rest (all to the first when Σa is 0).
-    #[inline]
-    fn shares(&self, prepared: &Prepared, rho: f32) -> [f32; LOBES_PER_PART] {
-        let mut a = [0.0f32; LOBES_PER_PART];
-        let mut total = 0.0f32;
-        let mut count = 0;
-        for (slot, lobe) in a.iter_mut().zip(self.lobes()) {
-            *slot = lobe.albedo(prepared, rho);
-            total += *slot;
-            count += 1;
-        }
-        let mut shares = [0.0f32; LOBES_PER_PART];
-        let mut taken = 0.0f32;
-        for j in 0..count {
-            shares[j] = if j + 1 == count {
-                1.0 - taken
-            } else if total > 0.0 {
-                a[j] / total
-            } else if j == 0 {
-                1.0
-            } else {
-                0.0
-            };
-            taken += shares[j];
-        }
-        shares
-    }
-
-    /// The part's sampling weight: its weight times the sum of its lobes' albedos.
-    #[inline]
-    fn probability_weight(&self, prepared: &Prepared, rho: f32) -> f32 {
-        if self.weight == 0.0 {
-            return 0.0;
-        }
-        let mut a = 0.0f32;
-        for lobe in self.lobes() {
-            a += lobe.albedo(prepared, rho);
-        }
-        self.weight * a
-    }
-}
-
+pub(super) const PARTS: usize = 3;
 /// A compiled material's scattering function: a tint (the colour; texture lookups replace it)
 /// and a weighted mixture of lobes. Its `Debug` text is the material's parameters (the scene
 /// hash of `.part` files and photon caches reads it, so it stays as it always was).
@@ -139,6 +45,9 @@ pub struct Bsdf {
     tint: Vec3,
     /// The diffuse, mirror and dielectric parts, in this order (the order sampling walks).
     parts: [Part; PARTS],
+    /// What each part takes part in, derived from `parts` whenever they change
+    /// ([`Bsdf::with_parts`]), so that per-vertex queries test flags instead of walking lobes.
+    uses: [PartUse; PARTS],
 }
 
 impl std::fmt::Debug for Bsdf {
@@ -194,13 +103,6 @@ pub struct DeltaLobes {
     pub eta_scale: f32,
 }
 
-/// The part probabilities of one sampling decision (summing to 1, or all 0 for a black BSDF),
-/// and each part's per-direction state.
-struct Choice {
-    p: [f32; PARTS],
-    prepared: [Prepared; PARTS],
-}
-
 impl Bsdf {
     /// Builds a BSDF, normalising the weights (`None` ones count as 0; all `None` means diffuse):
     /// `weights` are the diffuse (Lambert `color` + Phong `specular`, `shininess`), mirror and
@@ -230,13 +132,22 @@ impl Bsdf {
             specular,
             exponent: shininess,
         }));
-        Self {
-            tint: color,
-            parts: [
+        Self::with_parts(
+            color,
+            [
                 Part::new(w[0], Lobe::Lambert(Lambert), phong),
                 Part::new(w[1], Lobe::SpecularReflection(SpecularReflection), None),
                 Part::new(w[2], Lobe::Dielectric(Dielectric { ior }), None),
             ],
+        )
+    }
+
+    /// A BSDF of tint `tint` and parts `parts`, with the parts' uses derived.
+    fn with_parts(tint: Vec3, parts: [Part; PARTS]) -> Self {
+        Self {
+            tint,
+            parts,
+            uses: parts.map(|p| p.usage()),
         }
     }
 
@@ -283,7 +194,7 @@ impl Bsdf {
                 ];
             }
         }
-        self
+        Self::with_parts(self.tint, self.parts)
     }
 
     /// The microfacet distribution of the rough parts, if any.
@@ -396,34 +307,21 @@ impl Bsdf {
             ng: n,
             entering: true,
         };
-        self.f_in(wo, wi, &fr, TransportMode::Radiance)
-    }
-
-    /// The non-delta parts' value in frame `fr` and mode `mode`: reflecting parts only for `wi`
-    /// above the geometric surface, transmitting (rough dielectric) parts on either side.
-    #[inline]
-    fn f_in(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, mode: TransportMode) -> Vec3 {
-        let below = fr.ng.dot(wi) <= 0.0;
-        let mut f = Vec3::ZERO;
-        for part in &self.parts {
-            if part.weight == 0.0 || part.is_delta() || (below && !part.transmits_glossy()) {
-                continue;
-            }
-            let mut fp = Vec3::ZERO;
-            for lobe in part.lobes() {
-                fp += lobe.f(wo, wi, fr, mode, self.tint);
-            }
-            f += fp * part.weight;
-        }
-        f
+        non_delta_value(
+            &self.parts,
+            &self.uses,
+            self.tint,
+            wo,
+            wi,
+            &fr,
+            TransportMode::Radiance,
+        )
     }
 
     /// True if a part of non-zero weight transmits through a non-delta lobe.
     #[inline]
     fn transmits_glossy(&self) -> bool {
-        self.parts
-            .iter()
-            .any(|p| p.weight > 0.0 && p.transmits_glossy())
+        self.uses.iter().any(|u| u.transmits_glossy)
     }
 
     /// The non-delta BSDF value in frame `fr`, for `wi` above both the shading and the geometric
@@ -433,14 +331,8 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn eval(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, mode: TransportMode) -> Vec3 {
-        if fr.ng.dot(wi) <= 0.0 && !self.transmits_glossy() {
-            return Vec3::ZERO;
-        }
-        let f = self.f_in(wo, wi, fr, mode);
-        match mode {
-            TransportMode::Radiance => f,
-            TransportMode::Importance => f * shading_normal_correction(wo, wi, fr),
-        }
+        let any = self.transmits_glossy();
+        eval_value(&self.parts, &self.uses, any, self.tint, wo, wi, fr, mode)
     }
 
     /// Whether [`Bsdf::sample`]'s lobe number `u_lobe` can change its result: false for a
@@ -479,84 +371,12 @@ impl Bsdf {
         }
     }
 
-    /// The parts' probabilities for `wo` (each part's weight times its lobes' mean albedo,
-    /// normalised) and their per-direction state.
-    #[inline]
-    fn choice(&self, wo: Vec3, fr: &ShadingFrame, rho: f32) -> Choice {
-        let prepared = self.parts.map(|p| {
-            if p.weight > 0.0 {
-                p.prepare(wo, fr)
-            } else {
-                Prepared::Nothing
-            }
-        });
-        let mut q = [0.0f32; PARTS];
-        let mut sum = 0.0f32;
-        for ((q, part), prep) in q.iter_mut().zip(&self.parts).zip(&prepared) {
-            *q = part.probability_weight(prep, rho);
-            sum += *q;
-        }
-        let p = if sum > 0.0 {
-            q.map(|x| x / sum)
-        } else {
-            [0.0; PARTS]
-        };
-        Choice { p, prepared }
-    }
-
-    /// The density with which non-delta part `part`, chosen with probability `prob`, samples
-    /// `wi`: `prob · Σⱼ shareⱼ · pdfⱼ`, 0 below the shading or geometric surface.
-    #[inline]
-    #[allow(clippy::too_many_arguments)]
-    fn part_pdf(
-        &self,
-        part: &Part,
-        prepared: &Prepared,
-        prob: f32,
-        rho: f32,
-        wo: Vec3,
-        wi: Vec3,
-        fr: &ShadingFrame,
-    ) -> f32 {
-        if prob == 0.0
-            || ((fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0) && !part.transmits_glossy())
-        {
-            return 0.0;
-        }
-        let shares = part.shares(prepared, rho);
-        let mut d = 0.0f32;
-        for (lobe, &share) in part.lobes().zip(&shares) {
-            if share > 0.0 {
-                d += lobe.scaled_pdf(share, wo, wi, fr, self.tint);
-            }
-        }
-        prob * d
-    }
-
-    /// The mixture density of the non-delta parts at `wi` given a choice.
-    #[inline]
-    fn mixture_pdf(&self, c: &Choice, rho: f32, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
-        let mut pdf = 0.0f32;
-        for (i, part) in self.parts.iter().enumerate() {
-            if part.weight == 0.0 || part.is_delta() {
-                continue;
-            }
-            pdf += self.part_pdf(part, &c.prepared[i], c.p[i], rho, wo, wi, fr);
-        }
-        pdf
-    }
-
     /// Solid-angle density with which [`Bsdf::sample`] returns the non-delta direction `wi`
     /// (0 below the shading or geometric surface, where `sample` returns nothing). Delta lobes
     /// have no density; their discrete probabilities are in the samples themselves.
     #[must_use]
     pub fn pdf(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
-        if !self.parts.iter().any(|p| p.weight != 0.0 && !p.is_delta()) {
-            return 0.0;
-        }
-        let rho = mean(self.tint);
-        let c = self.choice(wo, fr, rho);
-        self.mixture_pdf(&c, rho, wo, wi, fr)
+        self.at(wo, fr).pdf(wi)
     }
 
     /// Samples a direction for a path arriving from `wo`: a part chosen with `u_lobe` (the
@@ -574,81 +394,28 @@ impl Bsdf {
         fr: &ShadingFrame,
         mode: TransportMode,
     ) -> Option<BsdfSample> {
-        let rho = mean(self.tint);
-        let c = self.choice(wo, fr, rho);
-        // Walk the parts: the first whose interval holds u_lobe, else (rounding) the last of
-        // non-zero weight; `rest` is u_lobe less the probabilities before the part.
-        let mut chosen = None;
-        let mut cum = 0.0f32;
-        let mut rest = u_lobe;
-        let mut rests = [0.0f32; PARTS];
-        for (i, (slot, &p)) in rests.iter_mut().zip(&c.p).enumerate() {
-            *slot = rest;
-            if u_lobe < cum + p {
-                chosen = Some(i);
-                break;
-            }
-            cum += p;
-            rest -= p;
-        }
-        let i = chosen.or_else(|| self.parts.iter().rposition(|p| p.weight > 0.0))?;
-        let part = &self.parts[i];
-        let v = rests[i] / c.p[i];
-        if part.is_delta() {
-            let lobe = part.lobes().next()?;
-            return lobe.sample_delta(
-                &c.prepared[i],
-                wo,
-                v,
-                fr,
-                mode,
-                part.weight,
-                c.p[i],
-                self.tint,
-                rho,
-            );
-        }
-        // A non-delta part: reuse the lobe number to pick one of its lobes.
-        let shares = part.shares(&c.prepared[i], rho);
-        let mut lobe = None;
-        let mut cum = 0.0f32;
-        let mut rest = v;
-        for (l, &share) in part.lobes().zip(&shares) {
-            lobe = Some(l);
-            rest = if share > 0.0 { (v - cum) / share } else { 0.0 };
-            if v < cum + share {
-                break;
-            }
-            cum += share;
-        }
-        let lobe = lobe?;
-        let rest = if lobe.uses_lobe_number() {
-            rest.clamp(0.0, 1.0 - f32::EPSILON)
-        } else {
-            0.0
-        };
-        let wi = lobe.sample_direction(wo, rest, u, fr, self.tint)?;
-        let pdf = self.mixture_pdf(&c, rho, wo, wi, fr);
-        let f = self.eval(wo, wi, fr, mode);
-        if !(pdf > 0.0) || f == Vec3::ZERO {
-            return None;
-        }
-        let transmitted = fr.ng.dot(wi) < 0.0;
-        // A glossy refraction in radiance mode carries (ηₒ/ηᵢ)² = 1/η² in `f` (Walter 2007,
-        // eq. 21), reported for Russian roulette as the smooth dielectric reports its own.
-        let mut eta_scale = 1.0;
-        if let (true, TransportMode::Radiance, Some(ior)) = (transmitted, mode, lobe.ior()) {
-            let eta = if fr.entering { ior } else { 1.0 / ior };
-            eta_scale = 1.0 / (eta * eta);
-        }
-        Some(BsdfSample {
-            wi,
-            weight: f * (fr.ns.dot(wi).abs() / pdf),
-            pdf,
-            delta: false,
-            transmitted,
-            eta_scale,
-        })
+        self.at(wo, fr).sample(u_lobe, u, mode)
+    }
+
+    /// The BSDF prepared for outgoing direction `wo` in frame `fr` ([`BsdfAt`]): what a path
+    /// vertex asks for its light sample's value and density and for its next direction, with
+    /// the mixture worked out once.
+    #[inline]
+    #[must_use]
+    pub fn at(&self, wo: Vec3, fr: &ShadingFrame) -> BsdfAt<'_> {
+        BsdfAt::new(self, wo, fr)
+    }
+
+    /// The mixture's parts, for [`BsdfAt`].
+    #[inline]
+    pub(super) fn parts(&self) -> &[Part; PARTS] {
+        &self.parts
+    }
+
+    /// What each part takes part in, for [`BsdfAt`].
+    #[inline]
+    pub(super) fn uses(&self) -> &[PartUse; PARTS] {
+        &self.uses
     }
 
     /// The fraction of light that crosses the surface in a straight line, for shadow rays of

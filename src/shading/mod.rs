@@ -3,6 +3,7 @@
 
 pub mod absorption;
 pub mod bsdf;
+pub mod bsdf_at;
 pub mod conductor;
 pub mod dielectric;
 pub mod lambert;
@@ -10,6 +11,7 @@ pub mod lobe;
 pub mod microfacet;
 pub mod normals;
 pub mod optics;
+mod part;
 pub mod phong;
 pub mod rough_conductor;
 pub mod rough_dielectric;
@@ -18,6 +20,7 @@ pub mod specular_conductor;
 pub mod specular_reflection;
 
 pub use bsdf::{Bsdf, DeltaLobes};
+pub use bsdf_at::BsdfAt;
 pub use lobe::Lobe;
 pub use normals::usable_shading_normal;
 pub use scattering::{

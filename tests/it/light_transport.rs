@@ -340,6 +340,7 @@ fn a_sphere_light_shadows_another_light_but_never_itself() {
         ng: sh.ng,
         entering: sh.entering,
     };
+    let at = sh.bsdf.at(wo, &fr);
     let mut rng = caustic::sampling::Rng::new(3, 0);
     let mut counters = Counters::default();
     let mut blocked = [0u32; 2];
@@ -351,9 +352,7 @@ fn a_sphere_light_shadows_another_light_but_never_itself() {
                 &scene,
                 light,
                 &sp,
-                wo,
-                &fr,
-                &sh.bsdf,
+                &at,
                 u,
                 &mut counters,
             )

@@ -169,9 +169,10 @@ impl PhotonMap {
     /// the camera side sees it), estimated from the nearest photons. See the module docs.
     #[must_use]
     pub fn estimate(&self, p: Vec3, wo: Vec3, fr: &ShadingFrame, bsdf: &Bsdf) -> Estimate {
+        let at = bsdf.at(wo, fr);
         self.gather(p, fr.ng, |ph, wi, cos_p| {
             let cos_s = wi.dot(fr.ns).max(0.0);
-            bsdf.eval(wo, wi, fr, TransportMode::Radiance) * ph.power() * (cos_s / cos_p)
+            at.eval(wi, TransportMode::Radiance) * ph.power() * (cos_s / cos_p)
         })
     }
 

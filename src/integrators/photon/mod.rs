@@ -404,7 +404,7 @@ impl<'a> PhotonMapper<'a> {
         let Some((index, pmf)) = self.lights.sample(u_light) else {
             return Vec3::ZERO;
         };
-        match connect_light(self.scene, index, sp, wo, fr, bsdf, u_point, counters) {
+        match connect_light(self.scene, index, sp, &bsdf.at(wo, fr), u_point, counters) {
             Some(c) if !c.occluded => c.f * c.ls.weight * (fr.ns.dot(c.ls.wi) / pmf),
             _ => Vec3::ZERO,
         }

@@ -1,0 +1,290 @@
+//! The BSDF mixture at one outgoing direction: what [`Bsdf::at`] works out once per path vertex
+//! (each part's per-direction state, the parts' sampling probabilities, each lobe's share of its
+//! part, which parts have a value and a density) so that next-event estimation's value and
+//! density, BSDF sampling, and the sample's own value and density all reuse it instead of
+//! re-deriving the mixture on every call (pbrt-v4 likewise builds its `BSDF` once per
+//! intersection). The arithmetic is the mixture's own, in the same order, so the numbers are
+//! identical to asking [`Bsdf`] directly.
+
+use glam::Vec3;
+
+use super::bsdf::{Bsdf, PARTS};
+use super::lobe::Prepared;
+use super::part::{LOBES_PER_PART, Part, PartUse};
+use super::scattering::{BsdfSample, ShadingFrame, TransportMode, mean, shading_normal_correction};
+
+/// A [`Bsdf`] prepared for one outgoing direction `wo` in one shading frame (see the module
+/// docs): ask it [`BsdfAt::eval`], [`BsdfAt::pdf`] and [`BsdfAt::sample`] for any number of
+/// incident directions. Cheap to build (a few Fresnel terms), no allocation.
+#[derive(Debug, Clone, Copy)]
+pub struct BsdfAt<'b> {
+    bsdf: &'b Bsdf,
+    wo: Vec3,
+    fr: ShadingFrame,
+    /// The tint's mean.
+    rho: f32,
+    uses: [PartUse; PARTS],
+    any_local: bool,
+    any_transmits_glossy: bool,
+    /// The parts' sampling probabilities (summing to 1, or all 0 for a black BSDF).
+    p: [f32; PARTS],
+    prepared: [Prepared; PARTS],
+    /// Each non-delta part's lobe shares (0 for the others).
+    shares: [[f32; LOBES_PER_PART]; PARTS],
+}
+
+/// The non-delta parts' value `Σ weight · Σ lobe f` for `wi`, in frame `fr` and mode `mode`:
+/// reflecting parts only for `wi` above the geometric surface, transmitting (rough dielectric)
+/// parts on either side. `uses` says which parts count.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn non_delta_value(
+    parts: &[Part; PARTS],
+    uses: &[PartUse; PARTS],
+    tint: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+    fr: &ShadingFrame,
+    mode: TransportMode,
+) -> Vec3 {
+    let below = fr.ng.dot(wi) <= 0.0;
+    let mut f = Vec3::ZERO;
+    for (part, use_) in parts.iter().zip(uses) {
+        if !use_.local || (below && !use_.transmits_glossy) {
+            continue;
+        }
+        let mut fp = Vec3::ZERO;
+        for lobe in part.lobes() {
+            fp += lobe.f(wo, wi, fr, mode, tint);
+        }
+        f += fp * part.weight;
+    }
+    f
+}
+
+/// The full non-delta BSDF value (see [`BsdfAt::eval`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn eval_value(
+    parts: &[Part; PARTS],
+    uses: &[PartUse; PARTS],
+    any_transmits_glossy: bool,
+    tint: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+    fr: &ShadingFrame,
+    mode: TransportMode,
+) -> Vec3 {
+    if fr.ng.dot(wi) <= 0.0 && !any_transmits_glossy {
+        return Vec3::ZERO;
+    }
+    let f = non_delta_value(parts, uses, tint, wo, wi, fr, mode);
+    match mode {
+        TransportMode::Radiance => f,
+        TransportMode::Importance => f * shading_normal_correction(wo, wi, fr),
+    }
+}
+
+impl<'b> BsdfAt<'b> {
+    /// Prepares `bsdf` for outgoing direction `wo` (unit, away from the surface) in frame `fr`:
+    /// each part's per-direction state, the parts' probabilities (weight times the lobes' mean
+    /// albedo, normalised) and the lobes' shares.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(bsdf: &'b Bsdf, wo: Vec3, fr: &ShadingFrame) -> Self {
+        let parts = bsdf.parts();
+        let uses = *bsdf.uses();
+        let rho = mean(bsdf.color());
+        let mut prepared = [Prepared::Nothing; PARTS];
+        let mut q = [0.0f32; PARTS];
+        let mut sum = 0.0f32;
+        for i in 0..PARTS {
+            let part = &parts[i];
+            if part.weight > 0.0 {
+                prepared[i] = part.prepare(wo, fr);
+                q[i] = part.probability_weight(&prepared[i], rho);
+            }
+            sum += q[i];
+        }
+        let p = if sum > 0.0 {
+            q.map(|x| x / sum)
+        } else {
+            [0.0; PARTS]
+        };
+        let mut shares = [[0.0f32; LOBES_PER_PART]; PARTS];
+        for i in 0..PARTS {
+            if uses[i].local {
+                shares[i] = parts[i].shares(&prepared[i], rho);
+            }
+        }
+        Self {
+            bsdf,
+            wo,
+            fr: *fr,
+            rho,
+            uses,
+            any_local: uses.iter().any(|u| u.local),
+            any_transmits_glossy: uses.iter().any(|u| u.transmits_glossy),
+            p,
+            prepared,
+            shares,
+        }
+    }
+
+    /// The BSDF this was prepared from.
+    #[inline]
+    #[must_use]
+    pub fn bsdf(&self) -> &'b Bsdf {
+        self.bsdf
+    }
+
+    /// The outgoing direction it was prepared for.
+    #[inline]
+    #[must_use]
+    pub fn wo(&self) -> Vec3 {
+        self.wo
+    }
+
+    /// The shading frame it was prepared in.
+    #[inline]
+    #[must_use]
+    pub fn frame(&self) -> &ShadingFrame {
+        &self.fr
+    }
+
+    /// The non-delta BSDF value for incident direction `wi` ([`Bsdf::eval`]): 0 below the
+    /// geometric surface unless a glossy part transmits; in importance mode it includes
+    /// [`shading_normal_correction`].
+    #[inline]
+    #[must_use]
+    pub fn eval(&self, wi: Vec3, mode: TransportMode) -> Vec3 {
+        eval_value(
+            self.bsdf.parts(),
+            &self.uses,
+            self.any_transmits_glossy,
+            self.bsdf.color(),
+            self.wo,
+            wi,
+            &self.fr,
+            mode,
+        )
+    }
+
+    /// The solid-angle density with which [`BsdfAt::sample`] returns the non-delta direction
+    /// `wi` ([`Bsdf::pdf`]): `Σ pₖ Σⱼ shareⱼ pdfⱼ(wi)` over the non-delta parts, 0 below the
+    /// shading or geometric surface for reflecting parts.
+    #[inline]
+    #[must_use]
+    pub fn pdf(&self, wi: Vec3) -> f32 {
+        if !self.any_local {
+            return 0.0;
+        }
+        let fr = &self.fr;
+        let below = fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0;
+        let tint = self.bsdf.color();
+        let mut pdf = 0.0f32;
+        for (i, part) in self.bsdf.parts().iter().enumerate() {
+            let prob = self.p[i];
+            if !self.uses[i].local || prob == 0.0 || (below && !self.uses[i].transmits_glossy) {
+                continue;
+            }
+            let mut d = 0.0f32;
+            for (lobe, &share) in part.lobes().zip(&self.shares[i]) {
+                if share > 0.0 {
+                    d += lobe.scaled_pdf(share, self.wo, wi, fr, tint);
+                }
+            }
+            pdf += prob * d;
+        }
+        pdf
+    }
+
+    /// The lobe number for [`BsdfAt::sample`] ([`Bsdf::lobe_number`]).
+    #[inline]
+    pub fn lobe_number(&self, draw: impl FnOnce() -> f32) -> f32 {
+        self.bsdf.lobe_number(draw)
+    }
+
+    /// Samples an incident direction ([`Bsdf::sample`]): a part chosen with `u_lobe` in
+    /// proportion to its probability, then a lobe of a non-delta part by its share with the
+    /// rest of the number, then a direction from `u`. `None` when the BSDF is black or the
+    /// direction is lost below the surface.
+    #[must_use]
+    pub fn sample(&self, u_lobe: f32, u: (f32, f32), mode: TransportMode) -> Option<BsdfSample> {
+        let parts = self.bsdf.parts();
+        let (wo, fr, rho, tint) = (self.wo, &self.fr, self.rho, self.bsdf.color());
+        // Walk the parts: the first whose interval holds u_lobe, else (rounding) the last of
+        // non-zero weight; `rest` is u_lobe less the probabilities before the part.
+        let mut chosen = None;
+        let mut cum = 0.0f32;
+        let mut rest = u_lobe;
+        let mut rests = [0.0f32; PARTS];
+        for (i, (slot, &p)) in rests.iter_mut().zip(&self.p).enumerate() {
+            *slot = rest;
+            if u_lobe < cum + p {
+                chosen = Some(i);
+                break;
+            }
+            cum += p;
+            rest -= p;
+        }
+        let i = chosen.or_else(|| parts.iter().rposition(|p| p.weight > 0.0))?;
+        let part = &parts[i];
+        let v = rests[i] / self.p[i];
+        // A chosen part has weight, so it is delta exactly when it is not local.
+        if !self.uses[i].local {
+            let lobe = part.lobes().next()?;
+            return lobe.sample_delta(
+                &self.prepared[i],
+                wo,
+                v,
+                fr,
+                mode,
+                part.weight,
+                self.p[i],
+                tint,
+                rho,
+            );
+        }
+        // A non-delta part: reuse the lobe number to pick one of its lobes.
+        let mut lobe = None;
+        let mut cum = 0.0f32;
+        let mut rest = v;
+        for (l, &share) in part.lobes().zip(&self.shares[i]) {
+            lobe = Some(l);
+            rest = if share > 0.0 { (v - cum) / share } else { 0.0 };
+            if v < cum + share {
+                break;
+            }
+            cum += share;
+        }
+        let lobe = lobe?;
+        let rest = if lobe.uses_lobe_number() {
+            rest.clamp(0.0, 1.0 - f32::EPSILON)
+        } else {
+            0.0
+        };
+        let wi = lobe.sample_direction(wo, rest, u, fr, tint)?;
+        let pdf = self.pdf(wi);
+        let f = self.eval(wi, mode);
+        if !(pdf > 0.0) || f == Vec3::ZERO {
+            return None;
+        }
+        let transmitted = fr.ng.dot(wi) < 0.0;
+        // A glossy refraction in radiance mode carries (ηₒ/ηᵢ)² = 1/η² in `f` (Walter 2007,
+        // eq. 21), reported for Russian roulette as the smooth dielectric reports its own.
+        let mut eta_scale = 1.0;
+        if let (true, TransportMode::Radiance, Some(ior)) = (transmitted, mode, lobe.ior()) {
+            let eta = if fr.entering { ior } else { 1.0 / ior };
+            eta_scale = 1.0 / (eta * eta);
+        }
+        Some(BsdfSample {
+            wi,
+            weight: f * (fr.ns.dot(wi).abs() / pdf),
+            pdf,
+            delta: false,
+            transmitted,
+            eta_scale,
+        })
+    }
+}
