@@ -48,6 +48,10 @@ pub struct Bsdf {
     /// What each part takes part in, derived from `parts` whenever they change
     /// ([`Bsdf::with_parts`]), so that per-vertex queries test flags instead of walking lobes.
     uses: [PartUse; PARTS],
+    /// Only the diffuse part has weight and its only lobe with a value is Lambert (Phong, if
+    /// present, is black): the common matte material, which [`BsdfAt`] evaluates, samples and
+    /// asks densities of without walking the mixture. Derived with `uses`.
+    lambert: bool,
 }
 
 impl std::fmt::Debug for Bsdf {
@@ -144,10 +148,20 @@ impl Bsdf {
 
     /// A BSDF of tint `tint` and parts `parts`, with the parts' uses derived.
     fn with_parts(tint: Vec3, parts: [Part; PARTS]) -> Self {
+        let [diffuse, mirror, dielectric] = &parts;
+        let lambert = diffuse.weight > 0.0
+            && mirror.weight == 0.0
+            && dielectric.weight == 0.0
+            && match diffuse.lobes {
+                [Some(Lobe::Lambert(_)), None] => true,
+                [Some(Lobe::Lambert(_)), Some(Lobe::Phong(p))] => p.specular == Vec3::ZERO,
+                _ => false,
+            };
         Self {
             tint,
             parts,
             uses: parts.map(|p| p.usage()),
+            lambert,
         }
     }
 
@@ -416,6 +430,12 @@ impl Bsdf {
     #[inline]
     pub(super) fn uses(&self) -> &[PartUse; PARTS] {
         &self.uses
+    }
+
+    /// Whether the BSDF is a matte Lambert material alone (see the field), for [`BsdfAt`].
+    #[inline]
+    pub(super) fn is_lambert(&self) -> bool {
+        self.lambert
     }
 
     /// The fraction of light that crosses the surface in a straight line, for shadow rays of

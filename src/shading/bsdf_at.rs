@@ -9,6 +9,7 @@
 use glam::Vec3;
 
 use super::bsdf::{Bsdf, PARTS};
+use super::lambert::Lambert;
 use super::lobe::Prepared;
 use super::part::{LOBES_PER_PART, Part, PartUse};
 use super::scattering::{BsdfSample, ShadingFrame, TransportMode, mean, shading_normal_correction};
@@ -31,6 +32,9 @@ pub struct BsdfAt<'b> {
     prepared: [Prepared; PARTS],
     /// Each non-delta part's lobe shares (0 for the others).
     shares: [[f32; LOBES_PER_PART]; PARTS],
+    /// A matte Lambert material with a finite tint: the queries take the mixture's arithmetic
+    /// for that case directly (the same numbers; see [`BsdfAt::lambert`]).
+    pub(super) lambert: bool,
 }
 
 /// The non-delta parts' value `Σ weight · Σ lobe f` for `wi`, in frame `fr` and mode `mode`:
@@ -95,6 +99,9 @@ impl<'b> BsdfAt<'b> {
         let parts = bsdf.parts();
         let uses = *bsdf.uses();
         let rho = mean(bsdf.color());
+        if bsdf.is_lambert() && rho.is_finite() {
+            return Self::lambert(bsdf, wo, fr, rho);
+        }
         let mut prepared = [Prepared::Nothing; PARTS];
         let mut q = [0.0f32; PARTS];
         let mut sum = 0.0f32;
@@ -128,6 +135,38 @@ impl<'b> BsdfAt<'b> {
             p,
             prepared,
             shares,
+            lambert: false,
+        }
+    }
+
+    /// [`BsdfAt::new`] for a matte Lambert BSDF ([`Bsdf::is_lambert`]) of finite tint mean
+    /// `rho`, with the numbers the general mixture arrives at: nothing to prepare, the diffuse
+    /// part's probability `q/q = 1` for `q = weight · ρ̄ > 0` (else the BSDF is black and all are
+    /// 0; adding the black Phong lobe's albedo 0 changes neither), and Lambert's share 1 (the
+    /// black Phong lobe's 0).
+    #[inline(always)]
+    fn lambert(bsdf: &'b Bsdf, wo: Vec3, fr: &ShadingFrame, rho: f32) -> Self {
+        let uses = *bsdf.uses();
+        let q = bsdf.parts()[0].weight * rho;
+        let p = if q > 0.0 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0; PARTS]
+        };
+        let mut shares = [[0.0f32; LOBES_PER_PART]; PARTS];
+        shares[0][0] = 1.0;
+        Self {
+            bsdf,
+            wo,
+            fr: *fr,
+            rho,
+            uses,
+            any_local: true,
+            any_transmits_glossy: false,
+            p,
+            prepared: [Prepared::Nothing; PARTS],
+            shares,
+            lambert: true,
         }
     }
 
@@ -158,6 +197,20 @@ impl<'b> BsdfAt<'b> {
     #[inline]
     #[must_use]
     pub fn eval(&self, wi: Vec3, mode: TransportMode) -> Vec3 {
+        if self.lambert {
+            let fr = &self.fr;
+            if fr.ng.dot(wi) <= 0.0 {
+                return Vec3::ZERO;
+            }
+            // The mixture's sum, `0 + (0 + f_Lambert [+ 0 from black Phong]) · weight`, kept
+            // literally so that signed zeros come out as they do there.
+            let lambert = Lambert.f(self.bsdf.color(), wi, fr.ns);
+            let f = Vec3::ZERO + (Vec3::ZERO + lambert) * self.bsdf.parts()[0].weight;
+            return match mode {
+                TransportMode::Radiance => f,
+                TransportMode::Importance => f * shading_normal_correction(self.wo, wi, fr),
+            };
+        }
         eval_value(
             self.bsdf.parts(),
             &self.uses,
@@ -181,6 +234,14 @@ impl<'b> BsdfAt<'b> {
         }
         let fr = &self.fr;
         let below = fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0;
+        if self.lambert {
+            let prob = self.p[0];
+            if prob == 0.0 || below {
+                return 0.0;
+            }
+            // The mixture's `0 + p · (0 + share · cos/π)` with Lambert's share 1.
+            return 0.0 + prob * (0.0 + Lambert.scaled_pdf(1.0, wi, fr));
+        }
         let tint = self.bsdf.color();
         let mut pdf = 0.0f32;
         for (i, part) in self.bsdf.parts().iter().enumerate() {
@@ -211,6 +272,11 @@ impl<'b> BsdfAt<'b> {
     /// direction is lost below the surface.
     #[must_use]
     pub fn sample(&self, u_lobe: f32, u: (f32, f32), mode: TransportMode) -> Option<BsdfSample> {
+        if self.lambert && u_lobe < self.p[0] {
+            // The walk below would choose the diffuse part and in it Lambert (share 1), which
+            // reads no more of the lobe number.
+            return self.weigh(Lambert.sample(u, &self.fr), mode, None);
+        }
         let parts = self.bsdf.parts();
         let (wo, fr, rho, tint) = (self.wo, &self.fr, self.rho, self.bsdf.color());
         // Walk the parts: the first whose interval holds u_lobe, else (rounding) the last of
@@ -265,6 +331,15 @@ impl<'b> BsdfAt<'b> {
             0.0
         };
         let wi = lobe.sample_direction(wo, rest, u, fr, tint)?;
+        self.weigh(wi, mode, lobe.ior())
+    }
+
+    /// The non-delta sample of direction `wi` from a lobe of index of refraction `ior` (a
+    /// transmitting glossy lobe's), with the mixture's value and density: `None` when either is
+    /// 0.
+    #[inline(always)]
+    fn weigh(&self, wi: Vec3, mode: TransportMode, ior: Option<f32>) -> Option<BsdfSample> {
+        let fr = &self.fr;
         let pdf = self.pdf(wi);
         let f = self.eval(wi, mode);
         if !(pdf > 0.0) || f == Vec3::ZERO {
@@ -274,7 +349,7 @@ impl<'b> BsdfAt<'b> {
         // A glossy refraction in radiance mode carries (ηₒ/ηᵢ)² = 1/η² in `f` (Walter 2007,
         // eq. 21), reported for Russian roulette as the smooth dielectric reports its own.
         let mut eta_scale = 1.0;
-        if let (true, TransportMode::Radiance, Some(ior)) = (transmitted, mode, lobe.ior()) {
+        if let (true, TransportMode::Radiance, Some(ior)) = (transmitted, mode, ior) {
             let eta = if fr.entering { ior } else { 1.0 / ior };
             eta_scale = 1.0 / (eta * eta);
         }

@@ -607,3 +607,71 @@ fn rough_glass_samples_transmit_with_weight_f_cos_over_pdf_and_the_eta_scale() {
         .expect("a refraction");
     assert!((s.eta_scale - 1.0 / 2.25).abs() < 1e-6);
 }
+
+#[test]
+fn the_lambert_fast_path_gives_the_general_mixtures_numbers_bit_for_bit() {
+    // The same matte BSDFs with the fast path switched off: every query must return the same
+    // bits, in both modes, for directions on both sides and tilted shading normals, black and
+    // coloured tints (a black Phong lobe, no Phong lobe, and a weight below 1 are all matte).
+    let mut no_phong = diffuse(0.6);
+    no_phong.parts[0].lobes[1] = None;
+    let matte = [
+        diffuse(0.6),
+        diffuse(0.0),
+        no_phong,
+        Bsdf::new(
+            Vec3::new(0.9, 0.2, 0.0),
+            Vec3::ZERO,
+            50.0,
+            [Some(0.5), None, None],
+            1.5,
+        ),
+    ];
+    let frames = [
+        frame_z(true),
+        ShadingFrame {
+            ns: Vec3::new(0.3, 0.0, 1.0).normalize(),
+            ng: Vec3::Z,
+            entering: false,
+        },
+    ];
+    let mut rng = Rng::new(17, 0);
+    for m in matte {
+        assert!(m.is_lambert());
+        let mut general = m;
+        general.lambert = false;
+        for fr in &frames {
+            for _ in 0..200 {
+                let wo = crate::sampling::warp::uniform_sphere(rng.next_2d());
+                let wi = crate::sampling::warp::uniform_sphere(rng.next_2d());
+                let (fast, slow) = (m.at(wo, fr), general.at(wo, fr));
+                assert!(fast.lambert && !slow.lambert);
+                for mode in [TransportMode::Radiance, TransportMode::Importance] {
+                    assert_eq!(
+                        fast.eval(wi, mode).to_array().map(f32::to_bits),
+                        slow.eval(wi, mode).to_array().map(f32::to_bits)
+                    );
+                    let (u_lobe, u) = (rng.next_f32(), rng.next_2d());
+                    assert_eq!(
+                        format!("{:?}", fast.sample(u_lobe, u, mode)),
+                        format!("{:?}", slow.sample(u_lobe, u, mode))
+                    );
+                }
+                assert_eq!(fast.pdf(wi).to_bits(), slow.pdf(wi).to_bits());
+            }
+        }
+    }
+    // Anything with a lit Phong lobe, a mirror or glass is not matte.
+    assert!(!mixed().is_lambert());
+    assert!(!Bsdf::new(Vec3::ONE, Vec3::splat(0.1), 10.0, [None; 3], 1.5).is_lambert());
+    assert!(
+        !Bsdf::new(
+            Vec3::ONE,
+            Vec3::ZERO,
+            1.0,
+            [Some(0.5), Some(0.5), None],
+            1.5
+        )
+        .is_lambert()
+    );
+}

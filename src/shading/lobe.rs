@@ -14,7 +14,6 @@ use super::rough_dielectric::RoughDielectric;
 use super::scattering::{BsdfSample, LobeFlags, ShadingFrame, TransportMode};
 use super::specular_conductor::SpecularConductor;
 use super::specular_reflection::SpecularReflection;
-use crate::geometry::Frame;
 
 /// One lobe of the mixture. Lobes tinted by the material's colour (Lambert's albedo, the mirror's
 /// reflectance, the dielectric's transmittance) take it as the `tint` argument, so a colour
@@ -202,23 +201,8 @@ impl Lobe {
             Lobe::Lambert(l) => Some(l.sample(u, fr)),
             Lobe::Phong(p) => Some(p.sample(wo, u, fr)),
             Lobe::SpecularReflection(_) | Lobe::SpecularConductor(_) | Lobe::Dielectric(_) => None,
-            Lobe::RoughConductor { lobe, .. } => {
-                let frame = Frame::from_normal(fr.ns);
-                let li = lobe.sample_local(frame.to_local(wo), u)?;
-                Some(frame.to_world(li))
-            }
-            Lobe::RoughDielectric(d) => {
-                let frame = Frame::from_normal(fr.ns);
-                let s = d.sample_local(
-                    frame.to_local(wo),
-                    v,
-                    u,
-                    fr.entering,
-                    TransportMode::Radiance,
-                    tint,
-                )?;
-                Some(frame.to_world(s.wi))
-            }
+            Lobe::RoughConductor { lobe, .. } => lobe.sample_direction(wo, u, fr),
+            Lobe::RoughDielectric(d) => d.sample_direction(wo, v, u, fr, tint),
         }
     }
 

@@ -93,7 +93,9 @@ impl RoughConductor {
     /// `f(wo, wi)` for world directions in frame `fr` (the tangent frame is
     /// `Frame::from_normal(fr.ns)`), 0 unless `wi` is above both the shading and the geometric
     /// surface.
-    #[inline]
+    // Out of line: inlined into the BSDF mixture, its frame and half-vector arithmetic was
+    // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
+    #[inline(never)]
     #[must_use]
     pub fn f(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> Vec3 {
         if fr.ng.dot(wi) <= 0.0 {
@@ -104,7 +106,9 @@ impl RoughConductor {
     }
 
     /// The density of [`RoughConductor::sample`] at the world direction `wi` (0 where `f` is 0).
-    #[inline]
+    // Out of line: inlined into the BSDF mixture, its frame and half-vector arithmetic was
+    // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
+    #[inline(never)]
     #[must_use]
     pub fn pdf(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
         if fr.ng.dot(wi) <= 0.0 {
@@ -112,6 +116,19 @@ impl RoughConductor {
         }
         let frame = Frame::from_normal(fr.ns);
         self.pdf_local(frame.to_local(wo), frame.to_local(wi))
+    }
+
+    /// A world direction from [`RoughConductor::sample_local`] (the visible normals) for the
+    /// world direction `wo` in frame `fr`, without its weight (the BSDF mixture weighs it);
+    /// `None` when the sample is lost.
+    // Out of line: inlined into the BSDF mixture, its frame and half-vector arithmetic was
+    // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
+    #[inline(never)]
+    #[must_use]
+    pub fn sample_direction(&self, wo: Vec3, u: (f32, f32), fr: &ShadingFrame) -> Option<Vec3> {
+        let frame = Frame::from_normal(fr.ns);
+        let li = self.sample_local(frame.to_local(wo), u)?;
+        Some(frame.to_world(li))
     }
 
     /// A sampled world direction with its weight `f |ns·wi| / pdf` (times the adjoint

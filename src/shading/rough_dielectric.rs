@@ -221,7 +221,9 @@ impl RoughDielectric {
     /// `f(wo, wi)` for world directions in frame `fr` (tangent frame `Frame::from_normal(fr.ns)`),
     /// in mode `mode`: 0 when the shading and geometric normals disagree about which side `wi`
     /// is on (no light leaks through a surface a shading normal leans over).
-    #[inline]
+    // Out of line: inlined into the BSDF mixture, its frame and half-vector arithmetic was
+    // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
+    #[inline(never)]
     #[must_use]
     pub fn f(
         &self,
@@ -239,13 +241,42 @@ impl RoughDielectric {
 
     /// The density of [`RoughDielectric::sample`]'s non-delta samples at the world direction
     /// `wi` (0 where `f` is 0, and for a pass-through).
-    #[inline]
+    // Out of line: inlined into the BSDF mixture, its frame and half-vector arithmetic was
+    // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
+    #[inline(never)]
     #[must_use]
     pub fn pdf(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, tint: Vec3) -> f32 {
         let frame = Frame::from_normal(fr.ns);
         Self::classify(fr, &frame, wi).map_or(0.0, |li| {
             self.pdf_local(frame.to_local(wo), li, fr.entering, tint)
         })
+    }
+
+    /// A world direction from [`RoughDielectric::sample_local`] (radiance mode's choice of
+    /// reflection or refraction by `v`) for the world direction `wo` in frame `fr`, without its
+    /// weight (the BSDF mixture weighs it); `None` when the sample is lost.
+    // Out of line: inlined into the BSDF mixture, its frame and half-vector arithmetic was
+    // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
+    #[inline(never)]
+    #[must_use]
+    pub fn sample_direction(
+        &self,
+        wo: Vec3,
+        v: f32,
+        u: (f32, f32),
+        fr: &ShadingFrame,
+        tint: Vec3,
+    ) -> Option<Vec3> {
+        let frame = Frame::from_normal(fr.ns);
+        let s = self.sample_local(
+            frame.to_local(wo),
+            v,
+            u,
+            fr.entering,
+            TransportMode::Radiance,
+            tint,
+        )?;
+        Some(frame.to_world(s.wi))
     }
 
     /// A sampled world direction with its weight `f |ns·wi| / pdf` (times the adjoint
