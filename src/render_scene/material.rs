@@ -79,6 +79,7 @@ impl RenderScene {
     /// surface), where the pixel's footprint is `width` world units wide across the incoming
     /// ray (0: sharpest). This is the single place textures, bump mapping and the
     /// shading-normal rules are applied.
+    #[inline(always)]
     #[must_use]
     pub fn shading_point(
         &self,
