@@ -185,7 +185,15 @@ fn resolved_scene(
     absolute_assets(&mut tree, base);
     pin_default_estimator(&mut tree, params);
     let scene: SceneFile = serde_json::from_value(tree).map_err(|e| fail(e.to_string()))?;
-    let body = ron::ser::to_string_pretty(&scene, ron::ser::PrettyConfig::default())
+    // Written with the extensions the scene loader reads RON with (`scene::parse::ron`):
+    // `Option` fields bare (`emission: (radiance: …)`, not `Some((…))`, which the loader's
+    // unwrapped newtypes would read as a newtype around a tuple and refuse) and newtype
+    // variants unwrapped. Both are default extensions there, so no `#![enable]` header.
+    let extensions = ron::extensions::Extensions::IMPLICIT_SOME
+        | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES;
+    let body = ron::Options::default()
+        .with_default_extension(extensions)
+        .to_string_pretty(&scene, ron::ser::PrettyConfig::default())
         .map_err(|e| fail(e.to_string()))?;
     Ok(format!(
         "// Written by `caustic farm plan` from `{}` with its overrides applied and asset paths\n// made absolute; the farm's shards render this file.\n{body}\n",
