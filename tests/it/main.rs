@@ -39,4 +39,5 @@ mod reported;
 mod reported_photon;
 mod rough_textures;
 mod textures;
+mod transmission_nee;
 mod watertight;

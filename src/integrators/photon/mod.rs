@@ -410,7 +410,8 @@ impl<'a> PhotonMapper<'a> {
             return Vec3::ZERO;
         };
         match connect_light(self.scene, index, sp, &bsdf.at(wo, fr), u_point, counters) {
-            Some(c) if !c.occluded => c.f * c.ls.weight * (fr.ns.dot(c.ls.wi) / pmf),
+            // |cos θ|: through a rough dielectric the light lies below the shading normal.
+            Some(c) if !c.occluded => c.f * c.ls.weight * (fr.ns.dot(c.ls.wi).abs() / pmf),
             _ => Vec3::ZERO,
         }
     }
