@@ -122,6 +122,16 @@ impl Radiance {
         self.parts[0] + self.parts[1] + self.parts[2] + self.parts[3]
     }
 
+    /// Every part scaled by `w` (e.g. the transmittance of the segment the light came along).
+    #[inline]
+    #[must_use]
+    pub fn scaled(mut self, w: Vec3) -> Self {
+        for a in &mut self.parts {
+            *a *= w;
+        }
+        self
+    }
+
     /// Adds every part of `other` scaled by `w`.
     #[inline]
     pub fn add_scaled(&mut self, other: &Radiance, w: Vec3) {

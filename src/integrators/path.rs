@@ -453,7 +453,9 @@ impl PathTracer<'_> {
         let c = if blocked {
             Vec3::ZERO
         } else {
-            f * (at.frame().ns.dot(ls.wi) * w / (ls.pdf * pmf)) * ls.radiance
+            // |cos θ|: a light seen through a transmitting non-delta lobe (rough glass) lies
+            // below the shading normal, where the signed cosine would subtract its light.
+            f * (at.frame().ns.dot(ls.wi).abs() * w / (ls.pdf * pmf)) * ls.radiance
         };
         if O::ACTIVE {
             let record = ShadowRecord {

@@ -1,5 +1,11 @@
 //! The recursive ray tracer of the report: direct light with shadow rays (Phong highlight
 //! included), mirror reflection and Fresnel-weighted refraction, limited by depth and weight.
+//!
+//! Beer–Lambert absorption ([`Medium`], the same rule as the path tracer's): every ray carries
+//! the medium it travels in, entered or left where it refracts or reflects at a surface whose
+//! material absorbs; the radiance it brings back is scaled by `exp(−σ t)` over its length.
+//! Shadow rays, which cross dielectrics in a straight line, start in the medium the shaded
+//! point's side is in and are attenuated over each stretch inside a medium too.
 
 use glam::Vec3;
 
@@ -9,8 +15,8 @@ use super::trace_log::{RayKind, ShadowRecord, TraceHit};
 use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Interaction, RenderScene, SurfacePoint};
-use crate::shading::{Bsdf, LobeFlags, ShadingFrame};
+use crate::render_scene::{Interaction, Medium, RenderScene, SurfaceHit};
+use crate::shading::{LobeFlags, ShadingFrame};
 
 /// The Whitted-style integrator over a compiled scene.
 #[derive(Debug)]
@@ -31,6 +37,8 @@ struct Path {
     weight: Vec3,
     kind: RayKind,
     cone: RayCone,
+    /// The absorbing medium the ray travels in.
+    medium: Medium,
 }
 
 impl<'a> Whitted<'a> {
@@ -55,6 +63,7 @@ impl<'a> Whitted<'a> {
             weight: Vec3::ONE,
             kind: RayKind::Camera,
             cone: RayCone::camera(self.pixel_spread),
+            medium: Medium::OUTSIDE,
         };
         self.trace(path, cx, None)
     }
@@ -87,8 +96,11 @@ impl<'a> Whitted<'a> {
         let scene = self.scene;
         cx.counters.rays += 1;
         let ray = &path.ray;
-        let v = match scene.interact(ray, |t| path.cone.width_at(ray, t)) {
-            Interaction::Escaped => return (seen(scene.params.background), None),
+        let it = scene.interact(ray, |t| path.cone.width_at(ray, t));
+        // Beer–Lambert absorption along this ray (exactly 1 outside media).
+        let tr = path.medium.transmittance(ray, &it);
+        let v = match it {
+            Interaction::Escaped => return (seen(scene.params.background * tr), None),
             Interaction::Emitter(e) => {
                 let entering = e.wo.dot(e.sp.ng) > 0.0;
                 let info = O::ACTIVE.then(|| TraceHit {
@@ -100,7 +112,7 @@ impl<'a> Whitted<'a> {
                     entering,
                 });
                 // An emitter: its radiance is seen from outside only.
-                return (seen(e.le(scene)), info);
+                return (seen(e.le(scene) * tr), info);
             }
             Interaction::Surface(v) => v,
         };
@@ -117,22 +129,22 @@ impl<'a> Whitted<'a> {
         });
         let mut l = Radiance::default();
         if material.has_local() {
-            let direct = self.direct(&sp, &material, wo, ng, ns, cx, me);
+            let direct = self.direct(&v, path.medium, cx, me);
             l.add(LightPath::Direct, direct);
         }
         if !material.has_delta() {
-            return (l, info);
+            return (l.scaled(tr), info);
         }
         if path.depth >= scene.params.max_depth {
             cx.observer
                 .note(me, "max depth reached: specular rays not traced");
-            return (l, info);
+            return (l.scaled(tr), info);
         }
         let lobes = material.delta_lobes(wo, ns, ng, entering);
         let min = scene.params.min_contribution;
         let curvature = scene.geometry.curvature(&hit);
         let mut spawn = |dir: Vec3, w: Vec3, kind: RayKind, cx: &mut Context<'_, O>| {
-            let weight = path.weight * w;
+            let weight = path.weight * tr * w;
             if weight.max_element() < min || weight.max_element() <= 0.0 {
                 return;
             }
@@ -148,6 +160,7 @@ impl<'a> Whitted<'a> {
                     curvature,
                     if kind == RayKind::Reflect { 2.0 } else { 1.0 },
                 ),
+                medium: path.medium.after(scene, &v, dir),
             };
             let seen = self.trace(child, cx, me);
             l.add_scaled(&seen, w);
@@ -161,21 +174,21 @@ impl<'a> Whitted<'a> {
         if let Some((dir, w)) = lobes.refract {
             spawn(dir, w, RayKind::Refract, cx);
         }
-        (l, info)
+        (l.scaled(tr), info)
     }
 
-    /// Light arriving directly from every light source, through the non-delta part of the BSDF.
-    #[allow(clippy::too_many_arguments)]
+    /// Light arriving directly from every light source at the hit `v`, through the non-delta
+    /// part of its BSDF; `medium` is the one the ray that found `v` travelled in (a shadow ray
+    /// starts in it, or in `v`'s own medium when it leaves into an absorbing object).
     fn direct<O: PathObserver>(
         &self,
-        sp: &SurfacePoint,
-        material: &Bsdf,
-        wo: Vec3,
-        ng: Vec3,
-        ns: Vec3,
+        v: &SurfaceHit,
+        medium: Medium,
         cx: &mut Context<'_, O>,
         me: Option<usize>,
     ) -> Vec3 {
+        let (sp, material, wo) = (&v.sp, &v.bsdf, v.wo);
+        let ShadingFrame { ns, ng, .. } = v.frame;
         let mut total = Vec3::ZERO;
         for (index, light) in self.scene.lights.iter().enumerate() {
             let n = light.shadow_samples(self.scene.params.light_samples);
@@ -195,7 +208,8 @@ impl<'a> Whitted<'a> {
                 }
                 // Aim at the sampled light point itself, stopping just short of it.
                 let shadow = shadow_ray(sp, ng, ls.point);
-                let transmittance = self.transmittance(&shadow, cx.counters);
+                let start = medium.after(self.scene, v, ls.wi);
+                let transmittance = self.transmittance(&shadow, start, cx.counters);
                 let occluded = transmittance == Vec3::ZERO;
                 let c = f * ls.weight * cos_s * transmittance;
                 sum += c;
@@ -227,14 +241,15 @@ impl<'a> Whitted<'a> {
 impl Whitted<'_> {
     /// How much of the light travelling along `shadow` (up to its `t_max`) arrives: 0 when an
     /// opaque surface is in the way, else the product of the straight-line transmittances of
-    /// the dielectric surfaces crossed (`Bsdf::straight_transmittance`).
-    fn transmittance(&self, shadow: &Ray, counters: &mut Counters) -> Vec3 {
+    /// the dielectric surfaces crossed (`Bsdf::straight_transmittance`) and of Beer–Lambert's
+    /// `exp(−σ t)` over each stretch inside an absorbing medium, the first in `start`.
+    fn transmittance(&self, shadow: &Ray, start: Medium, counters: &mut Counters) -> Vec3 {
         counters.rays += 1;
         let scene = self.scene;
         // Most shadow rays are unblocked, or blocked by something opaque: any-hit queries
         // settle them; only rays that meet nothing but transmitters walk their crossings.
         if !scene.geometry.occluded(shadow) {
-            return Vec3::ONE;
+            return start.transmittance_over(shadow.dir.length() * shadow.t_max);
         }
         if !self.transmissive
             || scene.geometry.occluded_by(shadow, |prim| {
@@ -246,15 +261,21 @@ impl Whitted<'_> {
         let end = shadow.origin + shadow.dir * shadow.t_max;
         let mut ray = *shadow;
         let mut t = Vec3::ONE;
+        let mut medium = start;
         for _ in 0..MAX_SHADOW_CROSSINGS {
             let v = match scene.interact(&ray, |_| 0.0) {
-                Interaction::Escaped => return t,
+                // Nothing more before the light: the last stretch, in the current medium.
+                Interaction::Escaped => {
+                    return t * medium.transmittance_over(ray.dir.length() * ray.t_max);
+                }
                 Interaction::Surface(v) if !scene.is_opaque(v.sp.object) => v,
                 Interaction::Surface(_) | Interaction::Emitter(_) => return Vec3::ZERO,
             };
+            t *= medium.transmittance_over(v.hit.t * ray.dir.length());
             t *= v
                 .bsdf
                 .straight_transmittance(v.frame.ns.dot(v.wo), v.frame.entering);
+            medium = medium.after(scene, &v, ray.dir);
             if t.max_element() <= 0.0 {
                 return Vec3::ZERO;
             }

@@ -1,6 +1,7 @@
 //! The absorbing medium a path segment travels through: Beer–Lambert attenuation inside
 //! dielectrics (water, coloured glass; [`crate::shading::absorption`]), the same for camera
-//! paths and photons.
+//! paths (`path` and the progressive integrators built on it, the photon integrator's camera
+//! branches and final-gather rays, Whitted's rays and its straight shadow rays) and photons.
 //!
 //! A path starts outside every object (cameras and lights are in air). The medium changes only
 //! where the path scatters at a surface whose material has an `absorption`: a direction into
@@ -55,6 +56,18 @@ impl Medium {
             Interaction::Surface(s) => s.hit.t,
         };
         self.absorption.transmittance(t * ray.dir.length())
+    }
+
+    /// The fraction of light (per channel) kept over `distance` metres in this medium (a
+    /// shadow ray's segment, which ends at a point rather than a hit). Exactly 1 in a clear
+    /// medium.
+    #[inline]
+    #[must_use]
+    pub fn transmittance_over(&self, distance: f32) -> Vec3 {
+        if self.is_clear() {
+            return Vec3::ONE;
+        }
+        self.absorption.transmittance(distance)
     }
 
     /// The medium after the path scatters at `v` into the direction `wi`: the material's

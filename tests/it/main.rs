@@ -1,6 +1,7 @@
 //! The integration tests, as one binary (one link of the library instead of one per file).
 
 mod absorption;
+mod absorption_integrators;
 mod architecture;
 mod assets;
 mod bad_scenes;
@@ -38,4 +39,5 @@ mod reported;
 mod reported_photon;
 mod rough_textures;
 mod textures;
+mod transmission_nee;
 mod watertight;

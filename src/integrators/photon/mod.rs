@@ -35,7 +35,9 @@ use super::trace_log::RayKind;
 use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Interaction, LightSampler, Medium, RenderScene, SurfacePoint};
+use crate::render_scene::{
+    Interaction, LightSampler, Medium, RenderScene, SurfaceHit, SurfacePoint,
+};
 use crate::sampling::Sampler;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
@@ -207,6 +209,7 @@ impl<'a> PhotonMapper<'a> {
                 let full = beta.max_element() >= FINAL_GATHER_MIN_WEIGHT;
                 let (c, note) = self.local(
                     maps,
+                    (&v, b.medium),
                     &sp,
                     &fr,
                     &bsdf,
@@ -296,12 +299,14 @@ impl<'a> PhotonMapper<'a> {
     }
 
     /// The radiance a camera-path vertex with a diffuse part sends towards `wo`: direct light,
-    /// caustics and indirect light. With `describe`, also a line for `debug-pixel` naming each
-    /// estimate's photon count and radius.
+    /// caustics and indirect light. `vertex` is the hit and the medium the camera ray reached
+    /// it through (where final-gather rays start). With `describe`, also a line for
+    /// `debug-pixel` naming each estimate's photon count and radius.
     #[allow(clippy::too_many_arguments)]
     fn local(
         &self,
         maps: &PhotonMaps,
+        vertex: (&SurfaceHit, Medium),
         sp: &SurfacePoint,
         fr: &ShadingFrame,
         bsdf: &Bsdf,
@@ -341,7 +346,7 @@ impl<'a> PhotonMapper<'a> {
         let gather = self.final_gather;
         let (indirect, global) = if gather > 0 {
             (
-                self.final_gather(maps, sp, fr, bsdf, wo, gather, sampler, counters),
+                self.final_gather(maps, vertex, sp, fr, bsdf, wo, gather, sampler, counters),
                 None,
             )
         } else {
@@ -405,7 +410,8 @@ impl<'a> PhotonMapper<'a> {
             return Vec3::ZERO;
         };
         match connect_light(self.scene, index, sp, &bsdf.at(wo, fr), u_point, counters) {
-            Some(c) if !c.occluded => c.f * c.ls.weight * (fr.ns.dot(c.ls.wi) / pmf),
+            // |cos θ|: through a rough dielectric the light lies below the shading normal.
+            Some(c) if !c.occluded => c.f * c.ls.weight * (fr.ns.dot(c.ls.wi).abs() / pmf),
             _ => Vec3::ZERO,
         }
     }
@@ -414,10 +420,14 @@ impl<'a> PhotonMapper<'a> {
     /// where each lands, its direct light, caustics and global-map radiance (following up to
     /// four mirror or glass bounces first; a ray shorter than [`SHORT_GATHER`] times the
     /// landing estimate's radius takes one more BSDF-sampled bounce instead of reading it).
+    /// Each ray carries its absorbing [`Medium`], starting from the vertex's (`vertex`: the hit
+    /// and the medium the camera ray arrived in) and changing where it scatters, as camera
+    /// paths do: what it brings back keeps `exp(−σ t)` of every segment inside.
     #[allow(clippy::too_many_arguments)]
     fn final_gather(
         &self,
         maps: &PhotonMaps,
+        vertex: (&SurfaceHit, Medium),
         sp: &SurfacePoint,
         fr: &ShadingFrame,
         bsdf: &Bsdf,
@@ -440,10 +450,14 @@ impl<'a> PhotonMapper<'a> {
             }
             let mut beta = s.weight;
             let mut ray = Ray::new(offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi), s.wi);
+            let mut medium = vertex.1.after(scene, vertex.0, s.wi);
             let (mut specular, mut shortcuts) = (0u32, 0u32);
             loop {
                 counters.rays += 1;
-                let g = match scene.interact(&ray, |_| 0.0) {
+                let it = scene.interact(&ray, |_| 0.0);
+                // Beer–Lambert absorption along the segment just travelled (1 outside media).
+                beta *= medium.transmittance(&ray, &it);
+                let g = match it {
                     Interaction::Escaped => {
                         sum += beta * scene.params.background;
                         break;
@@ -502,6 +516,7 @@ impl<'a> PhotonMapper<'a> {
                 if !beta.is_finite() || beta.max_element() <= 0.0 {
                     break;
                 }
+                medium = medium.after(scene, &g, gs.wi);
                 ray = Ray::new(offset_ray_origin(gp.p, gp.p_error, gfr.ng, gs.wi), gs.wi);
             }
         }

@@ -1,0 +1,135 @@
+"""Mitsuba 3 renders of the issue #26 comparison scenes, one per material.
+
+Use:  /root/.cache/mitsuba3-venv/bin/python scripts/mitsuba/materials.py SCENE [--spp N] [-o out.exr]
+      SCENE ∈ rough_chrome, rough_gold, frosted_01, frosted_05, water (or `all`).
+
+Every scene: 96×72 pixels, the floor y = 0 (Lambert 0.5), a sphere of the material (radius 0.5
+at (0, 0.5, 0)), the 1 × 0.6 quad light of lights.py (y = 2.5, facing down, L = 8) and a
+constant environment of radiance 0.3 (something for the metals to reflect); camera at
+(0, 2, 5) looking at (0, 0.5, 0), fov_y 18° (the ball fills most of the frame); path tracing with max_depth 17 (caustic: 16
+bounces), `volpath` for the absorbing water. Caustic's twins are
+`scripts/mitsuba/scenes/materials_*.ron`; `scripts/mitsuba/materials_compare.py` renders both
+and compares them.
+
+Convention differences and how each scene neutralises them:
+  roughness    caustic's `roughness` r is perceptual: the GGX width is α = r² (docs/material.md);
+               Mitsuba's `alpha` is α. So Mitsuba gets alpha = r² (GGX, visible-normal
+               sampling), r = 0.3 for chrome, 0.4 for gold, 0.1 and 0.5 for the frosted glass.
+  conductors   caustic's presets are complex indices η + ik at 650/550/450 nm (the table in
+               src/shading/conductor.rs); Mitsuba's named materials ("Cr", "Au") are spectral
+               tables converted to RGB its own way. The scenes give Mitsuba caustic's η and k
+               per RGB channel explicitly (`eta`, `k` as rgb), so both evaluate the same exact
+               conductor Fresnel.
+  masking      NOT neutralised (cannot be from the scene): caustic's rough lobes use Heitz's
+               height-correlated G2 = 1/(1 + Λ(ωo) + Λ(ωi)) (src/shading/microfacet.rs);
+               Mitsuba 3's microfacet distribution uses the separable G1(ωo)·G1(ωi)
+               (MicrofacetDistribution::G in include/mitsuba/render/microfacet.h). G2 ≥ G1·G1,
+               equal when either Λ is 0; the difference grows with α and at grazing angles.
+  dielectric   Mitsuba's `roughdielectric`/`dielectric` with int_ior 1.5 (1.33), ext_ior 1:
+               caustic's `ior` is the inside index relative to the outside (air).
+  absorption   caustic's `absorption` σ (per metre) inside a closed dielectric; Mitsuba: the
+               sphere's `interior` is a `homogeneous` medium with sigma_t = σ and albedo 0 (no
+               scattering), rendered by `volpath` (Mitsuba's `path` ignores media).
+  emitters     one-sided quad as in lights.py; `constant` emitter = caustic's constant
+               Environment (same meaning).
+"""
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import common  # noqa: E402
+import lights  # noqa: E402
+
+# caustic's presets (src/shading/conductor.rs, ConductorPreset::complex_index), (η, k) per RGB.
+CHROME = ([3.1071, 3.1812, 2.3230], [3.3314, 3.3291, 3.1350])
+GOLD = ([0.1556, 0.4241, 1.3831], [3.6024, 2.4721, 1.9155])
+WATER_SIGMA = [2.0, 0.4, 0.2]   # per metre: blue-green, strong enough to see through 1 m
+ENV = 0.3
+FOV = 18.0
+
+
+def base(mi, spp, seed, integrator="path"):
+    return {
+        "type": "scene",
+        "integrator": {"type": integrator, "max_depth": 17},
+        "sensor": common.sensor(mi, lights.EYE, lights.LOOK, FOV, lights.W, lights.H, spp, seed),
+        "floor": common.floor(mi),
+        "panel": lights.quad_light(mi),
+        "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [ENV] * 3}},
+    }
+
+
+def ball(bsdf, **more):
+    return {"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5, "bsdf": bsdf, **more}
+
+
+def rough_conductor(index, r):
+    eta, k = index
+    return {"type": "roughconductor", "distribution": "ggx", "alpha": r * r, "sample_visible": True,
+            "eta": {"type": "rgb", "value": eta}, "k": {"type": "rgb", "value": k}}
+
+
+def rough_dielectric(r):
+    return {"type": "roughdielectric", "distribution": "ggx", "alpha": r * r, "sample_visible": True,
+            "int_ior": 1.5, "ext_ior": 1.0}
+
+
+def scene_rough_chrome(mi, spp, seed):
+    """A rough chrome ball (r = 0.3, α = 0.09)."""
+    d = base(mi, spp, seed)
+    d["ball"] = ball(rough_conductor(CHROME, 0.3))
+    return d
+
+
+def scene_rough_gold(mi, spp, seed):
+    """A rough gold ball (r = 0.4, α = 0.16)."""
+    d = base(mi, spp, seed)
+    d["ball"] = ball(rough_conductor(GOLD, 0.4))
+    return d
+
+
+def scene_frosted(mi, spp, seed, r):
+    """A frosted glass ball (η = 1.5, roughness r, α = r²)."""
+    d = base(mi, spp, seed)
+    d["ball"] = ball(rough_dielectric(r))
+    return d
+
+
+def scene_water(mi, spp, seed):
+    """A ball of absorbing water: smooth dielectric η = 1.33 around a purely absorbing medium."""
+    d = base(mi, spp, seed, integrator="volpath")
+    # Mitsuba reads an RGB sigma_t as a reflectance (each channel in [0, 1]): it is given
+    # divided by its largest channel, with `scale` = that channel.
+    top = max(WATER_SIGMA)
+    d["water"] = {"type": "homogeneous", "scale": top,
+                  "sigma_t": {"type": "rgb", "value": [s / top for s in WATER_SIGMA]},
+                  "albedo": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}
+    d["ball"] = ball({"type": "dielectric", "int_ior": 1.33, "ext_ior": 1.0},
+                     interior={"type": "ref", "id": "water"})
+    return d
+
+
+SCENES = {
+    "rough_chrome": scene_rough_chrome,
+    "rough_gold": scene_rough_gold,
+    "frosted_01": lambda mi, spp, seed: scene_frosted(mi, spp, seed, 0.1),
+    "frosted_05": lambda mi, spp, seed: scene_frosted(mi, spp, seed, 0.5),
+    "water": scene_water,
+}
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2 or sys.argv[1] not in list(SCENES) + ["all"]:
+        sys.exit(f"usage: {sys.argv[0]} {{{','.join(SCENES)},all}} [--spp N] [--seed S] [--threads T] [-o out.exr]")
+    which = sys.argv.pop(1)
+    names = list(SCENES) if which == "all" else [which]
+    import argparse
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("-o", "--out", default=None, help="EXR path (default /tmp/mitsuba_<scene>.exr)")
+    a = ap.parse_args()
+    for name in names:
+        out = a.out if (a.out and len(names) == 1) else f"/tmp/mitsuba_{name}.exr"
+        common.render(lambda mi, f=SCENES[name]: f(mi, a.spp, a.seed), a.spp, out, a.threads, a.seed)
