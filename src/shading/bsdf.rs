@@ -324,10 +324,8 @@ impl Bsdf {
     pub fn delta_share(&self) -> f32 {
         let mut s = 0.0f32;
         for p in self.parts.iter().filter(|p| p.is_delta()) {
-            s += match p.lobes().next() {
-                Some(l @ Lobe::Coated { .. }) => p.weight * l.focusing_fraction(),
-                _ => p.weight,
-            };
+            // × 1 (exactly) for mirrors and dielectrics.
+            s += p.weight * p.lobes().next().map_or(1.0, Lobe::focusing_fraction);
         }
         s
     }
