@@ -245,6 +245,37 @@ pub fn tiles_height() -> GrayImage {
     })
 }
 
+/// Height of white in [`tiles_height`] per image width that [`tiles_normal`] encodes: the
+/// relief of the tiled wall of `scenes/bump_map.ron` (depth 0.01 over a 2-unit repeat).
+pub const TILES_NORMAL_RELIEF: f32 = 0.005;
+
+/// The tangent-space normal map of [`tiles_height`] (its 8-bit grey values g/255 as heights,
+/// white [`TILES_NORMAL_RELIEF`] high per image width), for a material's `normal_map`: with
+/// central differences (wrapping) g_u = ∂g/∂u, g_v = ∂g/∂v in image units (v down), the normal
+/// is normalize(−R g_u, R g_v, 1) (x right, y up the image, z out), each channel written as
+/// round(127 c + 128) (so 128 is 0, as the renderer decodes it). Seamless.
+#[must_use]
+pub fn tiles_normal() -> RgbImage {
+    let heights = tiles_height();
+    let n = TILES_SIZE as i64;
+    let g = |x: i64, y: i64| {
+        f32::from(
+            heights
+                .get_pixel(x.rem_euclid(n) as u32, y.rem_euclid(n) as u32)
+                .0[0],
+        ) / 255.0
+    };
+    let encode = |c: f32| (127.0 * c + 128.0).round().clamp(0.0, 255.0) as u8;
+    RgbImage::from_fn(TILES_SIZE, TILES_SIZE, |x, y| {
+        let (x, y) = (i64::from(x), i64::from(y));
+        let scale = TILES_NORMAL_RELIEF * TILES_SIZE as f32 * 0.5;
+        let gu = (g(x + 1, y) - g(x - 1, y)) * scale;
+        let gv = (g(x, y + 1) - g(x, y - 1)) * scale;
+        let len = (gu * gu + gv * gv + 1.0).sqrt();
+        Rgb([encode(-gu / len), encode(gv / len), encode(1.0 / len)])
+    })
+}
+
 /// A 128×128 sRGB colour image aligned with [`tiles_height`]: pale, slightly varied off-white
 /// glazed tiles with a faint mottle, the glaze a little darker down the bevels, and speckled
 /// warm grey grout.

@@ -6,6 +6,8 @@
 //!   angles).
 //! - `tiles_height.png`, `tiles_color.png`: a seamless 128×128 height map of 4×4 bevelled square
 //!   tiles with grout, and the matching colour image.
+//! - `tiles_normal.png`: the tangent-space normal map of `tiles_height.png` (OpenGL convention,
+//!   8-bit 128 = 0).
 //! - `ramp_height.png`: a 64×64 linear ramp in x, for bump mapping with an analytic tilt.
 //! - `sky.exr`: a 128×64 equirectangular linear HDR sky (gradient, ground, sun) for environment
 //!   lighting.
@@ -72,6 +74,7 @@ fn main() -> std::io::Result<()> {
     rgb("hardwood.png", images::hardwood())?;
     grey("tiles_height.png", images::tiles_height())?;
     rgb("tiles_color.png", images::tiles_color())?;
+    rgb("tiles_normal.png", images::tiles_normal())?;
     grey("ramp_height.png", images::ramp_height())?;
     let sky = images::sky();
     let path = root.join("sky.exr");

@@ -18,8 +18,9 @@ use crate::shading::absorption::Absorption;
 use crate::shading::conductor::{ConductorFresnel, ConductorPreset};
 use crate::shading::microfacet::Ggx;
 use crate::texture::bitmap::read_colour_image;
+use crate::texture::normal_map::read_normal_image;
 use crate::texture::{
-    BitmapTexture, GreyMipMap, HeightMap, Marble, MipMap, Noise, Ripples, TextureError,
+    BitmapTexture, GreyMipMap, HeightMap, Marble, MipMap, Noise, NormalMap, Ripples, TextureError,
 };
 
 /// Materials resolved on first use, so unused ones (and their textures) are not compiled.
@@ -63,6 +64,15 @@ impl MaterialTable {
                 base_dir,
                 t,
                 &format!("materials.{name}.bump"),
+                errors,
+            )
+        });
+        let normal_map = m.normal_map.as_deref().and_then(|t| {
+            self.textures.resolve(
+                scene,
+                base_dir,
+                t,
+                &format!("materials.{name}.normal_map"),
                 errors,
             )
         });
@@ -117,8 +127,9 @@ impl MaterialTable {
             [m.diffuse, m.reflect, m.transmit],
             m.ior,
         )
-        .with_microfacets(distribution, conductor);
-        let filtered = [color_texture, bump, roughness_texture]
+        .with_microfacets(distribution, conductor)
+        .with_coat(m.coat.map(|c| c.ior));
+        let filtered = [color_texture, bump, normal_map, roughness_texture]
             .into_iter()
             .flatten()
             .any(|t| self.textures.list[t as usize].filtered());
@@ -129,6 +140,7 @@ impl MaterialTable {
                 bsdf,
                 color_texture,
                 bump,
+                normal_map,
                 roughness_texture,
                 conductor,
                 filtered,
@@ -147,6 +159,7 @@ pub(super) struct TextureTable {
     pub list: Vec<Texture>,
     colour_images: HashMap<(PathBuf, Option<bool>), Arc<MipMap<Vec3>>>,
     grey_images: HashMap<PathBuf, Arc<GreyMipMap>>,
+    normal_images: HashMap<PathBuf, Arc<MipMap<Vec3>>>,
     /// Image files decoded.
     pub images_loaded: usize,
     /// Warnings about the images read (negative texels clamped).
@@ -237,6 +250,22 @@ impl TextureTable {
                 )
                 .map_err(|e| load_error(file, e))?;
                 Texture::HeightMap(HeightMap::new(mip, *depth, Vec2::from(*tile)))
+            }
+            TextureSpec::NormalMap {
+                file,
+                tile,
+                strength,
+                flip_y,
+            } => {
+                let path = base_dir.join(file);
+                let mip = cached(
+                    &mut self.normal_images,
+                    &mut self.images_loaded,
+                    path.clone(),
+                    || read_normal_image(&path),
+                )
+                .map_err(|e| load_error(file, e))?;
+                Texture::NormalMap(NormalMap::new(mip, Vec2::from(*tile), *strength, *flip_y))
             }
             TextureSpec::Marble {
                 base,

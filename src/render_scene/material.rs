@@ -28,6 +28,9 @@ pub struct SurfaceMaterial {
     pub color_texture: Option<u32>,
     /// Texture perturbing the shading normal, as an index into `RenderScene::textures`.
     pub bump: Option<u32>,
+    /// Tangent-space normal map replacing the shading normal (never together with `bump`), as
+    /// an index into `RenderScene::textures`.
+    pub normal_map: Option<u32>,
     /// Texture giving the isotropic roughness r (mean channel, clamped to [0, 1]; GGX α = r²)
     /// of the mirror and dielectric parts at each hit, as an index into
     /// `RenderScene::textures`; `bsdf` is then the smooth BSDF it roughens.
@@ -49,6 +52,9 @@ impl std::fmt::Debug for SurfaceMaterial {
             .field("color_texture", &self.color_texture)
             .field("bump", &self.bump)
             .field("filtered", &self.filtered);
+        if let Some(t) = self.normal_map {
+            d.field("normal_map", &t);
+        }
         if let Some(t) = self.roughness_texture {
             d.field("roughness_texture", &t)
                 .field("conductor", &self.conductor);
@@ -93,6 +99,7 @@ impl RenderScene {
         let mut ns = sp.ns;
         if material.color_texture.is_some()
             || material.bump.is_some()
+            || material.normal_map.is_some()
             || material.roughness_texture.is_some()
         {
             let sps = self.geometry.surface_params(sp);
@@ -114,7 +121,9 @@ impl RenderScene {
                     width
                 },
             };
-            if let Some(t) = material.bump {
+            // A height source and a normal map are never both set (validated); either
+            // perturbs the interpolated normal in the surface's tangent frame.
+            if let Some(t) = material.bump.or(material.normal_map) {
                 ns = self.textures[t as usize].bump(ns, sps.dpdu, sps.dpdv, &lookup);
             }
             if let Some(t) = material.color_texture {

@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 
 use crate::texture::noise::octaves_for;
 use crate::texture::{
-    BitmapTexture, Footprint, HeightMap, Marble, Noise, Ripples, perturb_normal,
+    BitmapTexture, Footprint, HeightMap, Marble, Noise, NormalMap, Ripples, perturb_normal,
     perturb_normal_by_gradient,
 };
 
@@ -90,6 +90,9 @@ pub enum Texture {
     Noise(NoiseTexture),
     /// Water ripples over uv.
     Ripple(Ripples),
+    /// A tangent-space normal map (used by a material's `normal_map`, never as a colour or a
+    /// height).
+    NormalMap(NormalMap),
 }
 
 /// Where and how large a lookup is: the surface point and its parameterisation, and the pixel's
@@ -136,11 +139,14 @@ impl Texture {
             }
             Texture::HeightMap(h) => Vec3::splat(h.height(l.uv, l.footprint.width())),
             Texture::Ripple(r) => Vec3::splat(r.height(l.uv)),
+            // Validated never to be a colour: its tangent-space vector remapped to [0, 1].
+            Texture::NormalMap(m) => m.tangent_normal(l.uv, &l.footprint) * 0.5 + Vec3::splat(0.5),
         }
     }
 
     /// The unit normal `n` (outward, with the surface's `dpdu`, `dpdv`) perturbed by this
-    /// texture's height field at `l`. Bitmaps leave `n` unchanged.
+    /// texture's height field at `l`, or replaced by a normal map's normal in the tangent frame
+    /// of `dpdu`, `dpdv`. Bitmaps leave `n` unchanged.
     #[must_use]
     pub fn bump(&self, n: Vec3, dpdu: Vec3, dpdv: Vec3, l: &Lookup) -> Vec3 {
         let by_gradient = |mapping: Mapping, g: Vec3| match mapping {
@@ -172,6 +178,7 @@ impl Texture {
                 let (_, g) = t.value_and_gradient(q, w, true);
                 by_gradient(t.mapping, g * t.depth)
             }
+            Texture::NormalMap(m) => m.perturb(n, dpdu, dpdv, l.uv, &l.footprint),
             Texture::Bitmap(_) => n,
         }
     }
@@ -179,6 +186,9 @@ impl Texture {
     /// True if lookups depend on the footprint (image textures), so it is worth computing.
     #[must_use]
     pub fn filtered(&self) -> bool {
-        matches!(self, Texture::Bitmap(_) | Texture::HeightMap(_))
+        matches!(
+            self,
+            Texture::Bitmap(_) | Texture::HeightMap(_) | Texture::NormalMap(_)
+        )
     }
 }

@@ -19,6 +19,7 @@
 use glam::Vec3;
 
 use super::bsdf_at::{BsdfAt, eval_value, non_delta_value};
+use super::coated::{CoatLayer, Coated};
 use super::conductor::ConductorFresnel;
 use super::dielectric::Dielectric;
 use super::lambert::Lambert;
@@ -87,6 +88,9 @@ impl std::fmt::Debug for Bsdf {
             _ => None,
         }) {
             d.field("conductor", &c);
+        }
+        if let Some(c) = self.coat() {
+            d.field("coat_ior", &c.ior);
         }
         d.finish()
     }
@@ -211,6 +215,49 @@ impl Bsdf {
         Self::with_parts(self.tint, self.parts)
     }
 
+    /// The same BSDF as a coated material ([`Coated`]): a smooth clear coat of relative index
+    /// `ior` over a Lambertian base of this BSDF's colour. The diffuse part becomes the base and
+    /// the mirror part the coat's Fresnel reflection, both of weight 1 (the two layers add, they
+    /// are not a convex mixture), and the dielectric part is left at weight 0. `None` changes
+    /// nothing. The scene checks exclude the mirror, dielectric, roughness, conductor and Phong
+    /// parameters beside a coat, so nothing else of the material is lost.
+    #[must_use]
+    pub fn with_coat(self, ior: Option<f32>) -> Self {
+        let Some(ior) = ior else { return self };
+        let coat = Coated::new(ior);
+        let mut parts = self.parts;
+        parts[0] = Part::new(
+            1.0,
+            Lobe::Coated {
+                coat,
+                layer: CoatLayer::Base,
+            },
+            None,
+        );
+        parts[1] = Part::new(
+            1.0,
+            Lobe::Coated {
+                coat,
+                layer: CoatLayer::Coat,
+            },
+            None,
+        );
+        parts[2].weight = 0.0;
+        Self::with_parts(self.tint, parts)
+    }
+
+    /// The clear coat of a coated material, if it is one.
+    #[must_use]
+    pub fn coat(&self) -> Option<Coated> {
+        self.parts
+            .iter()
+            .flat_map(Part::lobes)
+            .find_map(|l| match l {
+                Lobe::Coated { coat, .. } => Some(*coat),
+                _ => None,
+            })
+    }
+
     /// The microfacet distribution of the rough parts, if any.
     #[must_use]
     pub fn distribution(&self) -> Option<Ggx> {
@@ -273,7 +320,7 @@ impl Bsdf {
             .iter()
             .filter(|p| p.weight > 0.0)
             .flat_map(Part::lobes)
-            .all(|l| !l.flags().contains(LobeFlags::GLOSSY) || l.is_black(self.tint))
+            .all(|l| l.is_flat(self.tint))
     }
 
     /// True if the BSDF has mirror or dielectric parts.
@@ -283,14 +330,16 @@ impl Bsdf {
         self.flags().is_delta()
     }
 
-    /// The total weight of the delta parts (mirror and dielectric): the share of the light
-    /// that can be focused, by which caustic photons are aimed at an object.
+    /// The total weight of the delta parts (mirror and dielectric; a coat counts with its mean
+    /// reflectance, [`super::Lobe::focusing_fraction`]): the share of the light that can be
+    /// focused, by which caustic photons are aimed at an object.
     #[inline]
     #[must_use]
     pub fn delta_share(&self) -> f32 {
         let mut s = 0.0f32;
         for p in self.parts.iter().filter(|p| p.is_delta()) {
-            s += p.weight;
+            // × 1 (exactly) for mirrors and dielectrics.
+            s += p.weight * p.lobes().next().map_or(1.0, Lobe::focusing_fraction);
         }
         s
     }

@@ -5,6 +5,7 @@
 
 use glam::Vec3;
 
+use super::coated::{CoatLayer, Coated};
 use super::dielectric::{DeltaWeights, Dielectric, FresnelSplit};
 use super::lambert::Lambert;
 use super::optics::fresnel_dielectric;
@@ -40,6 +41,15 @@ pub enum Lobe {
     },
     /// GGX microfacet dielectric ([`RoughDielectric`]): glossy reflection and transmission.
     RoughDielectric(RoughDielectric),
+    /// One layer of a diffuse base under a smooth clear coat ([`Coated`]): the coat's Fresnel
+    /// mirror (delta) or the base seen through it (diffuse); a coated material has one part of
+    /// each.
+    Coated {
+        /// The coat and its diffuse reflectances.
+        coat: Coated,
+        /// Which layer this lobe is.
+        layer: CoatLayer,
+    },
 }
 
 /// What a lobe works out once per outgoing direction and reuses while the mixture weighs and
@@ -70,6 +80,14 @@ impl Lobe {
             Lobe::RoughDielectric(_) => LobeFlags::GLOSSY
                 .union(LobeFlags::REFLECTION)
                 .union(LobeFlags::TRANSMISSION),
+            Lobe::Coated {
+                layer: CoatLayer::Coat,
+                ..
+            } => Coated::COAT_FLAGS,
+            Lobe::Coated {
+                layer: CoatLayer::Base,
+                ..
+            } => Coated::BASE_FLAGS,
         }
     }
 
@@ -81,7 +99,58 @@ impl Lobe {
             Lobe::Lambert(_) | Lobe::SpecularReflection(_) => tint == Vec3::ZERO,
             Lobe::Phong(p) => p.specular == Vec3::ZERO,
             Lobe::RoughConductor { tinted, .. } => *tinted && tint == Vec3::ZERO,
+            Lobe::Coated { layer, .. } => *layer == CoatLayer::Base && tint == Vec3::ZERO,
             Lobe::SpecularConductor(_) | Lobe::Dielectric(_) | Lobe::RoughDielectric(_) => false,
+        }
+    }
+
+    /// True if the lobe's non-delta value, where it has one, is the same for every incident
+    /// direction above the surface (Lambert), or it has none (delta lobes), or it is black with
+    /// this tint: what lets a photon map's irradiance stand in for a density estimate
+    /// ([`super::Bsdf::is_diffuse_only`]).
+    #[inline]
+    #[must_use]
+    pub fn is_flat(&self, tint: Vec3) -> bool {
+        match self {
+            Lobe::Lambert(_)
+            | Lobe::SpecularReflection(_)
+            | Lobe::SpecularConductor(_)
+            | Lobe::Dielectric(_) => true,
+            Lobe::Coated {
+                layer: CoatLayer::Coat,
+                ..
+            } => true,
+            // The base's value follows the coat's transmittance 1 − F(θᵢ).
+            Lobe::Coated {
+                layer: CoatLayer::Base,
+                ..
+            }
+            | Lobe::Phong(_)
+            | Lobe::RoughConductor { .. }
+            | Lobe::RoughDielectric(_) => self.is_black(tint),
+        }
+    }
+
+    /// The fraction of a delta part's weight that can focus light (by which caustic photons are
+    /// aimed at an object): 1 for mirrors and dielectrics, the coat's mean reflectance
+    /// `F_dr,ext` for a coat; 0 for non-delta lobes.
+    #[inline]
+    #[must_use]
+    pub fn focusing_fraction(&self) -> f32 {
+        match self {
+            Lobe::SpecularReflection(_) | Lobe::SpecularConductor(_) | Lobe::Dielectric(_) => 1.0,
+            Lobe::Coated {
+                coat,
+                layer: CoatLayer::Coat,
+            } => coat.external_reflectance(),
+            Lobe::Coated {
+                layer: CoatLayer::Base,
+                ..
+            }
+            | Lobe::Lambert(_)
+            | Lobe::Phong(_)
+            | Lobe::RoughConductor { .. }
+            | Lobe::RoughDielectric(_) => 0.0,
         }
     }
 
@@ -95,7 +164,8 @@ impl Lobe {
             | Lobe::Phong(_)
             | Lobe::SpecularReflection(_)
             | Lobe::SpecularConductor(_)
-            | Lobe::RoughConductor { .. } => false,
+            | Lobe::RoughConductor { .. }
+            | Lobe::Coated { .. } => false,
             Lobe::Dielectric(_) | Lobe::RoughDielectric(_) => true,
         }
     }
@@ -112,6 +182,7 @@ impl Lobe {
             Lobe::RoughDielectric(d) => {
                 Prepared::Reflectance(fresnel_dielectric(wo.dot(fr.ns), 1.0 / d.eta(fr.entering)))
             }
+            Lobe::Coated { coat, .. } => Prepared::Reflectance(coat.fresnel_at(wo, fr)),
         }
     }
 
@@ -134,8 +205,14 @@ impl Lobe {
                 }
             }
             (Lobe::RoughDielectric(_), Prepared::Reflectance(f)) => f + (1.0 - f) * rho,
+            (Lobe::Coated { coat, layer }, Prepared::Reflectance(f)) => {
+                coat.albedo(*layer, *f, rho)
+            }
             (
-                Lobe::SpecularConductor(_) | Lobe::RoughConductor { .. } | Lobe::RoughDielectric(_),
+                Lobe::SpecularConductor(_)
+                | Lobe::RoughConductor { .. }
+                | Lobe::RoughDielectric(_)
+                | Lobe::Coated { .. },
                 Prepared::Nothing | Prepared::Fresnel(_),
             ) => 0.0,
         }
@@ -165,6 +242,14 @@ impl Lobe {
                 if *tinted { f * tint } else { f }
             }
             Lobe::RoughDielectric(d) => d.f(wo, wi, fr, mode, tint),
+            Lobe::Coated {
+                coat,
+                layer: CoatLayer::Base,
+            } => coat.base_f(tint, wo, wi, fr.ns),
+            Lobe::Coated {
+                layer: CoatLayer::Coat,
+                ..
+            } => Vec3::ZERO,
         }
     }
 
@@ -180,6 +265,14 @@ impl Lobe {
             Lobe::SpecularConductor(_) => 0.0,
             Lobe::RoughConductor { lobe, .. } => share * lobe.pdf(wo, wi, fr),
             Lobe::RoughDielectric(d) => share * d.pdf(wo, wi, fr, tint),
+            Lobe::Coated {
+                layer: CoatLayer::Base,
+                ..
+            } => Lambert.scaled_pdf(share, wi, fr),
+            Lobe::Coated {
+                layer: CoatLayer::Coat,
+                ..
+            } => 0.0,
         }
     }
 
@@ -200,7 +293,17 @@ impl Lobe {
         match self {
             Lobe::Lambert(l) => Some(l.sample(u, fr)),
             Lobe::Phong(p) => Some(p.sample(wo, u, fr)),
-            Lobe::SpecularReflection(_) | Lobe::SpecularConductor(_) | Lobe::Dielectric(_) => None,
+            Lobe::SpecularReflection(_)
+            | Lobe::SpecularConductor(_)
+            | Lobe::Dielectric(_)
+            | Lobe::Coated {
+                layer: CoatLayer::Coat,
+                ..
+            } => None,
+            Lobe::Coated {
+                layer: CoatLayer::Base,
+                ..
+            } => Some(Lambert.sample(u, fr)),
             Lobe::RoughConductor { lobe, .. } => lobe.sample_direction(wo, u, fr),
             Lobe::RoughDielectric(d) => d.sample_direction(wo, v, u, fr, tint),
         }
@@ -228,9 +331,27 @@ impl Lobe {
                 Lobe::Lambert(_)
                 | Lobe::Phong(_)
                 | Lobe::RoughConductor { .. }
-                | Lobe::RoughDielectric(_),
+                | Lobe::RoughDielectric(_)
+                | Lobe::Coated {
+                    layer: CoatLayer::Base,
+                    ..
+                },
                 _,
             ) => None,
+            (
+                Lobe::Coated {
+                    coat,
+                    layer: CoatLayer::Coat,
+                },
+                Prepared::Reflectance(f),
+            ) => coat.sample_coat(*f, wo, fr, mode, weight, prob),
+            (
+                Lobe::Coated {
+                    coat,
+                    layer: CoatLayer::Coat,
+                },
+                Prepared::Nothing | Prepared::Fresnel(_),
+            ) => coat.sample_coat(coat.fresnel_at(wo, fr), wo, fr, mode, weight, prob),
             (Lobe::SpecularReflection(s), _) => s.sample(wo, fr, mode, weight, prob, tint),
             (Lobe::SpecularConductor(s), _) => s.sample(wo, fr, mode, weight, prob),
             (Lobe::Dielectric(d), Prepared::Fresnel(split)) => {
@@ -257,8 +378,19 @@ impl Lobe {
             Lobe::Lambert(_)
             | Lobe::Phong(_)
             | Lobe::RoughConductor { .. }
-            | Lobe::RoughDielectric(_) => DeltaWeights {
+            | Lobe::RoughDielectric(_)
+            | Lobe::Coated {
+                layer: CoatLayer::Base,
+                ..
+            } => DeltaWeights {
                 reflect: Vec3::ZERO,
+                refract: None,
+            },
+            Lobe::Coated {
+                coat,
+                layer: CoatLayer::Coat,
+            } => DeltaWeights {
+                reflect: Vec3::splat(coat.fresnel_at(wo, fr) * weight),
                 refract: None,
             },
             Lobe::SpecularReflection(_) => DeltaWeights {
@@ -290,7 +422,8 @@ impl Lobe {
             | Lobe::Phong(_)
             | Lobe::SpecularReflection(_)
             | Lobe::SpecularConductor(_)
-            | Lobe::RoughConductor { .. } => Vec3::ZERO,
+            | Lobe::RoughConductor { .. }
+            | Lobe::Coated { .. } => Vec3::ZERO,
             Lobe::Dielectric(d) => d.straight_transmittance(weight, tint, cos, entering),
             Lobe::RoughDielectric(r) => {
                 Dielectric { ior: r.ior }.straight_transmittance(weight, tint, cos, entering)
@@ -307,7 +440,8 @@ impl Lobe {
             | Lobe::Phong(_)
             | Lobe::SpecularReflection(_)
             | Lobe::SpecularConductor(_)
-            | Lobe::RoughConductor { .. } => None,
+            | Lobe::RoughConductor { .. }
+            | Lobe::Coated { .. } => None,
             Lobe::Dielectric(d) => Some(d.ior),
             Lobe::RoughDielectric(r) => Some(r.ior),
         }

@@ -4,6 +4,7 @@
 pub mod absorption;
 pub mod bsdf;
 pub mod bsdf_at;
+pub mod coated;
 pub mod conductor;
 pub mod dielectric;
 pub mod lambert;

@@ -1,4 +1,5 @@
-//! Textures: mipmapped bitmaps, height-map bump mapping, seeded noise, marble and water ripples.
+//! Textures: mipmapped bitmaps, height-map bump mapping, tangent-space normal maps, seeded noise,
+//! marble and water ripples.
 //!
 //! Self-contained building blocks for materials to call; nothing here allocates on lookup.
 //!
@@ -18,6 +19,7 @@ pub mod limits;
 pub mod marble;
 pub mod mipmap;
 pub mod noise;
+pub mod normal_map;
 pub mod ripple;
 
 pub use bitmap::BitmapTexture;
@@ -27,4 +29,5 @@ pub use footprint::{Footprint, lookup_anisotropic};
 pub use marble::Marble;
 pub use mipmap::{GreyMipMap, MipMap, Texel, srgb_to_linear};
 pub use noise::Noise;
+pub use normal_map::NormalMap;
 pub use ripple::Ripples;

@@ -71,6 +71,7 @@ fn committed_pngs_are_what_the_generator_makes() {
     check_rgb("hardwood.png", &images::hardwood());
     check_grey("tiles_height.png", &images::tiles_height());
     check_rgb("tiles_color.png", &images::tiles_color());
+    check_rgb("tiles_normal.png", &images::tiles_normal());
     check_grey("ramp_height.png", &images::ramp_height());
     eprintln!("generated and compared 4 images in {:?}", t.elapsed());
 }

@@ -26,6 +26,7 @@ mod light_transport;
 mod lights;
 mod models;
 mod mutated_scenes;
+mod normal_maps;
 mod passes;
 mod path_tracer;
 mod photon_map;

@@ -18,7 +18,9 @@ pub fn asset_files(scene: &SceneFile, base_dir: &Path) -> BTreeSet<PathBuf> {
     let mut files = BTreeSet::new();
     for texture in scene.textures.values() {
         match texture {
-            TextureSpec::Bitmap { file, .. } | TextureSpec::HeightMap { file, .. } => {
+            TextureSpec::Bitmap { file, .. }
+            | TextureSpec::HeightMap { file, .. }
+            | TextureSpec::NormalMap { file, .. } => {
                 files.insert(base_dir.join(file));
             }
             TextureSpec::Marble { .. } | TextureSpec::Noise { .. } | TextureSpec::Ripple { .. } => {

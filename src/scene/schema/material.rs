@@ -38,6 +38,10 @@ pub struct MaterialSpec {
     /// marble with a `depth`).
     #[serde(default)]
     pub bump: Option<String>,
+    /// Name of a `NormalMap` texture whose tangent-space normals replace the shading normal
+    /// (an alternative to `bump`; the two cannot both be set).
+    #[serde(default)]
+    pub normal_map: Option<String>,
     /// Microfacet roughness of the mirror and dielectric parts, in [0, 1]: `r`, or `(r_x, r_y)`
     /// along the shading frame's two tangents (anisotropic), or the name of a colour texture
     /// whose mean channel (clamped to [0, 1]) is the isotropic roughness at each hit. GGX with
@@ -56,6 +60,23 @@ pub struct MaterialSpec {
     /// `(color: (r, g, b), depth: d)` with colour in (0, 1] and `d` in metres.
     #[serde(default)]
     pub absorption: Option<AbsorptionSpec>,
+    /// A smooth clear coat over the diffuse `color` (a glazed tub, plastic, varnish):
+    /// `coat: (ior: 1.5)`. The coat reflects its Fresnel reflectance as a mirror and the base
+    /// is seen through it (Weidlich & Wilkie 2007, docs/material.md). Not combined with
+    /// `reflect`, `transmit`, `roughness`, `conductor` or `specular`; a rough coat is not
+    /// implemented.
+    #[serde(default)]
+    pub coat: Option<CoatSpec>,
+}
+
+/// A smooth dielectric clear coat over a diffuse base.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CoatSpec {
+    /// The coat's index of refraction relative to the outside (> 0; 1.5 for a glaze or
+    /// acrylic, 1.33 for a film of water).
+    #[serde(default = "default_ior")]
+    pub ior: f32,
 }
 
 /// A microfacet roughness: isotropic, or one value per tangent axis.
@@ -270,6 +291,23 @@ pub enum TextureSpec {
         #[serde(default)]
         mapping: Mapping,
     },
+    /// A tangent-space normal map (RGB: x right, y up the image, z out of the surface; 8-bit 128
+    /// is 0), for a material's `normal_map`.
+    NormalMap {
+        /// Image file, relative to the scene file (read as linear data, never sRGB).
+        file: String,
+        /// Repeats over the uv square, per axis (> 0).
+        #[serde(default = "unit_size")]
+        #[serde(deserialize_with = "exact_floats::<_, 2>")]
+        tile: [f32; 2],
+        /// Scale of the normals' tangential part (finite, ≥ 0; 0 flattens the map, 1 is as
+        /// drawn).
+        #[serde(default = "one")]
+        strength: f32,
+        /// The green channel points down the image (maps made for DirectX).
+        #[serde(default)]
+        flip_y: bool,
+    },
     /// Circular water ripples over the uv square, a bump source: the height is
     /// `amplitude · (1 + decay·r) · e^(−decay·r) · cos(frequency · r)` summed over the centres.
     Ripple {
@@ -306,6 +344,7 @@ impl TextureSpec {
             TextureSpec::Marble { .. } => "Marble",
             TextureSpec::Noise { .. } => "Noise",
             TextureSpec::Ripple { .. } => "Ripple",
+            TextureSpec::NormalMap { .. } => "NormalMap",
         }
     }
 
@@ -321,7 +360,16 @@ impl TextureSpec {
     /// True if the texture can perturb normals (is a height source).
     #[must_use]
     pub fn gives_bump(&self) -> bool {
-        !matches!(self, TextureSpec::Bitmap { .. })
+        !matches!(
+            self,
+            TextureSpec::Bitmap { .. } | TextureSpec::NormalMap { .. }
+        )
+    }
+
+    /// True if the texture is a tangent-space normal map.
+    #[must_use]
+    pub fn gives_normals(&self) -> bool {
+        matches!(self, TextureSpec::NormalMap { .. })
     }
 }
 

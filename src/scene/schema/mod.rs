@@ -18,8 +18,8 @@ mod values;
 
 pub use light::{EmissionSpec, LightSpec};
 pub use material::{
-    AbsorptionSpec, CONDUCTOR_PRESETS, ColorAtDepth, ColorSpec, ConductorSpec, ConductorTint,
-    Mapping, MaterialSpec, RoughnessSpec, TextureSpec,
+    AbsorptionSpec, CONDUCTOR_PRESETS, CoatSpec, ColorAtDepth, ColorSpec, ConductorSpec,
+    ConductorTint, Mapping, MaterialSpec, RoughnessSpec, TextureSpec,
 };
 pub use node::{NodeSpec, TransformStep};
 pub use values::ScaleSpec;

@@ -18,6 +18,18 @@ impl<'a> Validator<'a> {
         if let Some(name) = &m.bump {
             self.texture_ref(&format!("{path}.bump"), name, TextureUse::Bump);
         }
+        if let Some(name) = &m.normal_map {
+            self.texture_ref(&format!("{path}.normal_map"), name, TextureUse::Normal);
+            if m.bump.is_some() {
+                self.out.push(
+                    Diagnostic::error(
+                        format!("{path}.normal_map"),
+                        "`normal_map` and `bump` cannot both be set: each replaces the shading normal",
+                    )
+                    .with_help("keep one: `bump` for a height source, or `normal_map` for a NormalMap texture"),
+                );
+            }
+        }
         self.unit_rgb(&format!("{path}.specular"), m.specular, "specular");
         if self.finite(&format!("{path}.shininess"), m.shininess) && m.shininess < 0.0 {
             self.err(
@@ -63,6 +75,7 @@ impl<'a> Validator<'a> {
             );
         }
         self.microfacets(path, m);
+        self.coat(path, m);
         let Some(color) = color else { return };
         let gains = (0..3).any(|i| color[i] + m.specular[i] > 1.0 + 1e-6);
         if m.diffuse.unwrap_or(if any_given { 0.0 } else { 1.0 }) > 0.0
@@ -167,6 +180,69 @@ impl<'a> Validator<'a> {
         }
     }
 
+    /// A coat's index is finite and > 0, and the coat is the material's only specular part: the
+    /// mirror, the dielectric, roughness, a conductor and the Phong highlight are refused beside
+    /// it (each by the field that is set, with what to do instead).
+    fn coat(&mut self, path: &str, m: &'a MaterialSpec) {
+        let Some(coat) = &m.coat else { return };
+        let p = format!("{path}.coat.ior");
+        if self.finite(&p, coat.ior) && coat.ior <= 0.0 {
+            self.out.push(
+                Diagnostic::error(
+                    &p,
+                    format!(
+                        "the coat's index of refraction must be greater than 0, found {}",
+                        coat.ior
+                    ),
+                )
+                .with_help("typical values: 1.5 for a glaze, acrylic or varnish, 1.33 for water"),
+            );
+        }
+        let rough = match &m.roughness {
+            crate::scene::schema::RoughnessSpec::Isotropic(r) => *r != 0.0,
+            crate::scene::schema::RoughnessSpec::Anisotropic([x, y]) => *x != 0.0 || *y != 0.0,
+            crate::scene::schema::RoughnessSpec::Texture(_) => true,
+        };
+        let clashes = [
+            (
+                "reflect",
+                m.reflect.is_some(),
+                "the coat is the material's mirror (its Fresnel reflection); remove `reflect`",
+            ),
+            (
+                "transmit",
+                m.transmit.is_some(),
+                "a coated surface is opaque; for glass use `transmit` without `coat`",
+            ),
+            (
+                "roughness",
+                rough,
+                "a rough (GGX) coat is not implemented; remove `roughness` for a smooth coat",
+            ),
+            (
+                "conductor",
+                m.conductor.is_some(),
+                "a coated metal is not implemented; use `coat` over a diffuse `color`, or `conductor` without `coat`",
+            ),
+            (
+                "specular",
+                m.specular.iter().any(|s| *s != 0.0),
+                "the coat gives the highlight (a sharp Fresnel reflection); remove `specular`",
+            ),
+        ];
+        for (field, set, help) in clashes {
+            if set {
+                self.out.push(
+                    Diagnostic::error(
+                        format!("{path}.{field}"),
+                        format!("`{field}` cannot be combined with `coat`: a coated material is a diffuse base under a smooth clear coat"),
+                    )
+                    .with_help(help),
+                );
+            }
+        }
+    }
+
     pub(super) fn texture(&mut self, path: &str, t: &TextureSpec) {
         let tile = |v: &mut Self, tile: &[f32; 2]| {
             for (i, s) in tile.iter().enumerate() {
@@ -214,6 +290,24 @@ impl<'a> Validator<'a> {
                 file(self, f);
                 tile(self, t);
                 self.finite(&format!("{path}.depth"), *depth);
+            }
+            TextureSpec::NormalMap {
+                file: f,
+                tile: t,
+                strength,
+                ..
+            } => {
+                file(self, f);
+                tile(self, t);
+                let p = format!("{path}.strength");
+                if self.finite(&p, *strength) && *strength < 0.0 {
+                    self.out.push(
+                        Diagnostic::error(&p, format!("must not be negative, found {strength}"))
+                            .with_help(
+                                "0 flattens the map, 1 is as drawn, 2 doubles the tilt's tangent",
+                            ),
+                    );
+                }
             }
             TextureSpec::Marble {
                 base,
@@ -323,6 +417,24 @@ impl<'a> Validator<'a> {
         };
         self.used_textures.insert(name);
         match usage {
+            TextureUse::Color | TextureUse::Bump if t.gives_normals() => self.out.push(
+                Diagnostic::error(
+                    path,
+                    format!("texture `{name}` is a NormalMap, which gives normals, not {}", if usage == TextureUse::Color { "colours" } else { "heights" }),
+                )
+                .with_help(format!("use it as `normal_map: \"{name}\"`")),
+            ),
+            TextureUse::Normal if !t.gives_normals() => self.out.push(
+                Diagnostic::error(
+                    path,
+                    format!("texture `{name}` is a {}, not a NormalMap", t.kind()),
+                )
+                .with_help(if t.gives_bump() {
+                    format!("use a height source as `bump: \"{name}\"`, or define a `NormalMap(file: \"…\")` texture")
+                } else {
+                    "define a `NormalMap(file: \"…\")` texture and name it here".to_string()
+                }),
+            ),
             TextureUse::Color if !t.gives_color() => self.out.push(
                 Diagnostic::error(
                     path,

@@ -54,6 +54,7 @@ pub const MAX_RIPPLE_CENTERS: usize = 256;
 enum TextureUse {
     Color,
     Bump,
+    Normal,
 }
 
 /// Checks a scene and returns all errors and warnings (errors first keep the file order).
