@@ -204,21 +204,11 @@ impl<'a> PhotonMapper<'a> {
                 cx.observer.note(node, "max depth reached");
                 continue;
             }
-            let (bsdf, fr) = (v.bsdf, v.frame);
+            let (bsdf, fr) = (&v.bsdf, v.frame);
             if bsdf.has_local() {
                 let full = beta.max_element() >= FINAL_GATHER_MIN_WEIGHT;
-                let (c, note) = self.local(
-                    maps,
-                    (&v, b.medium),
-                    &sp,
-                    &fr,
-                    &bsdf,
-                    wo,
-                    full,
-                    cx.sampler,
-                    cx.counters,
-                    O::ACTIVE,
-                );
+                let (c, note) =
+                    self.local(maps, &v, b.medium, full, cx.sampler, cx.counters, O::ACTIVE);
                 gathered = beta * c.total();
                 l.add_scaled(&c, beta);
                 if let Some(text) = note {
@@ -299,23 +289,21 @@ impl<'a> PhotonMapper<'a> {
     }
 
     /// The radiance a camera-path vertex with a diffuse part sends towards `wo`: direct light,
-    /// caustics and indirect light. `vertex` is the hit and the medium the camera ray reached
-    /// it through (where final-gather rays start). With `describe`, also a line for
-    /// `debug-pixel` naming each estimate's photon count and radius.
+    /// caustics and indirect light, at the hit `v` reached through `medium` (where final-gather
+    /// rays start). With `describe`, also a line for `debug-pixel` naming each estimate's photon
+    /// count and radius.
     #[allow(clippy::too_many_arguments)]
     fn local(
         &self,
         maps: &PhotonMaps,
-        vertex: (&SurfaceHit, Medium),
-        sp: &SurfacePoint,
-        fr: &ShadingFrame,
-        bsdf: &Bsdf,
-        wo: Vec3,
+        v: &SurfaceHit,
+        medium: Medium,
         full: bool,
         sampler: &mut Sampler,
         counters: &mut Counters,
         describe: bool,
     ) -> (Radiance, Option<String>) {
+        let (sp, fr, bsdf, wo) = (&v.sp, &v.frame, &v.bsdf, v.wo);
         let direct = self.direct(sp, fr, bsdf, wo, sampler, counters);
         if !full && let Some(l) = cached_radiance(maps, sp, fr, bsdf, wo, counters) {
             let note = describe.then(|| {
@@ -346,7 +334,7 @@ impl<'a> PhotonMapper<'a> {
         let gather = self.final_gather;
         let (indirect, global) = if gather > 0 {
             (
-                self.final_gather(maps, vertex, sp, fr, bsdf, wo, gather, sampler, counters),
+                self.final_gather(maps, v, medium, gather, sampler, counters),
                 None,
             )
         } else {
@@ -420,29 +408,28 @@ impl<'a> PhotonMapper<'a> {
     /// where each lands, its direct light, caustics and global-map radiance (following up to
     /// four mirror or glass bounces first; a ray shorter than [`SHORT_GATHER`] times the
     /// landing estimate's radius takes one more BSDF-sampled bounce instead of reading it).
-    /// Each ray carries its absorbing [`Medium`], starting from the vertex's (`vertex`: the hit
-    /// and the medium the camera ray arrived in) and changing where it scatters, as camera
-    /// paths do: what it brings back keeps `exp(−σ t)` of every segment inside.
-    #[allow(clippy::too_many_arguments)]
+    /// Each ray carries its absorbing [`Medium`], starting from `medium` (the one the camera ray
+    /// reached the hit `v` through) and changing where it scatters, as camera paths do: what
+    /// it brings back keeps `exp(−σ t)` of every segment inside.
     fn final_gather(
         &self,
         maps: &PhotonMaps,
-        vertex: (&SurfaceHit, Medium),
-        sp: &SurfacePoint,
-        fr: &ShadingFrame,
-        bsdf: &Bsdf,
-        wo: Vec3,
+        v: &SurfaceHit,
+        medium: Medium,
         n: u32,
         sampler: &mut Sampler,
         counters: &mut Counters,
     ) -> Vec3 {
         let scene = self.scene;
+        let (sp, fr) = (&v.sp, &v.frame);
+        // The mixture worked out once for all `n` rays leaving this vertex.
+        let at = v.bsdf.at(v.wo, fr);
         let mut sum = Vec3::ZERO;
         for _ in 0..n {
             let u_lobe = sampler.defer_1d();
             let u_dir = sampler.next_2d();
-            let u_lobe = bsdf.lobe_number(|| sampler.get_1d(u_lobe));
-            let Some(s) = bsdf.sample(wo, u_lobe, u_dir, fr, TransportMode::Radiance) else {
+            let u_lobe = at.lobe_number(|| sampler.get_1d(u_lobe));
+            let Some(s) = at.sample(u_lobe, u_dir, TransportMode::Radiance) else {
                 continue;
             };
             if s.delta {
@@ -450,7 +437,7 @@ impl<'a> PhotonMapper<'a> {
             }
             let mut beta = s.weight;
             let mut ray = Ray::new(offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi), s.wi);
-            let mut medium = vertex.1.after(scene, vertex.0, s.wi);
+            let mut medium = medium.after(scene, v, s.wi);
             let (mut specular, mut shortcuts) = (0u32, 0u32);
             loop {
                 counters.rays += 1;
