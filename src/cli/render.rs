@@ -481,13 +481,19 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     {
         let t = &pr.totals;
         eprintln!(
-            "photons: {} passes of fresh maps, {} photons emitted and {} stored in all ({:.2} s), {} estimates; the last pass read {:.3} of each k-nearest radius",
+            "photons: {} passes of fresh maps, {} photons emitted and {} stored in all ({:.2} s), {} estimates; the last pass read {:.3} of each initial radius{}",
             t.passes,
             t.emitted,
             t.stored,
             t.time.as_secs_f64(),
             st.photon_estimates,
-            pr.last_shrink
+            pr.last_shrink,
+            match pr.caustic_radius {
+                Some((typical, empty)) => format!(
+                    " (caustic map: R = {typical:.4} for a typical photon, {empty:.4} where the pilot map found none)"
+                ),
+                None => String::new(),
+            }
         );
     } else if st.photon_estimates > 0 && !args.quiet {
         eprintln!(

@@ -323,6 +323,10 @@ impl<'a> RenderJob<'a> {
         stats.progressive = self.integrator.progressive().map(|p| ProgressiveStats {
             totals: p.totals(),
             last_shrink: p.shrink(self.done.saturating_sub(1)),
+            caustic_radius: p
+                .fields()
+                .and_then(|f| f.caustic.as_ref())
+                .map(|f| (f.typical(), f.fallback())),
         });
         let sums = std::mem::replace(&mut self.sums, PixelSums::new(0, 0));
         let parts = self

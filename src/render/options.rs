@@ -74,9 +74,12 @@ pub struct RenderStats {
 pub struct ProgressiveStats {
     /// Photon maps built, photons emitted and stored over all passes, and the time it took.
     pub totals: PassTotals,
-    /// The fraction of the k-nearest radius the last pass taken read (1 for the first pass;
-    /// it shrinks by Knaus & Zwicker's schedule).
+    /// The fraction of the initial radius `R(x)` the last pass taken read (1 for the first
+    /// pass; it shrinks by Knaus & Zwicker's schedule).
     pub last_shrink: f32,
+    /// The caustic map's initial radius field, if any: its typical `R` (median over the pilot
+    /// photons) and its value where the pilot map found no photon (scene units).
+    pub caustic_radius: Option<(f32, f32)>,
 }
 
 /// A rendered film with its statistics.

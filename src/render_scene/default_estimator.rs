@@ -32,7 +32,8 @@ pub const MIN_PASS_PHOTONS: u32 = 1_000;
 /// Most caustic photons per pass (large images: photon tracing is kept a bounded cost and the
 /// passes frequent, so the radius keeps shrinking).
 pub const MAX_PASS_PHOTONS: u32 = 100_000;
-/// Nearest photons per caustic estimate of the default estimator (the best row).
+/// Nearest photons whose distance sets the caustic map's initial radius `R(x)` (the k of the
+/// pilot map's k-nearest radius, `integrators::photon::radius_field`; the best row).
 pub const PASS_CAUSTIC_GATHER: u32 = 20;
 
 /// The photon budget of one pass of the default estimator.
@@ -40,7 +41,8 @@ pub const PASS_CAUSTIC_GATHER: u32 = 20;
 pub struct PassPhotons {
     /// Caustic photons emitted per pass.
     pub caustic: u32,
-    /// Nearest photons per caustic estimate (k of the first pass; later passes shrink it).
+    /// Nearest photons that set the initial radius `R(x)` (about that many photons per disc at
+    /// the first pass, where the pilot map's density holds; later passes shrink the disc).
     pub caustic_gather: u32,
     /// Photons emitted per pass for the global map: 0, no global map. The path tracer carries
     /// all diffuse interreflection itself, without the global map's blur (the local bias of the

@@ -87,13 +87,19 @@ fn ppm_error_under_water_falls_across_4_16_64_256_passes_towards_the_analytic_ra
         eprintln!("{integrator}: relative RMS error after 4, 16, 64, 256 passes: {rms_at:?}");
         // Noise alone would halve at each step (√4); the schedule's growing per-pass noise
         // takes some of that back (the RMSE of the mean falls as N^(−α/2): 4^(−1/3) ≈ 0.63 per
-        // step for α = 2/3), so ask for a clear fall at every step, and a small final error.
+        // step for α = 2/3, 64^(−1/3) = 0.25 over the three steps). The RMS over 64 points is
+        // itself uncertain by about 1/√128 ≈ 9 %, so ask for a fall at every step and for most
+        // of the predicted fall over the whole range.
         for w in rms_at.windows(2) {
             assert!(
-                w[1] < 0.8 * w[0],
+                w[1] < 0.9 * w[0],
                 "{integrator}: error after 4, 16, 64, 256 passes: {rms_at:?}"
             );
         }
+        assert!(
+            rms_at[3] < 0.45 * rms_at[0],
+            "{integrator}: error after 4, 16, 64, 256 passes: {rms_at:?}"
+        );
         assert!(rms_at[3] < 0.05, "{integrator}: final error {rms_at:?}");
         let mean: f64 = sums.iter().sum::<f64>() / 256.0;
         let exact: f64 = points.iter().map(|(_, e)| e).sum();

@@ -36,11 +36,13 @@
 //! cuts searches short the estimate does not depend on it (issue 29, estimate-radius-floor).
 
 use std::cell::RefCell;
+use std::sync::Arc;
 
 use glam::Vec3;
 
+use super::radius_field::RadiusField;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
-use crate::spatial::{HasPosition, KdTree, KnnHeap, Photon};
+use crate::spatial::{HasPosition, HashGrid, KdTree, KnnHeap, Photon};
 
 /// The radius given to an estimate whose k nearest photons all lie at one point (a zero radius),
 /// as a fraction of the map's largest radius.
@@ -87,9 +89,59 @@ pub struct PhotonMap {
     max_radius: f32,
     kernel: Kernel,
     /// Progressive passes: estimates use only the photons within this fraction of the k-nearest
-    /// radius (1: the plain k-nearest estimate).
+    /// radius (1: the plain k-nearest estimate), or of the radius field's `R(x)`.
     shrink: f32,
+    /// Progressive passes: the fixed per-pass lookup (`R(x)` from a pilot map and the pass's
+    /// photons in a hash grid) that replaces the k-nearest search.
+    pass: Option<PassLookup>,
 }
+
+/// A progressive pass's lookup ([`PhotonMap::set_pass_lookup`]): estimates read the photons
+/// within `shrink · R(x)` of `x`, found in a hash grid of the pass's photons.
+#[derive(Debug)]
+struct PassLookup {
+    field: Arc<RadiusField>,
+    /// The pass's photons in hash grids of growing cell side (each [`GRID_LEVEL_RATIO`] times
+    /// the last, from the disc diameter at the field's typical radius to its largest).
+    grids: Vec<HashGrid<Landing>>,
+}
+
+/// A photon decoded once per pass for the pass grids (each is read by many estimates): 48
+/// bytes instead of the stored 24, no octahedral or RGBE decoding per estimate.
+#[derive(Debug, Clone, Copy)]
+struct Landing {
+    position: [f32; 3],
+    /// Unit direction back towards where the photon came from (−its direction of travel).
+    wi: Vec3,
+    /// Unit geometric normal where it landed.
+    normal: Vec3,
+    /// Power per channel (W).
+    power: Vec3,
+}
+
+impl From<&Photon> for Landing {
+    #[inline]
+    fn from(ph: &Photon) -> Self {
+        Self {
+            position: ph.position().to_array(),
+            wi: -ph.direction(),
+            normal: ph.normal(),
+            power: ph.power(),
+        }
+    }
+}
+
+impl HasPosition for Landing {
+    #[inline]
+    fn position(&self) -> [f32; 3] {
+        self.position
+    }
+}
+
+/// Ratio of the cell sides of successive pass grids.
+const GRID_LEVEL_RATIO: f32 = 2.0;
+/// Most pass grids (cell sides up to 2⁹ times the finest).
+const MAX_GRID_LEVELS: usize = 10;
 
 /// One radiance estimate and how it was made (for `debug-pixel` and the summary).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -119,7 +171,54 @@ impl PhotonMap {
             max_radius,
             kernel,
             shrink: 1.0,
+            pass: None,
         }
+    }
+
+    /// Makes every later estimate a progressive pass's fixed-radius one: the photons within
+    /// `shrink · field.radius(x)` of the query `x` ([`RadiusField`]; `shrink` ∈ (0, 1] from the
+    /// radius schedule), over that disc's area. The pass's photons go into a hash grid whose
+    /// cell side is the disc's diameter at the field's typical radius, so a typical query
+    /// visits at most 8 cells. With a field that does not depend on this map's photons (a
+    /// pilot map's), each estimate is the plain density estimate over a fixed disc: its mean is
+    /// the radiance averaged over the disc (Knaus & Zwicker 2011).
+    pub fn set_pass_lookup(&mut self, shrink: f32, field: Arc<RadiusField>) {
+        self.set_shrink(shrink);
+        // Grids whose cells are the disc's diameter at the field's typical radius, then 4×, 16×
+        // … up to its largest, so that every estimate finds a grid where its disc overlaps at
+        // most 8 cells.
+        let mut grids = Vec::new();
+        let mut cell = 2.0 * self.shrink * field.typical();
+        let widest = 2.0 * self.shrink * field.fallback();
+        while grids.len() < MAX_GRID_LEVELS {
+            let landings = self.tree.items().iter().map(Landing::from).collect();
+            let Ok(grid) = HashGrid::build(landings, cell) else {
+                break;
+            };
+            grids.push(grid);
+            if cell >= widest {
+                break;
+            }
+            cell *= GRID_LEVEL_RATIO;
+        }
+        self.pass = Some(PassLookup { field, grids });
+    }
+
+    /// The distance of the k-th nearest photon to `p`, or the largest radius when fewer than k
+    /// lie within it (the radius of a plain k-nearest estimate, before the progressive shrink).
+    #[must_use]
+    pub fn knn_radius(&self, p: Vec3) -> f32 {
+        HEAP.with(|h| {
+            let mut heap = h.borrow_mut();
+            heap.set_k(self.k);
+            let max2 = self.max_radius * self.max_radius;
+            let found = self.tree.nearest(p.to_array(), max2, &mut heap);
+            if found < self.k {
+                self.max_radius
+            } else {
+                heap.max_dist2().unwrap_or(max2).sqrt()
+            }
+        })
     }
 
     /// Makes every later estimate a progressive pass's: it reads only the photons within
@@ -170,9 +269,9 @@ impl PhotonMap {
     #[must_use]
     pub fn estimate(&self, p: Vec3, wo: Vec3, fr: &ShadingFrame, bsdf: &Bsdf) -> Estimate {
         let at = bsdf.at(wo, fr);
-        self.gather(p, fr.ng, |ph, wi, cos_p| {
+        self.gather(p, fr.ng, |power, wi, cos_p| {
             let cos_s = wi.dot(fr.ns).max(0.0);
-            at.eval(wi, TransportMode::Radiance) * ph.power() * (cos_s / cos_p)
+            at.eval(wi, TransportMode::Radiance) * power * (cos_s / cos_p)
         })
     }
 
@@ -180,13 +279,16 @@ impl PhotonMap {
     /// nearest photons (the estimate's `radiance` field holds it).
     #[must_use]
     pub fn irradiance(&self, p: Vec3, n: Vec3) -> Estimate {
-        self.gather(p, n, |ph, _, _| ph.power())
+        self.gather(p, n, |power, _, _| power)
     }
 
     /// The density estimate at `p` (surface normal `ng`, on the query's side): the kernel-
     /// weighted sum of `value(photon, wi, cos θₚ)` over the accepted photons (`cos θₚ` the
     /// landing cosine, [`accept`]), over the disc's normalised area.
-    fn gather(&self, p: Vec3, ng: Vec3, value: impl Fn(&Photon, Vec3, f32) -> Vec3) -> Estimate {
+    fn gather(&self, p: Vec3, ng: Vec3, value: impl Fn(Vec3, Vec3, f32) -> Vec3) -> Estimate {
+        if let Some(pass) = &self.pass {
+            return self.gather_within(pass, p, ng, value);
+        }
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
             heap.set_k(self.k);
@@ -222,7 +324,7 @@ impl PhotonMap {
                 }
                 let ph = &photons[n.index as usize];
                 if let Some((wi, cos_g)) = accept(ph, ng) {
-                    sum += value(ph, wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r);
+                    sum += value(ph.power(), wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r);
                 }
             }
             let area = std::f32::consts::PI * r2 * self.kernel.normalisation();
@@ -233,6 +335,51 @@ impl PhotonMap {
                 cut,
             }
         })
+    }
+}
+
+impl PhotonMap {
+    /// A progressive pass's estimate at `p`: every accepted photon within `r = shrink · R(p)`,
+    /// kernel-weighted, over the disc's normalised area `π r² c`.
+    #[inline]
+    fn gather_within(
+        &self,
+        pass: &PassLookup,
+        p: Vec3,
+        ng: Vec3,
+        value: impl Fn(Vec3, Vec3, f32) -> Vec3,
+    ) -> Estimate {
+        let r = self.shrink * pass.field.radius(p);
+        let q = p.to_array();
+        let mut sum = Vec3::ZERO;
+        let mut found = 0;
+        let mut add = |ph: &Landing, dist2: f32| {
+            found += 1;
+            // The side tests of `accept`, on the decoded record.
+            if ph.normal.dot(ng) > 0.1 && ph.wi.dot(ng) > 0.0 {
+                let cos_g = ph.wi.dot(ph.normal).max(MIN_LANDING_COSINE);
+                sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), r);
+            }
+        };
+        // The finest grid whose cells are at least the disc's diameter (at most 8 cells to
+        // visit); a disc wider than the widest grid's cells is found through the kd-tree. Both
+        // find exactly the photons within r.
+        if let Some(grid) = pass.grids.iter().find(|g| g.cell_size() >= 2.0 * r) {
+            let photons = grid.items();
+            grid.within(q, r, |n| add(&photons[n.index as usize], n.dist2));
+        } else {
+            let photons = self.tree.items();
+            self.tree.within(q, r * r, |n| {
+                add(&Landing::from(&photons[n.index as usize]), n.dist2);
+            });
+        }
+        let area = std::f32::consts::PI * r * r * self.kernel.normalisation();
+        Estimate {
+            radiance: if found > 0 { sum / area } else { Vec3::ZERO },
+            found,
+            radius: r,
+            cut: false,
+        }
     }
 }
 

@@ -21,6 +21,7 @@ pub mod emit;
 pub mod estimate;
 pub mod maps;
 pub mod passes;
+pub mod radius_field;
 pub mod trace;
 
 pub use estimate::{Estimate, IrradianceCache, Kernel, PhotonMap};

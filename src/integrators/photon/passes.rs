@@ -4,12 +4,14 @@
 //! to pass as `r²ᵢ₊₁ = r²ᵢ (i + α)/(i + 1)`. Each pass's image is a density estimate whose blur
 //! (bias) and noise both vanish as passes are averaged: the mean converges to the exact image.
 //!
-//! The radius of pass `i` at a point is `sᵢ` times the distance of the k-th nearest photon of
-//! that pass's map (the largest radius when fewer are found), with `sᵢ = rᵢ/r₁` from the
-//! schedule: the first pass is the plain k-nearest estimate, and later ones shrink it (see
-//! `estimate`'s module docs for why this stays unbiased for a uniform density). The disc so
-//! follows the local photon density, sharp in a bright caustic and wide where photons are
-//! sparse, without any state shared between passes.
+//! The radius of pass `i` at a point `x` is `sᵢ·R(x)`, with `sᵢ = rᵢ/r₁` from the schedule and
+//! `R(x)` a [`RadiusField`]: the k-nearest radius of a **pilot** map, traced once per render
+//! from photon streams no pass uses (pass number [`PILOT_PASS`]), so `R` is independent of every
+//! pass's photons and each pass's estimate is a plain fixed-disc density estimate (unbiased for
+//! the disc-averaged radiance). The disc follows the photon density, sharp in a bright caustic
+//! and wide where photons are sparse, as the k-nearest radius does, while each pass answers its
+//! estimates from a hash grid of its photons (`PhotonMap::set_pass_lookup`) instead of a
+//! k-nearest search per estimate.
 //!
 //! Pass `i` is sample index `i` of every pixel, and its photons come from streams keyed by the
 //! pass, so any set of passes can be rendered anywhere, in any order, and the films merged
@@ -20,6 +22,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use super::maps::{MapScene, MapSet, PhotonMaps, build_maps_with};
+use super::radius_field::RadiusField;
 use crate::render_scene::RenderScene;
 
 /// Knaus & Zwicker's radius schedule.
@@ -41,6 +44,19 @@ impl RadiusSchedule {
         }
         r2.sqrt() as f32
     }
+}
+
+/// The pass number whose photon streams make the pilot maps of the radius fields. Sample
+/// indices are below the `u32` sample count, so no pass of a render is ever this one.
+pub const PILOT_PASS: u32 = u32::MAX;
+
+/// The radius fields of the caustic and global maps (`None`: that map has no pilot photons).
+#[derive(Debug, Clone, Default)]
+pub struct PassFields {
+    /// `R(x)` of the caustic map.
+    pub caustic: Option<Arc<RadiusField>>,
+    /// `R(x)` of the global map.
+    pub global: Option<Arc<RadiusField>>,
 }
 
 /// Totals over the passes a progressive render has traced (for its summary).
@@ -68,6 +84,8 @@ pub struct ProgressivePhotons<'a> {
     pass: Option<u32>,
     maps: PhotonMaps,
     totals: PassTotals,
+    /// The radius fields, built from the pilot maps before the first pass (`None` until then).
+    fields: Option<PassFields>,
 }
 
 impl<'a> ProgressivePhotons<'a> {
@@ -84,6 +102,7 @@ impl<'a> ProgressivePhotons<'a> {
             pass: None,
             maps: PhotonMaps::default(),
             totals: PassTotals::default(),
+            fields: None,
         }
     }
 
@@ -101,6 +120,27 @@ impl<'a> ProgressivePhotons<'a> {
             return;
         }
         let t = Instant::now();
+        let fields = match self.fields.clone() {
+            Some(f) => f,
+            None => {
+                let pilot = build_maps_with(self.scene, &self.prepared, Some(PILOT_PASS), self.set);
+                if pilot.summary.cancelled {
+                    self.pass = None;
+                    return;
+                }
+                let field = |m: &Option<super::PhotonMap>| {
+                    m.as_ref().and_then(RadiusField::from_pilot).map(Arc::new)
+                };
+                let f = PassFields {
+                    caustic: field(&pilot.caustic),
+                    global: field(&pilot.global),
+                };
+                self.totals.time += t.elapsed();
+                self.fields = Some(f.clone());
+                f
+            }
+        };
+        let t = Instant::now();
         self.maps = build_maps_with(self.scene, &self.prepared, Some(pass), self.set);
         if self.maps.summary.cancelled {
             self.pass = None;
@@ -108,11 +148,17 @@ impl<'a> ProgressivePhotons<'a> {
         }
         self.pass = Some(pass);
         let shrink = self.shrink(pass);
-        for m in [self.maps.caustic.as_mut(), self.maps.global.as_mut()]
-            .into_iter()
-            .flatten()
-        {
-            m.set_shrink(shrink);
+        for (m, field) in [
+            (self.maps.caustic.as_mut(), &fields.caustic),
+            (self.maps.global.as_mut(), &fields.global),
+        ] {
+            let Some(m) = m else { continue };
+            match field {
+                Some(f) => m.set_pass_lookup(shrink, Arc::clone(f)),
+                // No pilot photon although this pass stored some (a rare light path): the
+                // pass's own k-nearest radius, shrunk.
+                None => m.set_shrink(shrink),
+            }
         }
         let s = &self.maps.summary;
         for c in s.caustic.iter().chain(&s.global) {
@@ -129,7 +175,13 @@ impl<'a> ProgressivePhotons<'a> {
         &self.maps
     }
 
-    /// The fraction `sᵢ = rᵢ/r₁` of the k-nearest radius that pass `pass` reads.
+    /// The radius fields (after the first pass has begun).
+    #[must_use]
+    pub fn fields(&self) -> Option<&PassFields> {
+        self.fields.as_ref()
+    }
+
+    /// The fraction `sᵢ = rᵢ/r₁` of the initial radius `R(x)` that pass `pass` reads.
     #[must_use]
     pub fn shrink(&self, pass: u32) -> f32 {
         self.schedule.scale(pass)
