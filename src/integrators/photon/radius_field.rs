@@ -28,6 +28,11 @@ use crate::spatial::{HasPosition, HashGrid};
 /// Coarse cells per largest radius (the field's cell side is `max_radius / CELLS_PER_RADIUS`).
 pub const CELLS_PER_RADIUS: f32 = 2.0;
 
+/// The coarse grid's offset, in cell sides: a non-round fraction, so that axis-aligned walls at
+/// round coordinates (0 above all) do not lie on cell faces, where rounding would split a
+/// wall's photons between two cells and leave queries on it in empty ones.
+const CELL_OFFSET: [f32; 3] = [0.3719, 0.6180, 0.2113];
+
 /// One occupied cell of the field: a pilot photon's position (in the cell) and the median
 /// k-nearest radius over the cell's pilot photons.
 #[derive(Debug, Clone, Copy)]
@@ -46,7 +51,10 @@ impl HasPosition for FieldCell {
 /// `R(x)`: the initial estimate radius at every point, from a pilot map (see the module docs).
 #[derive(Debug, Clone)]
 pub struct RadiusField {
+    /// Occupied cells, keyed by position plus `offset`.
     cells: HashGrid<FieldCell>,
+    /// [`CELL_OFFSET`] in scene units.
+    offset: Vec3,
     /// `R` in cells without pilot photons: the pilot map's largest radius.
     fallback: f32,
     /// Smallest radius returned (`max_radius · MIN_RADIUS_FRACTION`: coincident photons).
@@ -77,12 +85,13 @@ impl RadiusField {
             .map(|ph| pilot.knn_radius(ph.position()).max(floor))
             .collect();
         let inv = 1.0 / side;
+        let offset = Vec3::from_array(CELL_OFFSET) * side;
         let mut keyed: Vec<([i32; 3], f32, [f32; 3])> = pilot
             .photons()
             .iter()
             .zip(&radii)
             .map(|(ph, &r)| {
-                let p = ph.position().to_array();
+                let p = (ph.position() + offset).to_array();
                 (p.map(|x| (x * inv).floor() as i32), r, p)
             })
             .collect();
@@ -101,6 +110,7 @@ impl RadiusField {
         let cells = HashGrid::build(cells, side).ok()?;
         Some(Self {
             cells,
+            offset,
             fallback: max_radius,
             floor,
             typical,
@@ -113,7 +123,7 @@ impl RadiusField {
     #[must_use]
     pub fn radius(&self, p: Vec3) -> f32 {
         let mut r = self.fallback;
-        let c = self.cells.cell_of(p.to_array());
+        let c = self.cells.cell_of((p + self.offset).to_array());
         self.cells.in_cell(c, |i| r = self.cells.items()[i].radius);
         r.max(self.floor)
     }
