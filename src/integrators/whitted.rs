@@ -96,7 +96,8 @@ impl<'a> Whitted<'a> {
         let scene = self.scene;
         cx.counters.rays += 1;
         let ray = &path.ray;
-        let it = scene.interact(ray, |t| path.cone.width_at(ray, t));
+        let mut textured = None;
+        let it = scene.interact(ray, |t| path.cone.width_at(ray, t), &mut textured);
         // Beer–Lambert absorption along this ray (exactly 1 outside media).
         let tr = path.medium.transmittance(ray, &it);
         let v = match it {
@@ -263,7 +264,8 @@ impl Whitted<'_> {
         let mut t = Vec3::ONE;
         let mut medium = start;
         for _ in 0..MAX_SHADOW_CROSSINGS {
-            let v = match scene.interact(&ray, |_| 0.0) {
+            let mut textured = None;
+            let v = match scene.interact(&ray, |_| 0.0, &mut textured) {
                 // Nothing more before the light: the last stretch, in the current medium.
                 Interaction::Escaped => {
                     return t * medium.transmittance_over(ray.dir.length() * ray.t_max);

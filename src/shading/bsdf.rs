@@ -53,6 +53,10 @@ pub struct Bsdf {
     /// present, is black): the common matte material, which [`BsdfAt`] evaluates, samples and
     /// asks densities of without walking the mixture. Derived with `uses`.
     lambert: bool,
+    /// The union of the flags of the parts of non-zero weight ([`Bsdf::flags`]), derived with
+    /// `uses` (per-vertex queries such as [`Bsdf::has_local`] read it instead of walking the
+    /// lobes).
+    flags: LobeFlags,
 }
 
 impl std::fmt::Debug for Bsdf {
@@ -161,11 +165,16 @@ impl Bsdf {
                 [Some(Lobe::Lambert(_)), Some(Lobe::Phong(p))] => p.specular == Vec3::ZERO,
                 _ => false,
             };
+        let flags = parts
+            .iter()
+            .filter(|p| p.weight > 0.0)
+            .fold(LobeFlags::NONE, |f, p| f | p.flags());
         Self {
             tint,
             parts,
             uses: parts.map(|p| p.usage()),
             lambert,
+            flags,
         }
     }
 
@@ -297,10 +306,7 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn flags(&self) -> LobeFlags {
-        self.parts
-            .iter()
-            .filter(|p| p.weight > 0.0)
-            .fold(LobeFlags::NONE, |f, p| f | p.flags())
+        self.flags
     }
 
     /// True if the BSDF has a non-delta (diffuse or glossy) part that direct lighting sees.

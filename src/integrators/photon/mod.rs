@@ -175,7 +175,8 @@ impl<'a> PhotonMapper<'a> {
             cx.counters.rays += 1;
             let node = cx.observer.ray(depth, b.kind, &ray, beta, b.parent);
             let mut gathered = Vec3::ZERO;
-            let it = scene.interact(&ray, |t| b.cone.width_at(&ray, t));
+            let mut textured = None;
+            let it = scene.interact(&ray, |t| b.cone.width_at(&ray, t), &mut textured);
             // Beer–Lambert absorption along the segment just travelled (1 outside media).
             let beta = beta * b.medium.transmittance(&ray, &it);
             let v = match it {
@@ -441,7 +442,8 @@ impl<'a> PhotonMapper<'a> {
             let (mut specular, mut shortcuts) = (0u32, 0u32);
             loop {
                 counters.rays += 1;
-                let it = scene.interact(&ray, |_| 0.0);
+                let mut textured = None;
+                let it = scene.interact(&ray, |_| 0.0, &mut textured);
                 // Beer–Lambert absorption along the segment just travelled (1 outside media).
                 beta *= medium.transmittance(&ray, &it);
                 let g = match it {
