@@ -57,6 +57,9 @@ pub struct Bsdf {
     /// `uses` (per-vertex queries such as [`Bsdf::has_local`] read it instead of walking the
     /// lobes).
     flags: LobeFlags,
+    /// [`Bsdf::lobe_choice_matters`], derived from the parts and the tint whenever either
+    /// changes (asked at every path vertex).
+    choice_matters: bool,
 }
 
 impl std::fmt::Debug for Bsdf {
@@ -175,6 +178,7 @@ impl Bsdf {
             uses: parts.map(|p| p.usage()),
             lambert,
             flags,
+            choice_matters: choice_matters(&parts, tint),
         }
     }
 
@@ -292,6 +296,7 @@ impl Bsdf {
     #[must_use]
     pub fn with_color(mut self, color: Vec3) -> Self {
         self.tint = color;
+        self.choice_matters = choice_matters(&self.parts, color);
         self
     }
 
@@ -411,21 +416,7 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn lobe_choice_matters(&self) -> bool {
-        let mut parts = 0;
-        for part in self.parts.iter().filter(|p| p.weight > 0.0) {
-            parts += 1;
-            let mut lit = 0;
-            for lobe in part.lobes() {
-                if lobe.uses_lobe_number() {
-                    return true;
-                }
-                lit += usize::from(!lobe.is_black(self.tint));
-            }
-            if lit > 1 {
-                return true;
-            }
-        }
-        parts > 1
+        self.choice_matters
     }
 
     /// The lobe number for [`Bsdf::sample`]: `draw()` where the choice matters
@@ -549,6 +540,27 @@ impl Bsdf {
         }
         lobes
     }
+}
+
+/// Whether a lobe number can change the sample of a mixture of `parts` with tint `tint`
+/// ([`Bsdf::lobe_choice_matters`]): a lobe that reads it itself (the dielectric), two parts of
+/// non-zero weight, or two non-black lobes in one part.
+fn choice_matters(parts: &[Part; PARTS], tint: Vec3) -> bool {
+    let mut count = 0;
+    for part in parts.iter().filter(|p| p.weight > 0.0) {
+        count += 1;
+        let mut lit = 0;
+        for lobe in part.lobes() {
+            if lobe.uses_lobe_number() {
+                return true;
+            }
+            lit += usize::from(!lobe.is_black(tint));
+        }
+        if lit > 1 {
+            return true;
+        }
+    }
+    count > 1
 }
 
 #[cfg(test)]
