@@ -188,7 +188,7 @@ impl<'a> Whitted<'a> {
         cx: &mut Context<'_, O>,
         me: Option<usize>,
     ) -> Vec3 {
-        let (sp, material, wo) = (&v.sp, &v.bsdf, v.wo);
+        let (sp, material, wo) = (&v.sp, v.bsdf, v.wo);
         let ShadingFrame { ns, ng, .. } = v.frame;
         let mut total = Vec3::ZERO;
         for (index, light) in self.scene.lights.iter().enumerate() {
