@@ -18,7 +18,7 @@
 
 use glam::Vec3;
 
-use super::bsdf_at::{BsdfAt, eval_value, non_delta_value};
+use super::bsdf_at::{BsdfAt, eval_value, lambert_value, non_delta_value};
 use super::coated::{CoatLayer, Coated};
 use super::conductor::ConductorFresnel;
 use super::dielectric::Dielectric;
@@ -29,6 +29,7 @@ use super::part::{Part, PartUse};
 use super::phong::Phong;
 use super::rough_conductor::RoughConductor;
 use super::rough_dielectric::RoughDielectric;
+use super::scattering::mean;
 pub use super::scattering::{
     BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction,
 };
@@ -60,6 +61,8 @@ pub struct Bsdf {
     /// [`Bsdf::lobe_choice_matters`], derived from the parts and the tint whenever either
     /// changes (asked at every path vertex).
     choice_matters: bool,
+    /// [`Bsdf::is_diffuse_only`], derived likewise (asked at every final-gather landing).
+    diffuse_only: bool,
 }
 
 impl std::fmt::Debug for Bsdf {
@@ -179,6 +182,7 @@ impl Bsdf {
             lambert,
             flags,
             choice_matters: choice_matters(&parts, tint),
+            diffuse_only: diffuse_only(&parts, tint),
         }
     }
 
@@ -297,6 +301,7 @@ impl Bsdf {
     pub fn with_color(mut self, color: Vec3) -> Self {
         self.tint = color;
         self.choice_matters = choice_matters(&self.parts, color);
+        self.diffuse_only = diffuse_only(&self.parts, color);
         self
     }
 
@@ -327,11 +332,7 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn is_diffuse_only(&self) -> bool {
-        self.parts
-            .iter()
-            .filter(|p| p.weight > 0.0)
-            .flat_map(Part::lobes)
-            .all(|l| l.is_flat(self.tint))
+        self.diffuse_only
     }
 
     /// True if the BSDF has mirror or dielectric parts.
@@ -405,6 +406,10 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn eval(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, mode: TransportMode) -> Vec3 {
+        if self.lambert && mean(self.tint).is_finite() {
+            // The matte-Lambert arithmetic [`BsdfAt`] takes (the same numbers).
+            return lambert_value(self, wo, wi, fr, mode);
+        }
         let any = self.transmits_glossy();
         eval_value(&self.parts, &self.uses, any, self.tint, wo, wi, fr, mode)
     }
@@ -561,6 +566,16 @@ fn choice_matters(parts: &[Part; PARTS], tint: Vec3) -> bool {
         }
     }
     count > 1
+}
+
+/// Whether no glossy lobe of non-zero weight scatters in a mixture of `parts` with tint `tint`
+/// ([`Bsdf::is_diffuse_only`]).
+fn diffuse_only(parts: &[Part; PARTS], tint: Vec3) -> bool {
+    parts
+        .iter()
+        .filter(|p| p.weight > 0.0)
+        .flat_map(Part::lobes)
+        .all(|l| l.is_flat(tint))
 }
 
 #[cfg(test)]

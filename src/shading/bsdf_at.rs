@@ -84,6 +84,29 @@ pub(super) fn non_delta_value(
     f
 }
 
+/// The non-delta value of a matte Lambert `bsdf` ([`Bsdf::is_lambert`]) of finite tint mean,
+/// with the general mixture's numbers (see [`BsdfAt::eval`]).
+#[inline(always)]
+pub(super) fn lambert_value(
+    bsdf: &Bsdf,
+    wo: Vec3,
+    wi: Vec3,
+    fr: &ShadingFrame,
+    mode: TransportMode,
+) -> Vec3 {
+    if fr.ng.dot(wi) <= 0.0 {
+        return Vec3::ZERO;
+    }
+    // The mixture's sum, `0 + (0 + f_Lambert [+ 0 from black Phong]) · weight`, kept
+    // literally so that signed zeros come out as they do there.
+    let lambert = Lambert.f(bsdf.color(), wi, fr.ns);
+    let f = Vec3::ZERO + (Vec3::ZERO + lambert) * bsdf.parts()[0].weight;
+    match mode {
+        TransportMode::Radiance => f,
+        TransportMode::Importance => f * shading_normal_correction(wo, wi, fr),
+    }
+}
+
 /// The full non-delta BSDF value (see [`BsdfAt::eval`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -209,18 +232,7 @@ impl<'b> BsdfAt<'b> {
     /// [`BsdfAt::eval`] of a matte Lambert material.
     #[inline(always)]
     fn lambert_eval(&self, wi: Vec3, mode: TransportMode) -> Vec3 {
-        let fr = &self.fr;
-        if fr.ng.dot(wi) <= 0.0 {
-            return Vec3::ZERO;
-        }
-        // The mixture's sum, `0 + (0 + f_Lambert [+ 0 from black Phong]) · weight`, kept
-        // literally so that signed zeros come out as they do there.
-        let lambert = Lambert.f(self.bsdf.color(), wi, fr.ns);
-        let f = Vec3::ZERO + (Vec3::ZERO + lambert) * self.bsdf.parts()[0].weight;
-        match mode {
-            TransportMode::Radiance => f,
-            TransportMode::Importance => f * shading_normal_correction(self.wo, wi, fr),
-        }
+        lambert_value(self.bsdf, self.wo, wi, &self.fr, mode)
     }
 
     /// The solid-angle density with which [`BsdfAt::sample`] returns the non-delta direction

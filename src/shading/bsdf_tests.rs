@@ -653,6 +653,10 @@ fn the_lambert_fast_path_gives_the_general_mixtures_numbers_bit_for_bit() {
                         fast.eval(wi, mode).to_array().map(f32::to_bits),
                         slow.eval(wi, mode).to_array().map(f32::to_bits)
                     );
+                    assert_eq!(
+                        m.eval(wo, wi, fr, mode).to_array().map(f32::to_bits),
+                        slow.eval(wi, mode).to_array().map(f32::to_bits)
+                    );
                     let (u_lobe, u) = (rng.next_f32(), rng.next_2d());
                     assert_eq!(
                         format!("{:?}", fast.sample(u_lobe, u, mode)),
