@@ -199,7 +199,8 @@ impl<'a> PathTracer<'a> {
                     cx.observer.set_radiance(node, l.total());
                 }
                 root = root.or(node);
-                let it = scene.interact(&ray, |t| cone.width_at(&ray, t));
+                let mut textured = None;
+                let it = scene.interact(&ray, |t| cone.width_at(&ray, t), &mut textured);
                 // Beer–Lambert absorption along the segment just travelled (1 outside media).
                 beta *= medium.transmittance(&ray, &it);
                 let v = match &it {
@@ -241,15 +242,15 @@ impl<'a> PathTracer<'a> {
                     }
                     Interaction::Surface(v) => v,
                 };
-                let (hit, sp, wo) = (v.hit, v.sp, v.wo);
+                let (hit, sp, wo) = (&v.hit, &v.sp, v.wo);
                 let name = &scene.material_names[v.material as usize];
-                cx.observer.hit(node, scene, &hit, &sp, name);
+                cx.observer.hit(node, scene, hit, sp, name);
                 if depth >= params.max_depth {
                     cx.observer.note(node, "max depth reached");
                     break;
                 }
                 let fr = v.frame;
-                let bsdf = &v.bsdf;
+                let bsdf = v.bsdf;
                 // The mixture worked out once for this vertex's light sample and next direction.
                 let at = bsdf.at(wo, &fr);
                 let may_scatter = diffuse_bounces < params.diffuse_depth;
@@ -267,7 +268,7 @@ impl<'a> PathTracer<'a> {
                 {
                     let u = cx.sampler.get_2d(u_point);
                     let scatter = may_scatter && !read_global;
-                    let c = self.direct(&sp, &at, index, pmf, u, scatter, cx, node);
+                    let c = self.direct(sp, &at, index, pmf, u, scatter, cx, node);
                     l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
                 }
                 let read_caustic = local
@@ -307,7 +308,7 @@ impl<'a> PathTracer<'a> {
                         && t_weight.max_element() > 0.0
                         && lobes.reflect_weight.max_element() > 0.0
                     {
-                        let curvature = scene.geometry.curvature(&hit);
+                        let curvature = scene.geometry.curvature(hit);
                         let branch = |dir: Vec3, weight: Vec3, transmitted: bool| Branch {
                             ray: Ray::new(offset_ray_origin(sp.p, sp.p_error, fr.ng, dir), dir),
                             cone: cone.bounce(
@@ -379,7 +380,7 @@ impl<'a> PathTracer<'a> {
                     }
                     beta /= q;
                 }
-                let curvature = scene.geometry.curvature(&hit);
+                let curvature = scene.geometry.curvature(hit);
                 cone = if s.delta {
                     cone.bounce(
                         &ray,

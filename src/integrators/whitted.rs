@@ -96,7 +96,8 @@ impl<'a> Whitted<'a> {
         let scene = self.scene;
         cx.counters.rays += 1;
         let ray = &path.ray;
-        let it = scene.interact(ray, |t| path.cone.width_at(ray, t));
+        let mut textured = None;
+        let it = scene.interact(ray, |t| path.cone.width_at(ray, t), &mut textured);
         // Beer–Lambert absorption along this ray (exactly 1 outside media).
         let tr = path.medium.transmittance(ray, &it);
         let v = match it {
@@ -187,7 +188,7 @@ impl<'a> Whitted<'a> {
         cx: &mut Context<'_, O>,
         me: Option<usize>,
     ) -> Vec3 {
-        let (sp, material, wo) = (&v.sp, &v.bsdf, v.wo);
+        let (sp, material, wo) = (&v.sp, v.bsdf, v.wo);
         let ShadingFrame { ns, ng, .. } = v.frame;
         let mut total = Vec3::ZERO;
         for (index, light) in self.scene.lights.iter().enumerate() {
@@ -263,7 +264,8 @@ impl Whitted<'_> {
         let mut t = Vec3::ONE;
         let mut medium = start;
         for _ in 0..MAX_SHADOW_CROSSINGS {
-            let v = match scene.interact(&ray, |_| 0.0) {
+            let mut textured = None;
+            let v = match scene.interact(&ray, |_| 0.0, &mut textured) {
                 // Nothing more before the light: the last stretch, in the current medium.
                 Interaction::Escaped => {
                     return t * medium.transmittance_over(ray.dir.length() * ray.t_max);

@@ -9,13 +9,13 @@ use super::{Hit, RenderScene, SurfacePoint};
 use crate::geometry::Ray;
 use crate::shading::{Bsdf, ShadingFrame};
 
-/// What a ray found ([`RenderScene::interact`]).
+/// What a ray found ([`RenderScene::interact`]); it borrows the scene's materials.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[allow(
     clippy::large_enum_variant,
     reason = "one per path vertex, on the stack and matched at once: never stored in arrays, so boxing would only add an allocation per hit"
 )]
-pub enum Interaction {
+pub enum Interaction<'s> {
     /// The ray left the scene (it sees the background). With an environment light, unbounded
     /// rays that leave the scene are [`Interaction::Emitter`] hits on it instead
     /// ([`RenderScene::escape`]).
@@ -24,7 +24,7 @@ pub enum Interaction {
     /// it and emits [`EmitterHit::le`]).
     Emitter(EmitterHit),
     /// The ray hit a surface with a material.
-    Surface(SurfaceHit),
+    Surface(SurfaceHit<'s>),
 }
 
 /// A ray's hit on an emitter.
@@ -40,9 +40,11 @@ pub struct EmitterHit {
     pub light: Option<u32>,
 }
 
-/// A ray's hit on a surface with a material, resolved for shading.
+/// A ray's hit on a surface with a material, resolved for shading. It borrows the material's
+/// BSDF, or the textured BSDF from the caller's slot where a texture changes it
+/// ([`RenderScene::interact`]), so a path vertex copies no BSDF.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SurfaceHit {
+pub struct SurfaceHit<'s> {
     /// The hit (distance, primitive).
     pub hit: Hit,
     /// The surface point.
@@ -52,7 +54,7 @@ pub struct SurfaceHit {
     /// Material index (`RenderScene::materials`, `material_names`).
     pub material: u32,
     /// The BSDF with textures applied.
-    pub bsdf: Bsdf,
+    pub bsdf: &'s Bsdf,
     /// The shading frame on the side of `wo` (bumped, usable shading normal; geometric normal;
     /// which side `wo` is on).
     pub frame: ShadingFrame,
@@ -73,13 +75,23 @@ impl EmitterHit {
 
 impl RenderScene {
     /// Traces `ray` to its first hit and resolves it: [`Interaction::Escaped`], an emitter, or a
-    /// surface shaded by [`RenderScene::shading_point`] with the texture footprint
+    /// surface shaded by [`RenderScene::shade`] with the texture footprint
     /// `footprint(t)` world units wide at hit distance `t` (in `ray`'s parameter units; a ray
     /// cone's width there, or 0 for the sharpest lookup). This is the one vertex step of every
     /// integrator and of photon tracing.
+    ///
+    /// The surface's BSDF is borrowed from its material; where a colour or roughness texture
+    /// changes it, the textured BSDF is written to `textured` and borrowed from there (the
+    /// caller's storage, usually a `None` local of the loop body: the common untextured hit
+    /// copies no BSDF).
     #[inline]
     #[must_use]
-    pub fn interact(&self, ray: &Ray, footprint: impl FnOnce(f32) -> f32) -> Interaction {
+    pub fn interact<'s>(
+        &'s self,
+        ray: &Ray,
+        footprint: impl FnOnce(f32) -> f32,
+        textured: &'s mut Option<Bsdf>,
+    ) -> Interaction<'s> {
         let Some(hit) = self.geometry.intersect(ray) else {
             return self.escape(ray);
         };
@@ -94,7 +106,8 @@ impl RenderScene {
                 light: object.light,
             }),
             Some(m) => {
-                let sh = self.shading_point(&self.materials[m as usize], &sp, wo, footprint(hit.t));
+                let material = &self.materials[m as usize];
+                let sh = self.shade(material, &sp, wo, footprint(hit.t), textured);
                 Interaction::Surface(SurfaceHit {
                     hit,
                     sp,

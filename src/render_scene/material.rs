@@ -66,7 +66,8 @@ impl std::fmt::Debug for SurfaceMaterial {
     }
 }
 
-/// The BSDF and frame at one hit, as seen from the outgoing direction `wo`.
+/// The BSDF and frame at one hit, as seen from the outgoing direction `wo`, with its own copy
+/// of the BSDF ([`RenderScene::shading_point`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadingPoint {
     /// The BSDF with textures applied.
@@ -80,12 +81,24 @@ pub struct ShadingPoint {
     pub entering: bool,
 }
 
+/// [`ShadingPoint`] borrowing its BSDF ([`RenderScene::shade`]): the material's own where no
+/// texture changes it, so a path vertex copies no BSDF, else the textured copy in the caller's
+/// slot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shading<'s> {
+    /// The BSDF with textures applied.
+    pub bsdf: &'s Bsdf,
+    /// Unit geometric normal on the side of `wo`.
+    pub ng: Vec3,
+    /// Unit shading normal on the side of `wo`, bumped and made usable.
+    pub ns: Vec3,
+    /// Whether `wo` is on the outside (the side the geometric normal points to).
+    pub entering: bool,
+}
+
 impl RenderScene {
-    /// Resolves `material` at surface point `sp` seen along unit `wo` (pointing away from the
-    /// surface), where the pixel's footprint is `width` world units wide across the incoming
-    /// ray (0: sharpest). This is the single place textures, bump mapping and the
-    /// shading-normal rules are applied.
-    #[inline(always)]
+    /// [`RenderScene::shade`] with its own copy of the BSDF (for tests and tools; the
+    /// integrators' vertex step, [`RenderScene::interact`], borrows it instead).
     #[must_use]
     pub fn shading_point(
         &self,
@@ -94,8 +107,34 @@ impl RenderScene {
         wo: Vec3,
         width: f32,
     ) -> ShadingPoint {
+        let mut textured = None;
+        let sh = self.shade(material, sp, wo, width, &mut textured);
+        ShadingPoint {
+            bsdf: *sh.bsdf,
+            ng: sh.ng,
+            ns: sh.ns,
+            entering: sh.entering,
+        }
+    }
+
+    /// Resolves `material` at surface point `sp` seen along unit `wo` (pointing away from the
+    /// surface), where the pixel's footprint is `width` world units wide across the incoming
+    /// ray (0: sharpest). This is the single place textures, bump mapping and the
+    /// shading-normal rules are applied. Where a colour or roughness texture changes the BSDF,
+    /// the textured BSDF is written to `textured` (the caller's storage) and borrowed from
+    /// there; otherwise the material's own is borrowed and `textured` is left alone.
+    #[inline(always)]
+    #[must_use]
+    pub fn shade<'s>(
+        &self,
+        material: &'s SurfaceMaterial,
+        sp: &SurfacePoint,
+        wo: Vec3,
+        width: f32,
+        textured: &'s mut Option<Bsdf>,
+    ) -> Shading<'s> {
         let entering = wo.dot(sp.ng) > 0.0;
-        let mut bsdf = material.bsdf;
+        let mut bsdf = &material.bsdf;
         let mut ns = sp.ns;
         if material.color_texture.is_some()
             || material.bump.is_some()
@@ -126,16 +165,20 @@ impl RenderScene {
             if let Some(t) = material.bump.or(material.normal_map) {
                 ns = self.textures[t as usize].bump(ns, sps.dpdu, sps.dpdv, &lookup);
             }
-            if let Some(t) = material.color_texture {
-                bsdf = bsdf.with_color(self.textures[t as usize].color(&lookup));
-            }
-            if let Some(t) = material.roughness_texture {
-                let c = self.textures[t as usize].color(&lookup);
-                bsdf = bsdf.with_microfacets(textured_ggx(c), material.conductor);
+            if material.color_texture.is_some() || material.roughness_texture.is_some() {
+                let mut b = material.bsdf;
+                if let Some(t) = material.color_texture {
+                    b = b.with_color(self.textures[t as usize].color(&lookup));
+                }
+                if let Some(t) = material.roughness_texture {
+                    let c = self.textures[t as usize].color(&lookup);
+                    b = b.with_microfacets(textured_ggx(c), material.conductor);
+                }
+                bsdf = textured.insert(b);
             }
         }
         let (ng, ns) = if entering { (sp.ng, ns) } else { (-sp.ng, -ns) };
-        ShadingPoint {
+        Shading {
             bsdf,
             ng,
             ns: usable_shading_normal(ns, ng, wo),

@@ -18,7 +18,7 @@ pub use geometry::{Geometry, Hit, PrimRef};
 pub use interaction::{EmitterHit, Interaction, SurfaceHit};
 pub use light::{EmissionSample, Light, LightSample};
 pub use light_sampler::LightSampler;
-pub use material::{ShadingPoint, SurfaceMaterial};
+pub use material::{Shading, ShadingPoint, SurfaceMaterial};
 pub use medium::Medium;
 pub use surface::{SurfaceParams, SurfacePoint};
 pub use texture::Texture;

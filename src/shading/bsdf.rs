@@ -18,7 +18,7 @@
 
 use glam::Vec3;
 
-use super::bsdf_at::{BsdfAt, eval_value, non_delta_value};
+use super::bsdf_at::{BsdfAt, eval_value, lambert_value, non_delta_value};
 use super::coated::{CoatLayer, Coated};
 use super::conductor::ConductorFresnel;
 use super::dielectric::Dielectric;
@@ -29,6 +29,7 @@ use super::part::{Part, PartUse};
 use super::phong::Phong;
 use super::rough_conductor::RoughConductor;
 use super::rough_dielectric::RoughDielectric;
+use super::scattering::mean;
 pub use super::scattering::{
     BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction,
 };
@@ -53,6 +54,15 @@ pub struct Bsdf {
     /// present, is black): the common matte material, which [`BsdfAt`] evaluates, samples and
     /// asks densities of without walking the mixture. Derived with `uses`.
     lambert: bool,
+    /// The union of the flags of the parts of non-zero weight ([`Bsdf::flags`]), derived with
+    /// `uses` (per-vertex queries such as [`Bsdf::has_local`] read it instead of walking the
+    /// lobes).
+    flags: LobeFlags,
+    /// [`Bsdf::lobe_choice_matters`], derived from the parts and the tint whenever either
+    /// changes (asked at every path vertex).
+    choice_matters: bool,
+    /// [`Bsdf::is_diffuse_only`], derived likewise (asked at every final-gather landing).
+    diffuse_only: bool,
 }
 
 impl std::fmt::Debug for Bsdf {
@@ -161,11 +171,18 @@ impl Bsdf {
                 [Some(Lobe::Lambert(_)), Some(Lobe::Phong(p))] => p.specular == Vec3::ZERO,
                 _ => false,
             };
+        let flags = parts
+            .iter()
+            .filter(|p| p.weight > 0.0)
+            .fold(LobeFlags::NONE, |f, p| f | p.flags());
         Self {
             tint,
             parts,
             uses: parts.map(|p| p.usage()),
             lambert,
+            flags,
+            choice_matters: choice_matters(&parts, tint),
+            diffuse_only: diffuse_only(&parts, tint),
         }
     }
 
@@ -283,6 +300,8 @@ impl Bsdf {
     #[must_use]
     pub fn with_color(mut self, color: Vec3) -> Self {
         self.tint = color;
+        self.choice_matters = choice_matters(&self.parts, color);
+        self.diffuse_only = diffuse_only(&self.parts, color);
         self
     }
 
@@ -297,10 +316,7 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn flags(&self) -> LobeFlags {
-        self.parts
-            .iter()
-            .filter(|p| p.weight > 0.0)
-            .fold(LobeFlags::NONE, |f, p| f | p.flags())
+        self.flags
     }
 
     /// True if the BSDF has a non-delta (diffuse or glossy) part that direct lighting sees.
@@ -316,11 +332,7 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn is_diffuse_only(&self) -> bool {
-        self.parts
-            .iter()
-            .filter(|p| p.weight > 0.0)
-            .flat_map(Part::lobes)
-            .all(|l| l.is_flat(self.tint))
+        self.diffuse_only
     }
 
     /// True if the BSDF has mirror or dielectric parts.
@@ -394,6 +406,10 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn eval(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, mode: TransportMode) -> Vec3 {
+        if self.lambert && mean(self.tint).is_finite() {
+            // The matte-Lambert arithmetic [`BsdfAt`] takes (the same numbers).
+            return lambert_value(self, wo, wi, fr, mode);
+        }
         let any = self.transmits_glossy();
         eval_value(&self.parts, &self.uses, any, self.tint, wo, wi, fr, mode)
     }
@@ -405,21 +421,7 @@ impl Bsdf {
     #[inline]
     #[must_use]
     pub fn lobe_choice_matters(&self) -> bool {
-        let mut parts = 0;
-        for part in self.parts.iter().filter(|p| p.weight > 0.0) {
-            parts += 1;
-            let mut lit = 0;
-            for lobe in part.lobes() {
-                if lobe.uses_lobe_number() {
-                    return true;
-                }
-                lit += usize::from(!lobe.is_black(self.tint));
-            }
-            if lit > 1 {
-                return true;
-            }
-        }
-        parts > 1
+        self.choice_matters
     }
 
     /// The lobe number for [`Bsdf::sample`]: `draw()` where the choice matters
@@ -543,6 +545,37 @@ impl Bsdf {
         }
         lobes
     }
+}
+
+/// Whether a lobe number can change the sample of a mixture of `parts` with tint `tint`
+/// ([`Bsdf::lobe_choice_matters`]): a lobe that reads it itself (the dielectric), two parts of
+/// non-zero weight, or two non-black lobes in one part.
+fn choice_matters(parts: &[Part; PARTS], tint: Vec3) -> bool {
+    let mut count = 0;
+    for part in parts.iter().filter(|p| p.weight > 0.0) {
+        count += 1;
+        let mut lit = 0;
+        for lobe in part.lobes() {
+            if lobe.uses_lobe_number() {
+                return true;
+            }
+            lit += usize::from(!lobe.is_black(tint));
+        }
+        if lit > 1 {
+            return true;
+        }
+    }
+    count > 1
+}
+
+/// Whether no glossy lobe of non-zero weight scatters in a mixture of `parts` with tint `tint`
+/// ([`Bsdf::is_diffuse_only`]).
+fn diffuse_only(parts: &[Part; PARTS], tint: Vec3) -> bool {
+    parts
+        .iter()
+        .filter(|p| p.weight > 0.0)
+        .flat_map(Part::lobes)
+        .all(|l| l.is_flat(tint))
 }
 
 #[cfg(test)]

@@ -16,12 +16,33 @@ use super::scattering::{BsdfSample, ShadingFrame, TransportMode, mean, shading_n
 
 /// A [`Bsdf`] prepared for one outgoing direction `wo` in one shading frame (see the module
 /// docs): ask it [`BsdfAt::eval`], [`BsdfAt::pdf`] and [`BsdfAt::sample`] for any number of
-/// incident directions. Cheap to build (a few Fresnel terms), no allocation.
+/// incident directions. Cheap to build (a few Fresnel terms; for a matte Lambert material one
+/// number), no allocation.
 #[derive(Debug, Clone, Copy)]
 pub struct BsdfAt<'b> {
     bsdf: &'b Bsdf,
     wo: Vec3,
     fr: ShadingFrame,
+    mix: Mixture,
+}
+
+/// The mixture's per-direction numbers.
+#[derive(Debug, Clone, Copy)]
+enum Mixture {
+    /// A matte Lambert material with a finite tint: the queries take the mixture's arithmetic
+    /// for that case directly (the same numbers; see [`BsdfAt::lambert`]). `p` is the diffuse
+    /// part's probability: 1, or 0 for a black BSDF.
+    Lambert {
+        /// The diffuse part's probability.
+        p: f32,
+    },
+    /// Any other BSDF: the mixture walked part by part.
+    General(General),
+}
+
+/// What the general mixture works out once per outgoing direction.
+#[derive(Debug, Clone, Copy)]
+struct General {
     /// The tint's mean.
     rho: f32,
     uses: [PartUse; PARTS],
@@ -32,9 +53,6 @@ pub struct BsdfAt<'b> {
     prepared: [Prepared; PARTS],
     /// Each non-delta part's lobe shares (0 for the others).
     shares: [[f32; LOBES_PER_PART]; PARTS],
-    /// A matte Lambert material with a finite tint: the queries take the mixture's arithmetic
-    /// for that case directly (the same numbers; see [`BsdfAt::lambert`]).
-    pub(super) lambert: bool,
 }
 
 /// The non-delta parts' value `Σ weight · Σ lobe f` for `wi`, in frame `fr` and mode `mode`:
@@ -64,6 +82,29 @@ pub(super) fn non_delta_value(
         f += fp * part.weight;
     }
     f
+}
+
+/// The non-delta value of a matte Lambert `bsdf` ([`Bsdf::is_lambert`]) of finite tint mean,
+/// with the general mixture's numbers (see [`BsdfAt::eval`]).
+#[inline(always)]
+pub(super) fn lambert_value(
+    bsdf: &Bsdf,
+    wo: Vec3,
+    wi: Vec3,
+    fr: &ShadingFrame,
+    mode: TransportMode,
+) -> Vec3 {
+    if fr.ng.dot(wi) <= 0.0 {
+        return Vec3::ZERO;
+    }
+    // The mixture's sum, `0 + (0 + f_Lambert [+ 0 from black Phong]) · weight`, kept
+    // literally so that signed zeros come out as they do there.
+    let lambert = Lambert.f(bsdf.color(), wi, fr.ns);
+    let f = Vec3::ZERO + (Vec3::ZERO + lambert) * bsdf.parts()[0].weight;
+    match mode {
+        TransportMode::Radiance => f,
+        TransportMode::Importance => f * shading_normal_correction(wo, wi, fr),
+    }
 }
 
 /// The full non-delta BSDF value (see [`BsdfAt::eval`]).
@@ -96,46 +137,15 @@ impl<'b> BsdfAt<'b> {
     #[inline(always)]
     #[must_use]
     pub fn new(bsdf: &'b Bsdf, wo: Vec3, fr: &ShadingFrame) -> Self {
-        let parts = bsdf.parts();
-        let uses = *bsdf.uses();
         let rho = mean(bsdf.color());
         if bsdf.is_lambert() && rho.is_finite() {
             return Self::lambert(bsdf, wo, fr, rho);
-        }
-        let mut prepared = [Prepared::Nothing; PARTS];
-        let mut q = [0.0f32; PARTS];
-        let mut sum = 0.0f32;
-        for i in 0..PARTS {
-            let part = &parts[i];
-            if part.weight > 0.0 {
-                prepared[i] = part.prepare(wo, fr);
-                q[i] = part.probability_weight(&prepared[i], rho);
-            }
-            sum += q[i];
-        }
-        let p = if sum > 0.0 {
-            q.map(|x| x / sum)
-        } else {
-            [0.0; PARTS]
-        };
-        let mut shares = [[0.0f32; LOBES_PER_PART]; PARTS];
-        for i in 0..PARTS {
-            if uses[i].local {
-                shares[i] = parts[i].shares(&prepared[i], rho);
-            }
         }
         Self {
             bsdf,
             wo,
             fr: *fr,
-            rho,
-            uses,
-            any_local: uses.iter().any(|u| u.local),
-            any_transmits_glossy: uses.iter().any(|u| u.transmits_glossy),
-            p,
-            prepared,
-            shares,
-            lambert: false,
+            mix: Mixture::General(General::new(bsdf, wo, fr, rho)),
         }
     }
 
@@ -146,27 +156,34 @@ impl<'b> BsdfAt<'b> {
     /// black Phong lobe's 0).
     #[inline(always)]
     fn lambert(bsdf: &'b Bsdf, wo: Vec3, fr: &ShadingFrame, rho: f32) -> Self {
-        let uses = *bsdf.uses();
         let q = bsdf.parts()[0].weight * rho;
-        let p = if q > 0.0 {
-            [1.0, 0.0, 0.0]
-        } else {
-            [0.0; PARTS]
-        };
-        let mut shares = [[0.0f32; LOBES_PER_PART]; PARTS];
-        shares[0][0] = 1.0;
         Self {
             bsdf,
             wo,
             fr: *fr,
-            rho,
-            uses,
-            any_local: true,
-            any_transmits_glossy: false,
-            p,
-            prepared: [Prepared::Nothing; PARTS],
-            shares,
-            lambert: true,
+            mix: Mixture::Lambert {
+                p: if q > 0.0 { 1.0 } else { 0.0 },
+            },
+        }
+    }
+
+    /// Whether the queries take the matte-Lambert arithmetic (for the tests that hold it to the
+    /// general walk).
+    #[cfg(test)]
+    pub(super) fn is_lambert(&self) -> bool {
+        matches!(self.mix, Mixture::Lambert { .. })
+    }
+
+    /// The same prepared BSDF asked through the general walk even where it is matte Lambert
+    /// (for the tests that hold the fast path to it).
+    #[cfg(test)]
+    pub(super) fn general(bsdf: &'b Bsdf, wo: Vec3, fr: &ShadingFrame) -> Self {
+        let rho = mean(bsdf.color());
+        Self {
+            bsdf,
+            wo,
+            fr: *fr,
+            mix: Mixture::General(General::new(bsdf, wo, fr, rho)),
         }
     }
 
@@ -197,30 +214,25 @@ impl<'b> BsdfAt<'b> {
     #[inline]
     #[must_use]
     pub fn eval(&self, wi: Vec3, mode: TransportMode) -> Vec3 {
-        if self.lambert {
-            let fr = &self.fr;
-            if fr.ng.dot(wi) <= 0.0 {
-                return Vec3::ZERO;
-            }
-            // The mixture's sum, `0 + (0 + f_Lambert [+ 0 from black Phong]) · weight`, kept
-            // literally so that signed zeros come out as they do there.
-            let lambert = Lambert.f(self.bsdf.color(), wi, fr.ns);
-            let f = Vec3::ZERO + (Vec3::ZERO + lambert) * self.bsdf.parts()[0].weight;
-            return match mode {
-                TransportMode::Radiance => f,
-                TransportMode::Importance => f * shading_normal_correction(self.wo, wi, fr),
-            };
+        match &self.mix {
+            Mixture::Lambert { .. } => self.lambert_eval(wi, mode),
+            Mixture::General(g) => eval_value(
+                self.bsdf.parts(),
+                &g.uses,
+                g.any_transmits_glossy,
+                self.bsdf.color(),
+                self.wo,
+                wi,
+                &self.fr,
+                mode,
+            ),
         }
-        eval_value(
-            self.bsdf.parts(),
-            &self.uses,
-            self.any_transmits_glossy,
-            self.bsdf.color(),
-            self.wo,
-            wi,
-            &self.fr,
-            mode,
-        )
+    }
+
+    /// [`BsdfAt::eval`] of a matte Lambert material.
+    #[inline(always)]
+    fn lambert_eval(&self, wi: Vec3, mode: TransportMode) -> Vec3 {
+        lambert_value(self.bsdf, self.wo, wi, &self.fr, mode)
     }
 
     /// The solid-angle density with which [`BsdfAt::sample`] returns the non-delta direction
@@ -229,35 +241,22 @@ impl<'b> BsdfAt<'b> {
     #[inline]
     #[must_use]
     pub fn pdf(&self, wi: Vec3) -> f32 {
-        if !self.any_local {
-            return 0.0;
+        match &self.mix {
+            Mixture::Lambert { p } => self.lambert_pdf(*p, wi),
+            Mixture::General(g) => g.pdf(self.bsdf, self.wo, wi, &self.fr),
         }
+    }
+
+    /// [`BsdfAt::pdf`] of a matte Lambert material whose diffuse part has probability `prob`.
+    #[inline(always)]
+    fn lambert_pdf(&self, prob: f32, wi: Vec3) -> f32 {
         let fr = &self.fr;
         let below = fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0;
-        if self.lambert {
-            let prob = self.p[0];
-            if prob == 0.0 || below {
-                return 0.0;
-            }
-            // The mixture's `0 + p · (0 + share · cos/π)` with Lambert's share 1.
-            return 0.0 + prob * (0.0 + Lambert.scaled_pdf(1.0, wi, fr));
+        if prob == 0.0 || below {
+            return 0.0;
         }
-        let tint = self.bsdf.color();
-        let mut pdf = 0.0f32;
-        for (i, part) in self.bsdf.parts().iter().enumerate() {
-            let prob = self.p[i];
-            if !self.uses[i].local || prob == 0.0 || (below && !self.uses[i].transmits_glossy) {
-                continue;
-            }
-            let mut d = 0.0f32;
-            for (lobe, &share) in part.lobes().zip(&self.shares[i]) {
-                if share > 0.0 {
-                    d += lobe.scaled_pdf(share, self.wo, wi, fr, tint);
-                }
-            }
-            pdf += prob * d;
-        }
-        pdf
+        // The mixture's `0 + p · (0 + share · cos/π)` with Lambert's share 1.
+        0.0 + prob * (0.0 + Lambert.scaled_pdf(1.0, wi, fr))
     }
 
     /// The lobe number for [`BsdfAt::sample`] ([`Bsdf::lobe_number`]).
@@ -272,13 +271,150 @@ impl<'b> BsdfAt<'b> {
     /// direction is lost below the surface.
     #[must_use]
     pub fn sample(&self, u_lobe: f32, u: (f32, f32), mode: TransportMode) -> Option<BsdfSample> {
-        if self.lambert && u_lobe < self.p[0] {
-            // The walk below would choose the diffuse part and in it Lambert (share 1), which
-            // reads no more of the lobe number.
-            return self.weigh(Lambert.sample(u, &self.fr), mode, None);
+        match &self.mix {
+            Mixture::Lambert { p } => {
+                // The walk would choose the diffuse part (whatever `u_lobe`: it is the only
+                // part of weight) and in it Lambert (share 1), which reads no more of the
+                // lobe number; for a black BSDF (p = 0) every density is 0, so no sample.
+                if *p == 0.0 {
+                    return None;
+                }
+                let wi = Lambert.sample(u, &self.fr);
+                let pdf = self.lambert_pdf(*p, wi);
+                let f = self.lambert_eval(wi, mode);
+                self.weigh(wi, f, pdf, None)
+            }
+            Mixture::General(g) => {
+                let (wi, ior) = g.sample(self.bsdf, self.wo, u_lobe, u, &self.fr, mode)?;
+                match wi {
+                    Sampled::Delta(s) => Some(s),
+                    Sampled::Direction(wi) => {
+                        let pdf = g.pdf(self.bsdf, self.wo, wi, &self.fr);
+                        let f = self.eval(wi, mode);
+                        self.weigh(wi, f, pdf, ior)
+                    }
+                }
+            }
         }
-        let parts = self.bsdf.parts();
-        let (wo, fr, rho, tint) = (self.wo, &self.fr, self.rho, self.bsdf.color());
+    }
+
+    /// The non-delta sample of direction `wi` from a lobe of index of refraction `ior` (a
+    /// transmitting glossy lobe's), with the mixture's value `f` and density `pdf` there:
+    /// `None` when either is 0.
+    #[inline(always)]
+    fn weigh(&self, wi: Vec3, f: Vec3, pdf: f32, ior: Option<f32>) -> Option<BsdfSample> {
+        let fr = &self.fr;
+        if !(pdf > 0.0) || f == Vec3::ZERO {
+            return None;
+        }
+        let transmitted = fr.ng.dot(wi) < 0.0;
+        // A glossy refraction in radiance mode carries (ηₒ/ηᵢ)² = 1/η² in `f` (Walter 2007,
+        // eq. 21), reported for Russian roulette as the smooth dielectric reports its own.
+        // (`ior` is only given in radiance mode.)
+        let mut eta_scale = 1.0;
+        if let (true, Some(ior)) = (transmitted, ior) {
+            let eta = if fr.entering { ior } else { 1.0 / ior };
+            eta_scale = 1.0 / (eta * eta);
+        }
+        Some(BsdfSample {
+            wi,
+            weight: f * (fr.ns.dot(wi).abs() / pdf),
+            pdf,
+            delta: false,
+            transmitted,
+            eta_scale,
+        })
+    }
+}
+
+/// What the general walk sampled: a delta lobe's finished sample, or a non-delta direction
+/// still to be weighed by the whole mixture.
+enum Sampled {
+    Delta(BsdfSample),
+    Direction(Vec3),
+}
+
+impl General {
+    /// Each part's per-direction state, the parts' probabilities (weight times the lobes' mean
+    /// albedo, normalised) and the lobes' shares, for `bsdf` of tint mean `rho` at `wo`.
+    #[inline(always)]
+    fn new(bsdf: &Bsdf, wo: Vec3, fr: &ShadingFrame, rho: f32) -> Self {
+        let parts = bsdf.parts();
+        let uses = *bsdf.uses();
+        let mut prepared = [Prepared::Nothing; PARTS];
+        let mut q = [0.0f32; PARTS];
+        let mut sum = 0.0f32;
+        for i in 0..PARTS {
+            let part = &parts[i];
+            if part.weight > 0.0 {
+                prepared[i] = part.prepare(wo, fr);
+                q[i] = part.probability_weight(&prepared[i], rho);
+            }
+            sum += q[i];
+        }
+        let p = if sum > 0.0 {
+            q.map(|x| x / sum)
+        } else {
+            [0.0; PARTS]
+        };
+        let mut shares = [[0.0f32; LOBES_PER_PART]; PARTS];
+        for i in 0..PARTS {
+            if uses[i].local {
+                shares[i] = parts[i].shares(&prepared[i], rho);
+            }
+        }
+        Self {
+            rho,
+            uses,
+            any_local: uses.iter().any(|u| u.local),
+            any_transmits_glossy: uses.iter().any(|u| u.transmits_glossy),
+            p,
+            prepared,
+            shares,
+        }
+    }
+
+    /// [`BsdfAt::pdf`] through the parts.
+    #[inline]
+    fn pdf(&self, bsdf: &Bsdf, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
+        if !self.any_local {
+            return 0.0;
+        }
+        let below = fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0;
+        let tint = bsdf.color();
+        let mut pdf = 0.0f32;
+        for (i, part) in bsdf.parts().iter().enumerate() {
+            let prob = self.p[i];
+            if !self.uses[i].local || prob == 0.0 || (below && !self.uses[i].transmits_glossy) {
+                continue;
+            }
+            let mut d = 0.0f32;
+            for (lobe, &share) in part.lobes().zip(&self.shares[i]) {
+                if share > 0.0 {
+                    d += lobe.scaled_pdf(share, wo, wi, fr, tint);
+                }
+            }
+            pdf += prob * d;
+        }
+        pdf
+    }
+
+    /// [`BsdfAt::sample`]'s walk: the part holding `u_lobe`, then (non-delta) its lobe by share
+    /// and that lobe's direction with the index of refraction of a transmitting glossy lobe
+    /// in radiance mode, or (delta) the lobe's own sample.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn sample(
+        &self,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        u_lobe: f32,
+        u: (f32, f32),
+        fr: &ShadingFrame,
+        mode: TransportMode,
+    ) -> Option<(Sampled, Option<f32>)> {
+        let parts = bsdf.parts();
+        let (rho, tint) = (self.rho, bsdf.color());
         // Walk the parts: the first whose interval holds u_lobe, else (rounding) the last of
         // non-zero weight; `rest` is u_lobe less the probabilities before the part.
         let mut chosen = None;
@@ -300,7 +436,7 @@ impl<'b> BsdfAt<'b> {
         // A chosen part has weight, so it is delta exactly when it is not local.
         if !self.uses[i].local {
             let lobe = part.lobes().next()?;
-            return lobe.sample_delta(
+            let s = lobe.sample_delta(
                 &self.prepared[i],
                 wo,
                 v,
@@ -310,7 +446,8 @@ impl<'b> BsdfAt<'b> {
                 self.p[i],
                 tint,
                 rho,
-            );
+            )?;
+            return Some((Sampled::Delta(s), None));
         }
         // A non-delta part: reuse the lobe number to pick one of its lobes.
         let mut lobe = None;
@@ -331,35 +468,7 @@ impl<'b> BsdfAt<'b> {
             0.0
         };
         let wi = lobe.sample_direction(wo, rest, u, fr, tint)?;
-        self.weigh(wi, mode, lobe.ior())
-    }
-
-    /// The non-delta sample of direction `wi` from a lobe of index of refraction `ior` (a
-    /// transmitting glossy lobe's), with the mixture's value and density: `None` when either is
-    /// 0.
-    #[inline(always)]
-    fn weigh(&self, wi: Vec3, mode: TransportMode, ior: Option<f32>) -> Option<BsdfSample> {
-        let fr = &self.fr;
-        let pdf = self.pdf(wi);
-        let f = self.eval(wi, mode);
-        if !(pdf > 0.0) || f == Vec3::ZERO {
-            return None;
-        }
-        let transmitted = fr.ng.dot(wi) < 0.0;
-        // A glossy refraction in radiance mode carries (ηₒ/ηᵢ)² = 1/η² in `f` (Walter 2007,
-        // eq. 21), reported for Russian roulette as the smooth dielectric reports its own.
-        let mut eta_scale = 1.0;
-        if let (true, TransportMode::Radiance, Some(ior)) = (transmitted, mode, ior) {
-            let eta = if fr.entering { ior } else { 1.0 / ior };
-            eta_scale = 1.0 / (eta * eta);
-        }
-        Some(BsdfSample {
-            wi,
-            weight: f * (fr.ns.dot(wi).abs() / pdf),
-            pdf,
-            delta: false,
-            transmitted,
-            eta_scale,
-        })
+        let ior = lobe.ior().filter(|_| mode == TransportMode::Radiance);
+        Some((Sampled::Direction(wi), ior))
     }
 }

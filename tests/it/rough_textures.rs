@@ -26,8 +26,9 @@ fn ball(m: &str, textures: &str) -> RenderScene {
 /// The BSDF at the hit of the ray from (x, y, 4) towards −z.
 fn bsdf_at(scene: &RenderScene, x: f32, y: f32) -> caustic::shading::Bsdf {
     let ray = Ray::new(Vec3::new(x, y, 4.0), -Vec3::Z);
-    match scene.interact(&ray, |_| 0.0) {
-        Interaction::Surface(v) => v.bsdf,
+    let mut textured = None;
+    match scene.interact(&ray, |_| 0.0, &mut textured) {
+        Interaction::Surface(v) => *v.bsdf,
         other => panic!("({x}, {y}) missed the ball: {other:?}"),
     }
 }

@@ -176,7 +176,8 @@ impl<'a> PhotonMapper<'a> {
             cx.counters.rays += 1;
             let node = cx.observer.ray(depth, b.kind, &ray, beta, b.parent);
             let mut gathered = Vec3::ZERO;
-            let it = scene.interact(&ray, |t| b.cone.width_at(&ray, t));
+            let mut textured = None;
+            let it = scene.interact(&ray, |t| b.cone.width_at(&ray, t), &mut textured);
             // Beer–Lambert absorption along the segment just travelled (1 outside media).
             let beta = beta * b.medium.transmittance(&ray, &it);
             let v = match it {
@@ -205,7 +206,7 @@ impl<'a> PhotonMapper<'a> {
                 cx.observer.note(node, "max depth reached");
                 continue;
             }
-            let (bsdf, fr) = (&v.bsdf, v.frame);
+            let (bsdf, fr) = (v.bsdf, v.frame);
             if bsdf.has_local() {
                 let full = beta.max_element() >= FINAL_GATHER_MIN_WEIGHT;
                 let (c, note) =
@@ -304,7 +305,7 @@ impl<'a> PhotonMapper<'a> {
         counters: &mut Counters,
         describe: bool,
     ) -> (Radiance, Option<String>) {
-        let (sp, fr, bsdf, wo) = (&v.sp, &v.frame, &v.bsdf, v.wo);
+        let (sp, fr, bsdf, wo) = (&v.sp, &v.frame, v.bsdf, v.wo);
         let direct = self.direct(sp, fr, bsdf, wo, sampler, counters);
         if !full && let Some(l) = cached_radiance(maps, sp, fr, bsdf, wo, counters) {
             let note = describe.then(|| {
@@ -442,7 +443,8 @@ impl<'a> PhotonMapper<'a> {
             let (mut specular, mut shortcuts) = (0u32, 0u32);
             loop {
                 counters.rays += 1;
-                let it = scene.interact(&ray, |_| 0.0);
+                let mut textured = None;
+                let it = scene.interact(&ray, |_| 0.0, &mut textured);
                 // Beer–Lambert absorption along the segment just travelled (1 outside media).
                 beta *= medium.transmittance(&ray, &it);
                 let g = match it {
@@ -456,7 +458,7 @@ impl<'a> PhotonMapper<'a> {
                 let (gp, gwo, gfr) = (g.sp, g.wo, g.frame);
                 let mut short = false;
                 if g.bsdf.has_local() {
-                    let mut lo = self.direct(&gp, &gfr, &g.bsdf, gwo, sampler, counters);
+                    let mut lo = self.direct(&gp, &gfr, g.bsdf, gwo, sampler, counters);
                     let near = maps
                         .irradiance
                         .as_ref()
@@ -467,13 +469,13 @@ impl<'a> PhotonMapper<'a> {
                         // The caustics here still come from their map; the rest of the light
                         // arriving here is gathered by the bounce below.
                         if let Some(map) = &maps.caustic {
-                            lo += counted(map, gp.p, gwo, &gfr, &g.bsdf, counters).radiance;
+                            lo += counted(map, gp.p, gwo, &gfr, g.bsdf, counters).radiance;
                         }
                     } else if let Some((e, _)) = near.filter(|_| g.bsdf.is_diffuse_only()) {
                         lo += g.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e;
                     } else {
                         for map in [&maps.caustic, &maps.global].into_iter().flatten() {
-                            lo += counted(map, gp.p, gwo, &gfr, &g.bsdf, counters).radiance;
+                            lo += counted(map, gp.p, gwo, &gfr, g.bsdf, counters).radiance;
                         }
                     }
                     sum += beta * lo;

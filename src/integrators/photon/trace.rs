@@ -94,7 +94,8 @@ pub fn trace_photon(
     let mut bounces = 0u32;
     let mut medium = Medium::OUTSIDE;
     loop {
-        let it = scene.interact(&ray, |_| 0.0);
+        let mut textured = None;
+        let it = scene.interact(&ray, |_| 0.0, &mut textured);
         // Beer–Lambert absorption along the segment just travelled (1 outside media).
         power *= medium.transmittance(&ray, &it);
         let v = match it {

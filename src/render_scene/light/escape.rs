@@ -26,7 +26,7 @@ impl RenderScene {
     /// ray (so [`Light::le`] reads the map in the ray's direction).
     #[inline]
     #[must_use]
-    pub fn escape(&self, ray: &Ray) -> Interaction {
+    pub fn escape(&self, ray: &Ray) -> Interaction<'_> {
         let Some(env) = self.environment else {
             return Interaction::Escaped;
         };
