@@ -203,6 +203,21 @@ impl<'a> PathTracer<'a> {
                 let it = scene.interact(&ray, |t| cone.width_at(&ray, t), &mut textured);
                 // Beer–Lambert absorption along the segment just travelled (1 outside media).
                 beta *= medium.transmittance(&ray, &it);
+                // A ray leaving the scene (to the background or the environment) also sees the
+                // suns whose disc it points into, counted as an emitter hit is.
+                let escaping = match &it {
+                    Interaction::Escaped => true,
+                    Interaction::Emitter(e) => scene
+                        .environment
+                        .is_some_and(|env| e.light == Some(env.light)),
+                    Interaction::Surface(_) => false,
+                };
+                if escaping && !background_only && !(map_read && since_local.is_some_and(|n| n > 0))
+                {
+                    let sun = self.suns(&ray, specular, prev_pdf, prev_p);
+                    let via = since_local.is_some_and(|n| n > 0);
+                    l.add(LightPath::classify(diffuse_bounces, via), beta * sun);
+                }
                 let v = match &it {
                     Interaction::Escaped => {
                         let via = since_local.is_some_and(|n| n > 0);
@@ -422,6 +437,25 @@ impl<'a> PathTracer<'a> {
 }
 
 impl PathTracer<'_> {
+    /// Radiance of the suns (distant lights with a disc) that the escaping `ray` sees, each
+    /// weighted as an emitter hit: fully after a delta bounce (`specular`) or from the camera,
+    /// else by the power heuristic between the BSDF sample that chose the ray (`prev_pdf`,
+    /// from `prev_p`) and the light's own samples.
+    fn suns(&self, ray: &Ray, specular: bool, prev_pdf: f32, prev_p: Vec3) -> Vec3 {
+        let mut sum = Vec3::ZERO;
+        for (i, le) in self.scene.suns_seen(ray) {
+            let w = if specular {
+                1.0
+            } else {
+                let wi = ray.dir.normalize();
+                let light_pdf = self.lights.pmf(i) * self.scene.lights[i].pdf_li(prev_p, wi);
+                power_heuristic(prev_pdf, light_pdf)
+            };
+            sum += le * w;
+        }
+        sum
+    }
+
     /// Next-event estimation at `sp` towards light `index` (chosen with probability `pmf`):
     /// the radiance it sends through the non-delta part of the BSDF, MIS-weighted against BSDF
     /// sampling when the path may still scatter diffusely (else the light sample alone stands

@@ -101,7 +101,12 @@ impl<'a> Whitted<'a> {
         // Beer–Lambert absorption along this ray (exactly 1 outside media).
         let tr = path.medium.transmittance(ray, &it);
         let v = match it {
-            Interaction::Escaped => return (seen(scene.params.background * tr), None),
+            // Leaving the scene: the background or the environment, and the suns whose disc
+            // the ray points into.
+            Interaction::Escaped => {
+                let suns = scene.suns_seen(ray).map(|(_, le)| le).sum::<Vec3>();
+                return (seen((scene.params.background + suns) * tr), None);
+            }
             Interaction::Emitter(e) => {
                 let entering = e.wo.dot(e.sp.ng) > 0.0;
                 let info = O::ACTIVE.then(|| TraceHit {
@@ -112,8 +117,16 @@ impl<'a> Whitted<'a> {
                     material: "light".into(),
                     entering,
                 });
-                // An emitter: its radiance is seen from outside only.
-                return (seen(e.le(scene) * tr), info);
+                // An emitter: its radiance is seen from outside only; the environment with the
+                // suns in front of it.
+                let mut le = e.le(scene);
+                if scene
+                    .environment
+                    .is_some_and(|env| e.light == Some(env.light))
+                {
+                    le += scene.suns_seen(ray).map(|(_, le)| le).sum::<Vec3>();
+                }
+                return (seen(le * tr), info);
             }
             Interaction::Surface(v) => v,
         };

@@ -125,13 +125,15 @@ impl Light {
     }
 
     /// True for lights whose samples carry no MIS weight because BSDF sampling never reaches
-    /// them: point and spot lights (deltas in position), distant lights (a delta direction, or
-    /// the sun's cone, which escaping rays do not see).
+    /// them: point and spot lights (deltas in position) and distant lights of angular radius 0
+    /// (a delta direction). A distant light with a disc (the sun) is not: escaping rays see it
+    /// ([`RenderScene::suns_seen`](crate::render_scene::RenderScene::suns_seen)).
     #[inline]
     #[must_use]
     pub fn is_delta(&self) -> bool {
         match self {
-            Light::Point { .. } | Light::Spot(_) | Light::Distant(_) => true,
+            Light::Distant(d) => d.is_delta(),
+            Light::Point { .. } | Light::Spot(_) => true,
             Light::Sphere { .. } | Light::Rect(_) | Light::Mesh(_) | Light::Environment(_) => false,
         }
     }
@@ -259,9 +261,9 @@ impl Light {
             Light::Rect(ref r) => r.sample_li(p, u),
             Light::Mesh(ref m) => m.sample_li(p, u).map(|s| s.light),
             Light::Spot(ref s) => s.sample_li(p, u),
-            // The sun's cone is sampled here only: escaping rays do not see it, so its samples
-            // stand alone (no MIS weight), as a delta light's do.
-            Light::Distant(ref d) => d.sample_li(p, u).map(|s| LightSample { delta: true, ..s }),
+            // The sun's cone: escaping rays see it too (`RenderScene::suns_seen`), so its samples
+            // are MIS-weighted against BSDF sampling as an environment's are.
+            Light::Distant(ref d) => d.sample_li(p, u),
             Light::Environment(ref e) => e.sample_li(p, u),
         }
     }
@@ -269,7 +271,8 @@ impl Light {
     /// Solid-angle density with which [`Light::sample_li`] at `p` returns the unit direction
     /// `wi`: 0 for point lights (a delta), 0 outside the cone a sphere subtends or when `p` is
     /// inside it. Used for the MIS weight when a BSDF-sampled ray hits a sphere light.
-    /// Spot and distant lights give 0 (their samples carry no MIS weight); a mesh gives the
+    /// Spot lights and delta distant lights give 0 (their samples carry no MIS weight); a sun's
+    /// disc gives `1/(2π(1 − cos α))` inside its cone; a mesh gives the
     /// density of the direction (every triangle the line meets, O(triangles): integrators use
     /// [`Light::pdf_li_hit`], which knows the point hit).
     #[must_use]
@@ -299,7 +302,7 @@ impl Light {
             Light::Rect(ref r) => r.pdf_li(p, wi),
             Light::Mesh(ref m) => m.pdf_li(p, wi),
             Light::Spot(ref s) => s.pdf_li(p, wi),
-            Light::Distant(_) => 0.0,
+            Light::Distant(ref d) => d.pdf_li(p, wi),
             Light::Environment(ref e) => e.pdf_li(p, wi),
         }
     }
@@ -328,7 +331,8 @@ impl Light {
     /// otherwise and for point lights (which rays cannot hit). Rectangles and meshes: their
     /// radiance on an emitting side (`n` is the triangle's winding normal). Environment: the
     /// radiance arriving along a ray escaping in direction `−w` (`n` unused). Spot and distant
-    /// lights: zero (rays never reach them).
+    /// lights: zero (rays never hit them as surfaces; an escaping ray sees a sun's disc through
+    /// [`RenderScene::suns_seen`](crate::render_scene::RenderScene::suns_seen)).
     #[inline]
     #[must_use]
     pub fn le(&self, n: Vec3, w: Vec3) -> Vec3 {

@@ -39,6 +39,7 @@ mod render_snapshots;
 mod reported;
 mod reported_photon;
 mod rough_textures;
+mod sun_caustic;
 mod textures;
 mod transmission_nee;
 mod watertight;

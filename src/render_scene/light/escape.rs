@@ -2,6 +2,12 @@
 //! on the environment, an emitter at infinity, so that every integrator sees the environment
 //! (directly, through mirrors and glass, and as the MIS partner of its light samples) through
 //! [`Interaction::Emitter`] and [`Light`]'s methods, with no case of its own.
+//!
+//! A distant light with an angular radius (the sun's disc) is also seen by escaping rays, in
+//! addition to the environment: [`RenderScene::suns_seen`] lists those whose disc an escaping
+//! ray points into. Without it a path tracer never finds light that reaches a diffuse surface
+//! from the sun through a mirror, glass or water (sun → specular → diffuse: the caustics under
+//! the bath's water, the sun's reflections off glazes and mirrors), which the photon maps carry.
 
 use super::Light;
 use crate::geometry::Ray;
@@ -51,5 +57,32 @@ impl RenderScene {
             wo,
             light: Some(env.light),
         })
+    }
+}
+
+impl RenderScene {
+    /// The distant lights with an angular radius (suns) that a ray leaving the scene along
+    /// `ray` sees: each one's index in `lights` and the radiance it sends back along the ray
+    /// (its disc's radiance when the direction lies in its cone). Nothing for a ray that ends
+    /// (`t_max` finite: a shadow ray) or a direction outside every disc. Integrators add these
+    /// to what [`RenderScene::escape`] resolves (the background or the environment), with the
+    /// MIS weight of [`Light::pdf_li`] against their light samples.
+    #[inline]
+    pub fn suns_seen<'s>(&'s self, ray: &Ray) -> impl Iterator<Item = (usize, glam::Vec3)> + 's {
+        let dir = if ray.t_max == f32::INFINITY {
+            ray.dir.try_normalize()
+        } else {
+            None
+        };
+        self.lights
+            .iter()
+            .enumerate()
+            .filter_map(move |(i, l)| match (l, dir) {
+                (Light::Distant(d), Some(w)) => {
+                    let le = d.le(w);
+                    (le != glam::Vec3::ZERO).then_some((i, le))
+                }
+                _ => None,
+            })
     }
 }
