@@ -1,7 +1,7 @@
 """Mitsuba 3 renders of the issue #26 comparison scenes, one per material.
 
 Use:  /root/.cache/mitsuba3-venv/bin/python scripts/mitsuba/materials.py SCENE [--spp N] [-o out.exr]
-      SCENE ∈ rough_chrome, rough_gold, frosted_01, frosted_05, water (or `all`).
+      SCENE ∈ rough_chrome, rough_gold, frosted_01, frosted_05, water, glazed (or `all`).
 
 Every scene: 96×72 pixels, the floor y = 0 (Lambert 0.5), a sphere of the material (radius 0.5
 at (0, 0.5, 0)), the 1 × 0.6 quad light of lights.py (y = 2.5, facing down, L = 8) and a
@@ -30,6 +30,16 @@ Convention differences and how each scene neutralises them:
   absorption   caustic's `absorption` σ (per metre) inside a closed dielectric; Mitsuba: the
                sphere's `interior` is a `homogeneous` medium with sigma_t = σ and albedo 0 (no
                scattering), rendered by `volpath` (Mitsuba's `path` ignores media).
+  coat         caustic's `coat: (ior: 1.5)` over a diffuse `color` is Mitsuba's `plastic` with
+               nonlinear = false, specular_reflectance 1, int_ior 1.5, the same diffuse
+               reflectance. One difference is left (it cannot be set from the scene): Mitsuba
+               takes the coat's internal diffuse reflectance F_dr,int from a fitted polynomial,
+               caustic integrates it (0.59635 at η = 1.5, Mitsuba 0.59681), so Mitsuba's base
+               would be brighter by (1 − F_dr,int,caustic)/(1 − F_dr,int,Mitsuba) − 1 = 0.115 %.
+               With nonlinear = false the base is linear in its reflectance, so the scene
+               neutralises this by giving Mitsuba the base colour times
+               (1 − F_dr,int,Mitsuba)/(1 − F_dr,int,caustic) (`plastic_base_scale`; F_dr,int of
+               caustic recomputed here by a midpoint rule, independently of the Rust code).
   emitters     one-sided quad as in lights.py; `constant` emitter = caustic's constant
                Environment (same meaning).
 """
@@ -109,12 +119,50 @@ def scene_water(mi, spp, seed):
     return d
 
 
+GLAZE = [0.8, 0.45, 0.15]   # the glazed ball's base colour (an orange glaze)
+
+
+def fresnel_dielectric(c, eta):
+    """Unpolarised Fresnel reflectance at cosine c, light arriving from index 1 into index eta."""
+    import numpy as np
+    s2 = (1.0 - c * c) / (eta * eta)
+    ct = np.sqrt(np.maximum(0.0, 1.0 - s2))
+    rs = (c - eta * ct) / (c + eta * ct)
+    rp = (eta * c - ct) / (eta * c + ct)
+    return np.where(s2 >= 1.0, 1.0, 0.5 * (rs * rs + rp * rp))
+
+
+def plastic_base_scale(mi, eta):
+    """(1 − F_dr,int of Mitsuba's fit)/(1 − F_dr,int integrated): the factor that makes Mitsuba's
+    linear `plastic` base equal to caustic's coated base. caustic's F_dr,int = 1 − (1 − F_dr,ext)/η²
+    with F_dr,ext = ∫ F(μ) 2μ dμ by a 2·10⁶-step midpoint rule."""
+    import numpy as np
+    n = 2_000_000
+    mu = (np.arange(n) + 0.5) / n
+    fdr_ext = float(np.mean(fresnel_dielectric(mu, eta) * 2.0 * mu))
+    fdr_int = 1.0 - (1.0 - fdr_ext) / (eta * eta)
+    fit = np.asarray(mi.fresnel_diffuse_reflectance(mi.Float(1.0 / eta))).ravel()[0]
+    return (1.0 - float(fit)) / (1.0 - fdr_int)
+
+
+def scene_glazed(mi, spp, seed):
+    """A glazed ball: a diffuse base under a smooth clear coat of index 1.5 (`plastic`), its base
+    colour scaled by `plastic_base_scale` (0.99885) to neutralise the fitted F_dr,int."""
+    d = base(mi, spp, seed)
+    k = plastic_base_scale(mi, 1.5)
+    d["ball"] = ball({"type": "plastic", "int_ior": 1.5, "ext_ior": 1.0, "nonlinear": False,
+                      "diffuse_reflectance": {"type": "rgb", "value": [k * c for c in GLAZE]},
+                      "specular_reflectance": {"type": "rgb", "value": [1.0, 1.0, 1.0]}})
+    return d
+
+
 SCENES = {
     "rough_chrome": scene_rough_chrome,
     "rough_gold": scene_rough_gold,
     "frosted_01": lambda mi, spp, seed: scene_frosted(mi, spp, seed, 0.1),
     "frosted_05": lambda mi, spp, seed: scene_frosted(mi, spp, seed, 0.5),
     "water": scene_water,
+    "glazed": scene_glazed,
 }
 
 
