@@ -24,6 +24,7 @@ mod kdtree;
 mod layers;
 mod light_transport;
 mod lights;
+mod materials_scene;
 mod models;
 mod mutated_scenes;
 mod normal_maps;
