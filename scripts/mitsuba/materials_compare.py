@@ -49,7 +49,8 @@ def mitsuba_runs(mi, dr, name, spp, seeds):
 def caustic_runs(mi, binary, name, spp, seeds, out_dir):
     """K caustic `path` renders of the twin scene."""
     import subprocess
-    scene = ROOT / "scripts" / "mitsuba" / "scenes" / f"materials_{name}.ron"
+    twin = name.removesuffix("_hc")   # the `_hc` scenes change Mitsuba's side only
+    scene = ROOT / "scripts" / "mitsuba" / "scenes" / f"materials_{twin}.ron"
     imgs = []
     for s in range(seeds):
         out = out_dir / f"caustic_{name}_{s}.exr"
@@ -100,7 +101,8 @@ def ball_mean(c_runs, m_runs, mask):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("scenes", nargs="*", default=list(materials.SCENES))
+    ap.add_argument("scenes", nargs="*", default=list(materials.SCENES),
+                    help="default: all, the `_hc` scenes (Mitsuba with height-correlated masking) included")
     ap.add_argument("--spp", type=int, default=256)
     ap.add_argument("--seeds", type=int, default=4)
     ap.add_argument("--caustic", default=os.environ.get("CAUSTIC_BIN", str(ROOT / "target" / "release" / "caustic")))
