@@ -59,8 +59,14 @@ fn bsdf_at(scene: &RenderScene, x: f32, y: f32) -> caustic::shading::Bsdf {
 #[test]
 fn roughness_zero_is_the_smooth_material_bit_for_bit_in_every_integrator() {
     let materials = [
-        ("tinted mirror", "color: (0.9, 0.7, 0.5), diffuse: 0, reflect: 1"),
-        ("glass", "color: (1, 1, 1), diffuse: 0, transmit: 1, ior: 1.5"),
+        (
+            "tinted mirror",
+            "color: (0.9, 0.7, 0.5), diffuse: 0, reflect: 1",
+        ),
+        (
+            "glass",
+            "color: (1, 1, 1), diffuse: 0, transmit: 1, ior: 1.5",
+        ),
         (
             "water",
             "color: (1, 1, 1), diffuse: 0, transmit: 1, ior: 1.33, absorption: (2, 0.4, 0.2)",
