@@ -39,6 +39,7 @@ mod queries;
 mod render_snapshots;
 mod reported;
 mod reported_photon;
+mod rough_integrators;
 mod rough_textures;
 mod textures;
 mod transmission_nee;
