@@ -10,8 +10,16 @@ by a midpoint rule over (θh, φh) (1500 × 3000 cells), written from the formul
 the Rust code. Prints E under each convention and their ratio − 1 for the α of the comparison's
 rough chrome (0.09) and rough gold (0.16).
 
-Use: /root/.cache/mitsuba3-venv/bin/python scripts/mitsuba/smith_albedo.py   (numpy only)
+With --mitsuba it also prints the same albedo (α = 0.16) estimated from 2²⁰ samples of Mitsuba's
+`roughconductor` (material "none": F = 1) and of that BSDF wrapped in `height_correlated`
+(materials.py): the wrapped one must reproduce the height-correlated column, the plain one the
+separable column.
+
+Use: /root/.cache/mitsuba3-venv/bin/python scripts/mitsuba/smith_albedo.py [--mitsuba]
 """
+import sys
+from pathlib import Path
+
 import numpy as np
 
 
@@ -48,5 +56,29 @@ def main():
             print(f"| {alpha} | {deg}° | {hc:.4f} | {sep:.4f} | {100 * (hc / sep - 1):+.2f} % |")
 
 
+def mitsuba_check(alpha=0.16, n=1 << 20):
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import common
+    import materials
+    mi, dr = common.mitsuba(2)
+    plain = {"type": "roughconductor", "distribution": "ggx", "alpha": alpha, "sample_visible": True}
+    bsdfs = {"separable (Mitsuba)": mi.load_dict(plain),
+             "height_correlated wrapper": mi.load_dict(materials.height_correlated(mi, dict(plain)))}
+    print(f"\nMitsuba {mi.__version__}, white roughconductor α = {alpha}, mean sample weight of {n} samples:")
+    for name, bsdf in bsdfs.items():
+        row = []
+        for deg in (0, 60, 80, 85):
+            th = np.radians(deg)
+            si = dr.zeros(mi.SurfaceInteraction3f)
+            si.wi = mi.Vector3f(float(np.sin(th)), 0.0, float(np.cos(th)))
+            sampler = mi.load_dict({"type": "independent"})
+            sampler.seed(1, n)
+            _, w = bsdf.sample(mi.BSDFContext(), si, sampler.next_1d(), sampler.next_2d(), True)
+            row.append(f"{deg}°: {float(dr.mean(w[0])[0]):.4f}")
+        print(f"  {name}: " + ", ".join(row))
+
+
 if __name__ == "__main__":
     main()
+    if "--mitsuba" in sys.argv:
+        mitsuba_check()
