@@ -50,8 +50,9 @@ fn ball(m: &str, integrator: &str) -> RenderScene {
 fn bsdf_at(scene: &RenderScene, x: f32, y: f32) -> caustic::shading::Bsdf {
     let o = Vec3::new(x, y, 4.0);
     let ray = Ray::new(o, (Vec3::new(0.0, 0.5, 0.0) - o).normalize());
-    match scene.interact(&ray, |_| 0.0) {
-        Interaction::Surface(v) => v.bsdf,
+    let mut textured = None;
+    match scene.interact(&ray, |_| 0.0, &mut textured) {
+        Interaction::Surface(v) => *v.bsdf,
         other => panic!("({x}, {y}) missed the ball: {other:?}"),
     }
 }
