@@ -166,10 +166,13 @@ fn a_point_lights_caustic_through_a_ball_lens_carries_the_power_it_passes() {
     eprintln!(
         "caustic flux on the floor: {after_4} W after 4 passes, {flux} W after 32, {expected} W analytic"
     );
-    // The k-nearest estimate's tails beyond the spot's sharp rim add flux (≈ +10 % after 4
-    // passes); the shrinking radius removes them, which is the consistency this tests.
+    // The analytic flux omits the few per cent that internal reflections scatter widely onto
+    // the floor, so the rendered flux converges a little above it. With the initial radius from
+    // a pilot map (`radius_field`) the early blur beyond the spot's sharp rim is already small
+    // (+2.5 % after 4 passes; the k-nearest radius of the pass's own map gave ≈ +10 %), so ask
+    // for both to be within the stated bounds rather than for a fall between them.
     assert!(
-        e32.abs() < 0.05 && e32.abs() < 0.6 * e4.abs(),
+        e32.abs() < 0.05 && e4.abs() < 0.10,
         "rendered caustic flux: error {e4:+.4} after 4 passes, {e32:+.4} after 32 ({expected} W analytic)"
     );
 }
