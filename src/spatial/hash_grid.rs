@@ -76,6 +76,13 @@ fn cell_coord(x: f32, inv: f32) -> i32 {
     (x * inv).floor() as i32
 }
 
+/// Cells in the box from cell `lo` to cell `hi` (inclusive), saturating at `u64::MAX`.
+#[inline]
+fn cell_count(lo: CellIndex, hi: CellIndex) -> u64 {
+    let axis = |a: usize| (i64::from(hi[a]) - i64::from(lo[a]) + 1) as u64;
+    axis(0).saturating_mul(axis(1)).saturating_mul(axis(2))
+}
+
 /// Teschner et al.'s hash of a cell: the coordinates times three large primes, XORed.
 #[inline]
 fn hash(c: CellIndex) -> u32 {
@@ -192,19 +199,13 @@ impl<T: HasPosition> HashGrid<T> {
         }
     }
 
-    /// How many cells the box of the ball of radius `r` around `q` overlaps (what
-    /// [`HashGrid::within`] visits before its scan fallback): 8 or fewer when `r` is at most
-    /// half a cell side. Saturates at `u64::MAX`; 0 for a non-finite `q` or a negative or NaN `r`.
+    /// The lowest and highest cell of the box of the ball of radius `r` around `q`.
     #[inline]
-    #[must_use]
-    pub fn span(&self, q: [f32; 3], r: f32) -> u64 {
-        if !(r >= 0.0) || !q.iter().all(|c| c.is_finite()) {
-            return 0;
-        }
-        let lo = q.map(|x| cell_coord(x - r, self.inv_cell));
-        let hi = q.map(|x| cell_coord(x + r, self.inv_cell));
-        let axis = |a: usize| (i64::from(hi[a]) - i64::from(lo[a]) + 1) as u64;
-        axis(0).saturating_mul(axis(1)).saturating_mul(axis(2))
+    fn cell_range(&self, q: [f32; 3], r: f32) -> (CellIndex, CellIndex) {
+        (
+            q.map(|x| cell_coord(x - r, self.inv_cell)),
+            q.map(|x| cell_coord(x + r, self.inv_cell)),
+        )
     }
 
     /// Calls `visit` for every item with `distance2(q, p) ≤ r²`, each once, in an order that
@@ -216,9 +217,8 @@ impl<T: HasPosition> HashGrid<T> {
             return;
         }
         let r2 = r * r;
-        let lo = q.map(|x| cell_coord(x - r, self.inv_cell));
-        let hi = q.map(|x| cell_coord(x + r, self.inv_cell));
-        if self.span(q, r) > self.items.len() as u64 {
+        let (lo, hi) = self.cell_range(q, r);
+        if cell_count(lo, hi) > self.items.len() as u64 {
             // More cells than items (a radius as large as the scene): scan everything.
             for (i, it) in self.items.iter().enumerate() {
                 let dist2 = distance2(q, it.position());

@@ -179,20 +179,21 @@ impl PhotonMap {
     /// `shrink · field.radius(x)` of the query `x` ([`RadiusField`]; `shrink` ∈ (0, 1] from the
     /// radius schedule), over that disc's area. The pass's photons go into a hash grid whose
     /// cell side is the disc's diameter at the field's typical radius, so a typical query
-    /// visits at most 8 cells. With a field that does not depend on this map's photons (a
+    /// visits at most 8 cells (one grid per power of two of the disc's diameter, up to the
+    /// field's largest radius). With a field that does not depend on this map's photons (a
     /// pilot map's), each estimate is the plain density estimate over a fixed disc: its mean is
     /// the radiance averaged over the disc (Knaus & Zwicker 2011).
     pub fn set_pass_lookup(&mut self, shrink: f32, field: Arc<RadiusField>) {
         self.set_shrink(shrink);
-        // Grids whose cells are the disc's diameter at the field's typical radius, then 4×, 16×
+        // Grids whose cells are the disc's diameter at the field's typical radius, then 2×, 4×
         // … up to its largest, so that every estimate finds a grid where its disc overlaps at
-        // most 8 cells.
+        // most 8 cells. The photons are decoded once for all of them.
+        let landings: Vec<Landing> = self.tree.items().iter().map(Landing::from).collect();
         let mut grids = Vec::new();
         let mut cell = 2.0 * self.shrink * field.typical();
         let widest = 2.0 * self.shrink * field.fallback();
         while grids.len() < MAX_GRID_LEVELS {
-            let landings = self.tree.items().iter().map(Landing::from).collect();
-            let Ok(grid) = HashGrid::build(landings, cell) else {
+            let Ok(grid) = HashGrid::build(landings.clone(), cell) else {
                 break;
             };
             grids.push(grid);
@@ -355,9 +356,7 @@ impl PhotonMap {
         let mut found = 0;
         let mut add = |ph: &Landing, dist2: f32| {
             found += 1;
-            // The side tests of `accept`, on the decoded record.
-            if ph.normal.dot(ng) > 0.1 && ph.wi.dot(ng) > 0.0 {
-                let cos_g = ph.wi.dot(ph.normal).max(MIN_LANDING_COSINE);
+            if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, ng) {
                 sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), r);
             }
         };
@@ -390,12 +389,15 @@ impl PhotonMap {
 /// shadow ray see it: a facet lit at a grazing angle keeps its own photons).
 #[inline]
 fn accept(ph: &Photon, ng: Vec3) -> Option<(Vec3, f32)> {
-    let np = ph.normal();
-    if np.dot(ng) <= 0.1 {
-        return None;
-    }
     let wi = -ph.direction();
-    (wi.dot(ng) > 0.0).then(|| (wi, wi.dot(np).max(MIN_LANDING_COSINE)))
+    landing_cosine(ph.normal(), wi, ng).map(|cos| (wi, cos))
+}
+
+/// [`accept`]'s tests on a decoded photon (stored normal `np`, incoming direction `wi`): its
+/// landing cosine, or `None` when it landed on another surface or arrived from the other side.
+#[inline]
+fn landing_cosine(np: Vec3, wi: Vec3, ng: Vec3) -> Option<f32> {
+    (!(np.dot(ng) <= 0.1) && wi.dot(ng) > 0.0).then(|| wi.dot(np).max(MIN_LANDING_COSINE))
 }
 
 /// Precomputed irradiance for final gathering (Christensen, "Faster Photon Map Global
