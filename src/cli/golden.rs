@@ -14,6 +14,7 @@ use caustic::farm::part_meta::settings_hash;
 use caustic::pipeline::{SceneOverrides, prepare};
 use caustic::render::golden::{BlockTest, GoldenImage, GoldenMeta, PixelEstimates};
 use caustic::render::{RenderOptions, render};
+use caustic::settings::{IntegratorKind, SamplerKind};
 
 use super::golden_report::{self as report, Outcome};
 use super::{SceneArgs, print_warnings};
@@ -170,6 +171,12 @@ fn record(o: &SceneOverrides) -> Vec<(String, String)> {
             out.push((key.into(), v.to_string()));
         }
     }
+    if let Some(i) = o.integrator {
+        out.push(("integrator".into(), i.cli_name().into()));
+    }
+    if let Some(s) = o.sampler {
+        out.push(("sampler".into(), s.cli_name().into()));
+    }
     out
 }
 
@@ -183,6 +190,12 @@ fn combined(
 ) -> Result<SceneOverrides, Error> {
     let mut o = SceneOverrides::default();
     for (key, value) in &golden.overrides {
+        let unknown = || {
+            usage(format!(
+                "`{}`: its recorded flag `{key}={value}` names no such choice; run `caustic golden update` again",
+                path.display()
+            ))
+        };
         let num = || {
             value.parse::<u32>().map_err(|_| {
                 usage(format!(
@@ -198,6 +211,10 @@ fn combined(
             "spp" => o.samples_per_pixel = Some(num()?),
             "max_depth" => o.max_depth = Some(num()?),
             "caustic_photons" => o.caustic_photons = Some(num()?),
+            "integrator" => {
+                o.integrator = Some(IntegratorKind::from_name(value).ok_or_else(unknown)?)
+            }
+            "sampler" => o.sampler = Some(SamplerKind::from_name(value).ok_or_else(unknown)?),
             _ => {
                 return Err(usage(format!(
                     "`{}`: unknown recorded flag `{key}` (written by a newer caustic?); run `caustic golden update` again",
@@ -212,6 +229,8 @@ fn combined(
     o.samples_per_pixel = own.samples_per_pixel.or(o.samples_per_pixel);
     o.max_depth = own.max_depth.or(o.max_depth);
     o.caustic_photons = own.caustic_photons.or(o.caustic_photons);
+    o.integrator = own.integrator.or(o.integrator);
+    o.sampler = own.sampler.or(o.sampler);
     o.seed = Some(own.seed.unwrap_or(golden.seed.wrapping_add(1)));
     Ok(o)
 }

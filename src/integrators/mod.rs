@@ -11,6 +11,7 @@
 //! line in `integrators!` (plus its `IntegratorKind` variant).
 
 pub mod context;
+pub mod light_guide;
 pub mod path;
 pub mod photon;
 pub mod progressive_path;

@@ -6,13 +6,14 @@
 use glam::Vec3;
 
 use super::context::{Context, PathObserver};
+use super::light_guide::LightGuide;
 use super::photon::PhotonMap;
 use super::shadow::{LightConnection, RayCone, connect_light};
 use super::trace_log::{RayKind, ShadowRecord};
 use super::{LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Interaction, LightSampler, Medium, RenderScene, SurfacePoint};
+use crate::render_scene::{Interaction, Medium, RenderScene, SurfacePoint};
 use crate::shading::{BsdfAt, TransportMode};
 
 /// Bounces after which Russian roulette may end a path.
@@ -37,7 +38,7 @@ pub struct PathMaps<'m> {
 #[derive(Debug)]
 pub struct PathTracer<'a> {
     scene: &'a RenderScene,
-    lights: LightSampler,
+    lights: LightGuide,
     pixel_spread: f32,
     specular_splits: u32,
 }
@@ -89,12 +90,13 @@ fn power_heuristic(pdf: f32, other: f32) -> f32 {
 }
 
 impl<'a> PathTracer<'a> {
-    /// Prepares the light-selection table (lights chosen in proportion to their power).
+    /// Prepares the light choice of next-event estimation: learned per region by a pilot
+    /// ([`LightGuide::learn`]) when the scene has several lights, else by power.
     #[must_use]
     pub fn new(scene: &'a RenderScene) -> Self {
         Self {
             scene,
-            lights: LightSampler::new(&scene.lights),
+            lights: LightGuide::learn(scene),
             pixel_spread: scene.pixel_spread(),
             specular_splits: 0,
         }
@@ -241,7 +243,7 @@ impl<'a> PathTracer<'a> {
                                     let w = if specular {
                                         1.0
                                     } else {
-                                        let light_pdf = self.lights.pmf(i as usize)
+                                        let light_pdf = self.lights.pmf(prev_p, i as usize)
                                             * scene.lights[i as usize]
                                                 .pdf_li_hit(prev_p, -e.wo, e.sp.p, e.sp.ng);
                                         power_heuristic(prev_pdf, light_pdf)
@@ -279,7 +281,8 @@ impl<'a> PathTracer<'a> {
                 let u_light = cx.sampler.defer_1d();
                 let u_point = cx.sampler.defer_2d();
                 if local
-                    && let Some((index, pmf)) = self.lights.choose(|| cx.sampler.get_1d(u_light))
+                    && let Some((index, pmf)) =
+                        self.lights.choose(sp.p, || cx.sampler.get_1d(u_light))
                 {
                     let u = cx.sampler.get_2d(u_point);
                     let scatter = may_scatter && !read_global;
@@ -448,7 +451,8 @@ impl PathTracer<'_> {
                 1.0
             } else {
                 let wi = ray.dir.normalize();
-                let light_pdf = self.lights.pmf(i) * self.scene.lights[i].pdf_li(prev_p, wi);
+                let light_pdf =
+                    self.lights.pmf(prev_p, i) * self.scene.lights[i].pdf_li(prev_p, wi);
                 power_heuristic(prev_pdf, light_pdf)
             };
             sum += le * w;

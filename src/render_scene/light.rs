@@ -516,15 +516,22 @@ impl Light {
     /// the flux divides by that density. `None` when `aim` gives nothing, the direction leaves
     /// the surface inwards (no light goes there; the photon still counts as emitted, so the
     /// estimate stays unbiased) or the flux is not finite. A spot's aimed photon carries the
-    /// intensity along its direction (none outside the cone). Lights at infinity have no
-    /// point to aim from: their caustic photons are emitted as [`Light::emit_spread`] emits
-    /// them (the disc of the scene's bounding sphere), unaimed — unbiased, but only the
-    /// photons that meet a specular object land in the caustic map.
+    /// intensity along its direction (none outside the cone).
+    ///
+    /// Lights at infinity have no point to aim from: their direction is drawn as
+    /// [`Light::sample_le`] draws it (one `sampler` pair), then `cross(dir, sampler)` gives a
+    /// point the photon's line passes through and the density (1/m², over the plane
+    /// perpendicular to `dir`) of the line chosen — the projection of the targets instead of
+    /// the whole disc of the scene's bounding sphere that [`Light::emit_spread`] uses. The
+    /// photon starts where that line enters the bounding sphere's upstream plane, with flux
+    /// `L / (pdf_dir · pdf_line · n)`. Every caustic path's first segment meets a target, so
+    /// lines that meet none carry nothing the caustic map keeps: leaving them out is unbiased.
     #[must_use]
     pub fn emit_aimed(
         &self,
         sampler: &mut Sampler,
         aim: impl FnOnce(Vec3, &mut Sampler) -> Option<(Vec3, f32)>,
+        cross: impl FnOnce(Vec3, &mut Sampler) -> Option<(Vec3, f32)>,
         n: f32,
     ) -> Option<(Ray, Vec3)> {
         match *self {
@@ -583,8 +590,38 @@ impl Light {
                 (power.is_finite() && power.max_element() > 0.0)
                     .then(|| (Ray::new(s.position, dir), power))
             }
-            Light::Distant(_) | Light::Environment(_) => self.emit_spread(|| Vec3::Z, sampler, n),
+            Light::Distant(ref d) => Self::emit_crossing(
+                d.sample_le((0.5, 0.5), sampler.next_2d()),
+                d.scene,
+                sampler,
+                cross,
+                n,
+            ),
+            Light::Environment(ref e) => Self::emit_crossing(
+                e.sample_le((0.5, 0.5), sampler.next_2d()),
+                e.scene,
+                sampler,
+                cross,
+                n,
+            ),
         }
+    }
+
+    /// The photon of a light at infinity whose direction (and radiance, density) `e` holds,
+    /// along the line `cross` chooses (see [`Light::emit_aimed`]).
+    fn emit_crossing(
+        e: Option<EmissionSample>,
+        scene: SceneSphere,
+        sampler: &mut Sampler,
+        cross: impl FnOnce(Vec3, &mut Sampler) -> Option<(Vec3, f32)>,
+        n: f32,
+    ) -> Option<(Ray, Vec3)> {
+        let e = e?;
+        let (x, pdf_line) = cross(e.dir, sampler)?;
+        // Upstream of the whole bounding sphere, on the line through `x`.
+        let origin = x - e.dir * ((x - scene.center).dot(e.dir) + scene.radius);
+        let power = e.le / (pdf_line * e.pdf_dir * n);
+        (power.is_finite() && power.max_element() > 0.0).then(|| (Ray::new(origin, e.dir), power))
     }
 }
 

@@ -128,6 +128,38 @@ fn a_path_traced_golden_passes_a_path_ppm_render_of_the_same_scene() {
 }
 
 #[test]
+fn golden_check_renders_with_the_recorded_and_the_given_integrator() {
+    // A golden made with `--integrator path` is checked with `path` again when no flag is
+    // given, and with the integrator a flag names: Whitted (no indirect light) must fail
+    // against it, which it could not if the flag were dropped (as it once was).
+    let dir = tempfile::tempdir().expect("temp dir");
+    let gs = dir.path().to_str().expect("utf-8");
+    let size = ["--width", "24", "--height", "24", "--spp", "16"];
+    let mut update = vec!["golden", "update", "scenes/cornell.ron", "-o", gs];
+    update.extend(size);
+    update.extend(["--integrator", "path"]);
+    let out = common::caustic(&update);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let check = |extra: &[&str]| {
+        let mut args = vec!["golden", "check", "scenes/cornell.ron", "--golden", gs];
+        args.extend(extra);
+        let out = common::caustic(&args);
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+        )
+    };
+    let (code, stdout) = check(&[]);
+    assert_eq!(code, Some(0), "{stdout}");
+    let (code, stdout) = check(&["--integrator", "whitted"]);
+    assert_eq!(code, Some(3), "{stdout}");
+}
+
+#[test]
 fn the_command_line_exits_0_or_3_names_changed_settings_and_writes_the_error_image() {
     let dir = tempfile::tempdir().expect("temp dir");
     let g = dir.path().join("golden");

@@ -22,6 +22,7 @@ mod hard_cases;
 mod interrupt;
 mod kdtree;
 mod layers;
+mod light_guide;
 mod light_transport;
 mod lights;
 mod materials_scene;

@@ -92,7 +92,8 @@ impl LightEmitter {
         self.light.emit_spread(lattice, sampler, n)
     }
 
-    /// Photon `index` of a caustic map, aimed at `targets` ([`Light::emit_aimed`]): its ray
+    /// Photon `index` of a caustic map, aimed at `targets` ([`Light::emit_aimed`]; lights at
+    /// infinity along lines through the targets, [`CausticTargets::sample_crossing`]): its ray
     /// and flux, or `None` when the drawn direction leaves the light's surface inwards (no
     /// light goes there; the photon still counts as emitted, so the estimate stays unbiased).
     /// `cones` is scratch space.
@@ -109,7 +110,11 @@ impl LightEmitter {
             let u_pick = sampler.next_1d();
             sample_cones(cones, total, u_pick, sampler.next_2d())
         };
-        self.light.emit_aimed(sampler, aim, n)
+        let cross = |dir: Vec3, sampler: &mut Sampler| {
+            let u_pick = sampler.next_1d();
+            targets.sample_crossing(dir, u_pick, sampler.next_2d())
+        };
+        self.light.emit_aimed(sampler, aim, cross, n)
     }
 }
 
