@@ -43,6 +43,34 @@ impl AtomicWrite {
         tmp.persist(path).map_err(|e| e.error)?;
         Ok(())
     }
+
+    /// Writes several files as one step as far as a file system allows: each file's bytes go
+    /// to a temporary file in its folder and are synced, and only when every one of them is
+    /// written are they renamed over their targets, in order. A failure before the renames
+    /// (a full disk, a folder that cannot be written) leaves every target as it was and no
+    /// temporary file behind; only a rename itself failing can leave the earlier files
+    /// replaced and the later ones not.
+    ///
+    /// # Errors
+    /// The index in `files` of the file that failed, and the OS error (as `tempfile` reports
+    /// it).
+    pub fn write_all(&self, files: &[(&Path, &[u8])]) -> Result<(), (usize, std::io::Error)> {
+        let mut staged = Vec::with_capacity(files.len());
+        for (i, (path, bytes)) in files.iter().enumerate() {
+            let stage = || -> std::io::Result<tempfile::NamedTempFile> {
+                let mut tmp = self.temp_builder().tempfile_in(parent_dir(path))?;
+                tmp.write_all(bytes)?;
+                tmp.as_file().sync_all()?;
+                Ok(tmp)
+            };
+            // On an error the files staged so far are dropped, which removes them.
+            staged.push(stage().map_err(|e| (i, e))?);
+        }
+        for (i, (tmp, (path, _))) in staged.into_iter().zip(files).enumerate() {
+            tmp.persist(path).map_err(|e| (i, e.error))?;
+        }
+        Ok(())
+    }
 }
 
 /// The folder a file goes in (`.` for a bare file name).
@@ -75,6 +103,26 @@ mod tests {
         assert!(W.write(&dir.path().join("no/such/f.bin"), b"x").is_err());
         assert_eq!(parent_dir(Path::new("f.bin")), PathBuf::from("."));
         assert_eq!(parent_dir(Path::new("a/f.bin")), PathBuf::from("a"));
+    }
+
+    #[test]
+    fn several_files_are_replaced_only_when_all_of_them_are_written() {
+        let dir = tempfile::tempdir().expect("tmp");
+        let (a, b) = (dir.path().join("a.bin"), dir.path().join("b.bin"));
+        W.write(&a, b"old a").expect("written");
+        // The second file's folder is missing: the first may not change, and no temporary
+        // file may remain.
+        let blocked = dir.path().join("no/such/c.bin");
+        let files: [(&Path, &[u8]); 3] = [(&a, b"new a"), (&blocked, b"c"), (&b, b"b")];
+        let (at, _) = W.write_all(&files).expect_err("a missing folder");
+        assert_eq!(at, 1);
+        assert_eq!(std::fs::read(&a).expect("read"), b"old a");
+        assert_eq!(std::fs::read_dir(dir.path()).expect("ls").count(), 1);
+        W.write_all(&[(&a, b"new a"), (&b, b"new b")])
+            .expect("both written");
+        assert_eq!(std::fs::read(&a).expect("read"), b"new a");
+        assert_eq!(std::fs::read(&b).expect("read"), b"new b");
+        assert_eq!(std::fs::read_dir(dir.path()).expect("ls").count(), 2);
     }
 
     #[cfg(unix)]

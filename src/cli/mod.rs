@@ -8,6 +8,7 @@ mod error_image;
 mod farm;
 mod golden;
 mod golden_report;
+mod layers_flag;
 mod max_rmse;
 mod merge;
 mod photons;

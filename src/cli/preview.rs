@@ -45,7 +45,7 @@ pub struct SaveSettings {
     pub output: PathBuf,
     /// Write the mergeable `.part` film.
     pub part: bool,
-    /// EXR layers beside the image.
+    /// Layers beside the image: EXR channels, or pictures beside a PNG.
     pub layers: Vec<Layer>,
     /// `--compare`'s reference, read once at start.
     pub reference: Option<Reference>,
@@ -99,14 +99,6 @@ impl Settings {
             }
             OutputFormat::for_path(&output)?;
         }
-        let mut layers: Vec<Layer> = args.layers.iter().flatten().copied().collect();
-        layers.dedup();
-        if !layers.is_empty() && !matches!(OutputFormat::for_path(&output), Ok(OutputFormat::Exr)) {
-            return Err(usage(format!(
-                "--layers are written into an EXR file: the output `{}` must end in `.exr`",
-                output.display()
-            )));
-        }
         let shard = args
             .shard
             .as_deref()
@@ -130,6 +122,8 @@ impl Settings {
         for path in std::iter::once(&output).chain(&args.checkpoint) {
             caustic::render::output::check_writable(path)?;
         }
+        let layers = super::layers_flag::listed(&args.layers);
+        super::layers_flag::check(&output, &layers, args.checkpoint.as_deref())?;
         if args.threads == Some(0) {
             return Err(usage("--threads must be at least 1".into()));
         }

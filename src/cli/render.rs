@@ -17,9 +17,9 @@ use caustic::pipeline::prepare;
 use caustic::render::output::{OutputFormat, write_image};
 use caustic::render::passes::{CheckpointPlan, PassPlan, render_in_passes};
 use caustic::render::tonemap::Display;
-use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, write_layers};
+use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, write_with_layers};
 
-use super::{SceneArgs, count, print_warnings};
+use super::{SceneArgs, count, layers_flag, print_warnings};
 
 /// Samples per pixel a `--time` render may reach when `--spp` is not given.
 pub(super) const BUDGET_SPP_CAP: u32 = 1 << 20;
@@ -89,11 +89,14 @@ pub struct RenderArgs {
     /// what merging such parts gives.
     #[arg(long, value_name = "START..END", conflicts_with_all = ["compare", "shard"], value_parser = parse_samples)]
     pub(super) samples: Option<Range<u32>>,
-    /// Also write these layers into the `.exr` output beside the image, comma-separated:
-    /// specular (emitters and background seen directly or through mirrors and glass), direct
-    /// (light after one diffuse or glossy bounce), caustic (light through mirrors or glass onto
-    /// a diffuse surface), indirect (two or more bounces), variance (of each pixel's mean),
-    /// samples (per pixel); `all` for every one. The four light kinds add up to the image.
+    /// Also write these layers, comma-separated: specular (emitters and background seen
+    /// directly or through mirrors and glass), direct (light after one diffuse or glossy
+    /// bounce), caustic (light through mirrors or glass onto a diffuse surface), indirect (two
+    /// or more bounces), variance (of each pixel's mean), samples (per pixel); `all` for every
+    /// one. The four light kinds add up to the image. An `.exr` output holds them as channels
+    /// beside the image; a `.png` output gets each light kind as a picture of its own beside
+    /// it, tone-mapped like the image (`-o out.png --layers direct,caustic` also writes
+    /// `out.direct.png` and `out.caustic.png`; variance and samples need an `.exr`).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_layers)]
     pub(super) layers: Vec<Vec<Layer>>,
 }
@@ -259,13 +262,6 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         }
         OutputFormat::for_path(&output)?;
     }
-    if !args.layers.is_empty() && !matches!(OutputFormat::for_path(&output), Ok(OutputFormat::Exr))
-    {
-        return Err(Error::Usage(format!(
-            "--layers are written into an EXR file: the output `{}` must end in `.exr`",
-            output.display()
-        )));
-    }
     let shard = args
         .shard
         .as_deref()
@@ -290,6 +286,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     for path in std::iter::once(&output).chain(&args.checkpoint) {
         caustic::render::output::check_writable(path)?;
     }
+    let layers = layers_flag::listed(&args.layers);
+    let pictures = layers_flag::check(&output, &layers, args.checkpoint.as_deref())?;
     let region = args.region.as_deref().map(parse_region).transpose()?;
     let reference = super::max_rmse::load(args.compare.as_deref())?;
     if args.threads == Some(0) {
@@ -333,8 +331,6 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let samples_taken = samples.clone();
     let hash = is_part(&output).then(|| settings_hash(&prepared.render_scene));
     let terminal = !args.quiet && std::io::stderr().is_terminal();
-    let mut layers: Vec<Layer> = args.layers.iter().flatten().copied().collect();
-    layers.dedup();
     let options = RenderOptions {
         threads: args.threads,
         region,
@@ -430,7 +426,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         };
         out.sums.write(&output, &meta.to_text())?;
     } else if !layers.is_empty() {
-        write_layers(&out.sums, out.parts.as_deref(), &layers, &output)?;
+        write_with_layers(&out.sums, out.parts.as_deref(), &layers, &output, display)?;
     } else {
         write_image(&out.film, &output, display)?;
     }
@@ -476,6 +472,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         st.threads,
         if st.threads == 1 { "" } else { "s" }
     );
+    if !pictures.is_empty() && !args.quiet {
+        let names: Vec<String> = pictures
+            .iter()
+            .map(|p| format!("`{}`", p.display()))
+            .collect();
+        eprintln!("layers: {}", names.join(", "));
+    }
     if let Some(pr) = &st.progressive
         && !args.quiet
     {

@@ -3,7 +3,8 @@
 //! the pixel's mean and the sample count, so a user sees which part of an image is wrong (or
 //! still noisy) without rendering it again. Written as one EXR part whose channels are named
 //! `R, G, B` (the combined image, what viewers show first) and `<layer>.R/G/B` (or
-//! `samples.Y`), the OpenEXR convention for layers in one part.
+//! `samples.Y`), the OpenEXR convention for layers in one part. Beside a PNG image the light
+//! layers are pictures instead ([`super::layer_pictures`]).
 
 use std::path::Path;
 

@@ -4,6 +4,7 @@ pub mod exr;
 pub mod film;
 pub mod golden;
 pub mod job;
+pub mod layer_pictures;
 pub mod layers;
 pub mod options;
 pub mod output;
@@ -15,6 +16,7 @@ pub mod trace_pixel;
 
 pub use film::Film;
 pub use job::{RenderJob, render};
+pub use layer_pictures::{NotAPicture, layer_path, picture_layers, write_with_layers};
 pub use layers::{Layer, UnknownLayer, encode_layers, write_layers};
 pub use options::{
     ProgressiveStats, Region, RenderError, RenderOptions, RenderOutput, RenderStats,

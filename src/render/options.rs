@@ -40,8 +40,8 @@ pub struct RenderOptions {
     /// of disjoint ranges merge ([`crate::render::PixelSums::merge`]) into exactly the render
     /// of their union.
     pub samples: Option<Range<u32>>,
-    /// Also keep the radiance of each kind of light path ([`crate::integrators::LightPath`]) per pixel, for EXR
-    /// layers (`--layers`).
+    /// Also keep the radiance of each kind of light path ([`crate::integrators::LightPath`]) per
+    /// pixel, for the layers of `--layers` (EXR channels, or PNG pictures beside the image).
     pub light_paths: bool,
     /// Folder of the photon-map cache (`--photon-cache`): the photon integrator reads its maps
     /// from there when they were saved for this scene, and saves them there otherwise.

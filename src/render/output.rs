@@ -52,6 +52,15 @@ pub enum OutputError {
         /// Why.
         reason: String,
     },
+    /// The layers asked for cannot be written as pictures beside a PNG image (a statistics
+    /// layer, or a light-path layer the render did not keep).
+    #[error("error: cannot write the layer pictures of `{}`: {reason}", path.display())]
+    Pictures {
+        /// The image's path.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
     /// Encoding failed.
     #[error("error: cannot encode `{}`: {source}", path.display())]
     Encode {
@@ -234,6 +243,23 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         path: path.to_path_buf(),
         source: bare(source),
     })
+}
+
+/// Writes several files ([`AtomicWrite::write_all`]): every one goes to a temporary file beside
+/// its target first, and they are renamed into place only once all are written, so a failure
+/// while writing leaves every target as it was. Errors name the user's path of the file that
+/// failed.
+pub fn write_atomic_all(files: &[(PathBuf, Vec<u8>)]) -> Result<(), OutputError> {
+    let refs: Vec<(&Path, &[u8])> = files
+        .iter()
+        .map(|(p, b)| (p.as_path(), b.as_slice()))
+        .collect();
+    IMAGES
+        .write_all(&refs)
+        .map_err(|(i, source)| OutputError::Io {
+            path: files.get(i).map(|f| f.0.clone()).unwrap_or_default(),
+            source: bare(source),
+        })
 }
 
 #[cfg(test)]

@@ -236,9 +236,19 @@ mod cli {
         let dir = tempfile::tempdir().expect("tmp");
         let out = dir.path().join("out.png");
         std::fs::write(&out, KEEP).expect("seed the output");
+        // With layer pictures beside the image: none of them is written either.
+        let picture = dir.path().join("out.direct.png");
+        std::fs::write(&picture, KEEP).expect("seed a layer picture");
         let child = spawn(&render_args(
             out.to_str().expect("utf8"),
-            &["--width", "1024", "--height", "1024"],
+            &[
+                "--width",
+                "1024",
+                "--height",
+                "1024",
+                "--layers",
+                "direct,caustic",
+            ],
         ));
         std::thread::sleep(Duration::from_millis(1500));
         let (o, lag) = interrupt(child);
@@ -252,7 +262,12 @@ mod cli {
             String::from_utf8_lossy(&o.stdout)
         );
         assert_eq!(std::fs::read(&out).expect("output"), KEEP);
-        assert_eq!(files_in(dir.path()), ["out.png"], "no temporary files left");
+        assert_eq!(std::fs::read(&picture).expect("picture"), KEEP);
+        assert_eq!(
+            files_in(dir.path()),
+            ["out.direct.png", "out.png"],
+            "no temporary files left"
+        );
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! The page's save (`s`): writes the image so far the way `caustic render -o` writes its
-//! output (PNG or EXR, EXR with `--layers`, or the mergeable `.part` film), atomically, and runs
-//! `--compare` on it. The bytes equal those of `caustic render` for the same samples
-//! (`--samples 0..N`, N the samples per pixel taken when saving), since passes add up exactly.
+//! output (PNG or EXR; with `--layers` EXR channels or PNG pictures beside the image; or the
+//! mergeable `.part` film), atomically, and runs `--compare` on it. The bytes equal those of
+//! `caustic render` for the same samples (`--samples 0..N`, N the samples per pixel taken when
+//! saving), since passes add up exactly.
 
 use std::time::Instant;
 
@@ -9,7 +10,8 @@ use caustic::farm::PartMeta;
 use caustic::farm::part_meta::settings_hash;
 use caustic::pipeline::Prepared;
 use caustic::render::output::write_image;
-use caustic::render::{RenderJob, write_layers};
+use caustic::render::tonemap::Display;
+use caustic::render::{RenderJob, write_with_layers};
 
 use super::Settings;
 
@@ -31,6 +33,10 @@ pub fn save(
         return Err("not saved: no pass has finished yet".into());
     }
     let p = &prepared.render_scene.params;
+    let display = Display {
+        exposure: p.exposure,
+        tonemap: p.tonemap,
+    };
     let written = if s.part {
         let meta = PartMeta {
             hash: settings_hash(&prepared.render_scene),
@@ -47,16 +53,9 @@ pub fn save(
         };
         sums.write(output, &meta.to_text())
     } else if !s.layers.is_empty() {
-        write_layers(sums, job.parts(), &s.layers, output)
+        write_with_layers(sums, job.parts(), &s.layers, output, display)
     } else {
-        write_image(
-            &job.snapshot(),
-            output,
-            caustic::render::tonemap::Display {
-                exposure: p.exposure,
-                tonemap: p.tonemap,
-            },
-        )
+        write_image(&job.snapshot(), output, display)
     };
     written.map_err(|e| format!("not saved: {e}"))?;
     let mut message = format!(
