@@ -27,6 +27,11 @@ use glam::Vec3;
 
 use crate::sampling::SamplerKind;
 pub use crate::settings::{IntegratorKind, TextureFilter, Tonemap};
+
+/// The smallest camera spread, as a fraction of a pixel's angular size: the spread of one
+/// sample at 64 samples per pixel and above ([`RenderScene::pixel_spread`]), and the footprint
+/// bump and normal maps are always looked up at.
+pub const MIN_SPREAD_FRACTION: f32 = 0.125;
 use crate::shading::LobeFlags;
 
 /// Rendering parameters after command-line overrides.
@@ -144,11 +149,12 @@ impl RenderScene {
     }
 
     /// The angle one camera sample's footprint subtends: the pixel's angular size, shrunk by
-    /// `1/√spp` (down to ⅛) since samples are spread over the pixel. The ray cones that size
+    /// `1/√spp` (down to [`MIN_SPREAD_FRACTION`]) since samples are spread over the pixel. The ray cones that size
     /// texture footprints start from this.
     #[must_use]
     pub fn pixel_spread(&self) -> f32 {
         let pixel = 2.0 * self.camera.up.length() / self.params.height.max(1) as f32;
-        pixel * (1.0 / (self.params.samples_per_pixel.max(1) as f32).sqrt()).max(0.125)
+        pixel
+            * (1.0 / (self.params.samples_per_pixel.max(1) as f32).sqrt()).max(MIN_SPREAD_FRACTION)
     }
 }

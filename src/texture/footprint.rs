@@ -43,6 +43,16 @@ impl Footprint {
         self.major.length().max(self.minor)
     }
 
+    /// The footprint shrunk (or grown) uniformly by `s` ≥ 0 about its centre.
+    #[inline]
+    #[must_use]
+    pub fn scaled(&self, s: f32) -> Self {
+        Self {
+            major: self.major * s,
+            minor: self.minor * s,
+        }
+    }
+
     /// The footprint in the coordinates of a texture repeated `tile` times per axis: both of
     /// its axes (`major` and the width across it) are scaled per axis, and the longer of the
     /// two becomes the new long axis (a non-uniform tile can turn a footprint's short side into
