@@ -66,10 +66,39 @@ done
 (cd "$OUT" && sha256sum pool_ref.exr pool_ref_h1.exr pool_ref_h2.exr pool_path.exr)
 
 echo "residual, path (16384 spp) against the reference (path-ppm, 8192 passes):"
-"$caustic" compare "$OUT/pool_path.exr" "$OUT/pool_ref.exr" | head -1
+"$caustic" compare "$OUT/pool_path.exr" "$OUT/pool_ref.exr" | sed -n 1p
 for b in 8 32; do
   echo "  ${b}x${b} blocks: $("$PY" scripts/mitsuba/z8.py "$OUT/pool_path_h1.exr" "$OUT/pool_path_h2.exr" \
     "$OUT/pool_ref_h1.exr" --ref2 "$OUT/pool_ref_h2.exr" --light 1000 --block "$b")"
 done
 echo "the reference's own noise (its halves against each other):"
 "$PY" scripts/mitsuba/z8.py "$OUT/pool_ref_h1.exr" "$OUT/pool_ref_h2.exr" "$OUT/pool_ref.exr" --light 1000 --noise
+# The reference's own bias (progressive photon mapping blurs by the radius, which shrinks as
+# r_i² ∝ i^(−1/3) for α = 2/3): with bias b_i ∝ r_i², the mean over passes [0, N) has bias
+# ≈ 1.5·c·N^(−1/3); the halves (passes [0, N/2) and [N/2, N)) then differ by ≈ 0.52·B(N), so the whole
+# render's bias is B(N) ≈ 1.92 × (h1 − h2) in expectation. Printed per 8×8 block (where the
+# halves' noise is small): the RMS of (h1 − h2), its noise part (from the pixel noise of the
+# halves, which here includes the drift, so an upper bound), and the bias's range: 1.92× the
+# systematic rest (a lower bound) to 1.92× the whole RMS (an upper bound).
+echo "the reference's bias, estimated from the drift between its halves (8×8 block means):"
+"$PY" - "$OUT/pool_ref_h1.exr" "$OUT/pool_ref_h2.exr" <<'PYEOF'
+import sys
+import mitsuba as mi
+import numpy as np
+mi.set_variant("scalar_rgb")
+h1, h2 = (np.array(mi.Bitmap(p).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False))
+          .astype(np.float64)[..., :3] for p in sys.argv[1:3])
+b = 8
+H, W = (h1.shape[0] // b) * b, (h1.shape[1] // b) * b
+blocks = lambda x: x[:H, :W].reshape(H // b, b, W // b, b, 3).mean(axis=(1, 3))
+d = h1 - h2
+rms = np.sqrt((blocks(d) ** 2).mean())
+# Noise of a block mean of d: sum of its pixels' d^2 / 64^2 (d's pixel variance <= d^2).
+noise = np.sqrt((blocks(d**2) / (b * b)).mean())
+sys_part = np.sqrt(max(rms**2 - noise**2, 0.0))
+mean = ((h1 + h2) / 2).mean()
+lo, hi = 1.92 * sys_part, 1.92 * rms
+print(f"  rms(h1 - h2) = {rms:.5f}, its noise <= {noise:.5f}, systematic >= {sys_part:.5f}; "
+      f"estimated bias of the reference per 8x8 block: {lo:.5f} to {hi:.5f} RMS "
+      f"({lo / mean * 100:.2f} to {hi / mean * 100:.2f} % of the image mean {mean:.5f})")
+PYEOF

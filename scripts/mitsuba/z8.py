@@ -27,7 +27,9 @@ Options:
       glint_ref (issue #24's glint figure: at most 1.5 at every seed).
   --noise  also prints noise_rmse = sqrt(mean (A1 - A2)^2 / 4) and noise_relmse = mean
       ((A1 - A2)^2 / 4 / (r^2 + 0.01)): the RMSE and relMSE that M's own noise contributes
-      (for a reference given as two halves, its residual).
+      (for a reference given as two halves, its residual), and mean_ratio_sigma: the standard
+      deviation of mean_ratio from the noise of M (and of the reference, with --ref2), pixels
+      independent, a pixel's three channels not.
 Reads EXR with Mitsuba's Bitmap (the venv of ../shared/bench/mitsuba/setup.sh).
 """
 import argparse
@@ -81,7 +83,14 @@ def main():
     line = f"rmse={rmse:.5f} relmse={relmse:.5f} mean_ratio={ratio:.5f} z8={z8:.3f} blocks={ok.sum() // 3}"
     if args.noise:
         d2 = (a1 - a2) ** 2 / 4
-        line += f" noise_rmse={np.sqrt(d2.mean()):.5f} noise_relmse={(d2 / (r**2 + 0.01)).mean():.6f}"
+        # The image mean's standard deviation (pixels independent, a pixel's channels not):
+        # var(mean M) = sum_p (sum_c (A1 - A2)_pc)^2 / 4 / (3 N)^2, plus the reference's.
+        n = r.shape[0] * r.shape[1] * 3
+        var_m = (((a1 - a2).sum(axis=2)) ** 2).sum() / 4 / n**2
+        if args.ref2:
+            var_m += (((r2 - load(args.ref)).sum(axis=2)) ** 2).sum() / 4 / n**2
+        line += (f" noise_rmse={np.sqrt(d2.mean()):.5f} noise_relmse={(d2 / (r**2 + 0.01)).mean():.6f}"
+                 f" mean_ratio_sigma={np.sqrt(var_m) / r.mean():.5f}")
     if args.glint:
         sees = r.max(axis=2) >= args.light
         pad = np.pad(sees, 1)
