@@ -17,10 +17,11 @@
 #    the mean of its halves: √(mean (h1 − h2)² / 4)), and z8 of the path render against the
 #    reference with BOTH estimators' per-pixel variances from their halves
 #    (scripts/mitsuba/z8.py --ref2), 8×8 and 32×32 blocks.
-# Shards already present are kept (the script can be stopped and restarted). About 70 CPU-minutes
-# on a 2-vCPU AMD EPYC (both estimators about equal). Renders of the same commit, seed and flags
-# are the same bytes on any machine and thread count; the sha256s in docs/convergence.md are of
-# caustic 80ce43c.
+# Shards already present are kept (the script can be stopped and restarted). Cost: 3.7·10⁹ rays
+# (path-ppm) + 6.0·10⁹ (path), about an hour of one core for each estimator (made on a loaded
+# machine, so not a timing). Renders of the same commit, seed and flags are the same bytes on any
+# machine and thread count; the sha256s in docs/convergence.md are of caustic 80ce43c. The first
+# half of the reference (shards 1 + 2) is byte for byte the 4096-pass render `--spp 4096`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-../pool_ref}
