@@ -6,7 +6,7 @@
 # a QUIET machine: every figure is wall-clock. It prints its expected run time first.
 #
 #   scripts/convergence_slopes.sh [MAX_SECONDS] [OUT_DIR] [POOL_REF_DIR]
-#     MAX_SECONDS  256 (the issue's range, about 30 min), 64 (about 8 min) or any 4·2^k
+#     MAX_SECONDS  256 (the issue's range, about 25 min), 64 (about 7 min) or any 4·2^k
 #     OUT_DIR      default ../convergence_slopes_MAX (CSVs, SVG plots, JSON, the last images)
 #     POOL_REF_DIR default ../pool_ref (pool_ref.exr and its halves pool_ref_h{1,2}.exr)
 #   SKIP_MITSUBA=1 / SKIP_POOL=1 leave those parts out.
@@ -67,7 +67,7 @@ for k in range(max(lo, 2), max(hi, 2) + 1):
 EOF
 }
 # Expected run time: caustic Σ T per scene plus ~3 s per render (load, BVH, process); Mitsuba
-# about 2·MAX of rendering (the doubling series up to ≈ MAX) plus ~8 s per render.py call.
+# about 2·MAX of rendering (the doubling series up to ≈ MAX) plus ~3 s per render.py call.
 estimate() { # tau
   python3 - "$1" "$MAX" "${#times[@]}" "${SKIP_MITSUBA:-0}" "${SKIP_POOL:-0}" "$(levels "$1" | awk '{s += $3} END {print s}')" \
     "$(levels "$1" | awk -v t="$1" '{s += $1 * t} END {print s}')" <<'EOF'
@@ -75,7 +75,7 @@ import sys
 tau, mx, n, skm, skp, calls, mrender = sys.argv[1:]
 mx, n, calls, mrender = float(mx), int(n), int(calls), float(mrender)
 caustic = (2 * mx - 4 + 3 * n) * (1 if skp == "1" else 2)
-mitsuba = 0 if skm == "1" else mrender + 8 * calls + 15
+mitsuba = 0 if skm == "1" else mrender + 3 * calls + 15
 print(f"{(caustic + mitsuba) / 60:.0f} min (caustic {caustic / 60:.1f} min, Mitsuba {mitsuba / 60:.1f} min)")
 EOF
 }
