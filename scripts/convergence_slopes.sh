@@ -108,7 +108,7 @@ mitsuba_point() { # spp chunk_spp chunks csv
     local line t
     line=$("$PY" "$M/render.py" --spp "$c" --sampler ldsampler --threads 2 --seed "$j" -o "$OUT/m_${n}_$j.exr" 2>/dev/null)
     t=$(echo "$line" | grep -o 'render_s=[0-9.]*' | cut -d= -f2)
-    total=$(python3 -c "print($total + $t)")
+    total=$(python3 -c "print(round($total + $t, 3))")
     files+=("$OUT/m_${n}_$j.exr")
   done
   if [ "$k" -gt 1 ]; then
