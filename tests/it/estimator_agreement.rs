@@ -38,8 +38,11 @@ use crate::common::scene_files;
 const KNOWN_DISAGREEMENTS: [(&str, &str); 1] = [(
     "blob.ron",
     "path-ppm's image mean is ~2.4 % below path's (image z ≈ −4) with 1 000 caustic photons \
-     per pass; path-ppm before camera-path splitting was as dim (before and after agree \
-     within noise, mean ratio 1.005): unresolved",
+     per pass. Located (5 December, path 512 spp against path-ppm 64 spp at 64²): the smooth \
+     clay blob reads 6.5 % dark (block z −3.6); with 20 000 photons per pass that block \
+     agrees. Likely cause, not verified: few photons land there, the disc's radius approaches \
+     the blob's radius of curvature, and photons beyond its bend fail the normal test while the \
+     disc's area still counts them. Unresolved",
 )];
 
 #[test]
