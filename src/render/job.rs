@@ -274,6 +274,58 @@ impl<'a> RenderJob<'a> {
     /// When the region is empty or outside the image, or as [`RenderJob::render_pass`].
     pub fn render_region(&mut self, region: Region) -> Result<RenderOutput, RenderError> {
         check_region(region, self.scene.params.width, self.scene.params.height)?;
+        self.start_region(region);
+        self.render_pass(self.end - self.done)?;
+        Ok(self.take_output())
+    }
+
+    /// Renders every sample of each of `regions` (as [`RenderJob::render_region`] does, one
+    /// output per region, the same bytes), taking them pass by pass for a progressive
+    /// integrator: each pass's photon maps are traced once for all the regions instead of once
+    /// per region. For tools that render many small crops of one image (the doc-image test's
+    /// row strips of a path-ppm scene traced every pass's photons once per strip).
+    ///
+    /// # Errors
+    /// As [`RenderJob::render_region`], for the first region that fails.
+    pub fn render_regions(&mut self, regions: &[Region]) -> Result<Vec<RenderOutput>, RenderError> {
+        for &region in regions {
+            check_region(region, self.scene.params.width, self.scene.params.height)?;
+        }
+        if !self.integrator.is_progressive() {
+            return regions.iter().map(|&r| self.render_region(r)).collect();
+        }
+        // Each region's accumulators, swapped into the job for its sweeps.
+        let mut states: Vec<RegionState> = regions
+            .iter()
+            .map(|&region| {
+                self.start_region(region);
+                self.take_state()
+            })
+            .collect();
+        for sample in self.first..self.end {
+            if self.is_cancelled() {
+                return Err(RenderError::Cancelled);
+            }
+            let integrator = &mut self.integrator;
+            self.pool.install(|| integrator.begin_pass(sample));
+            for state in &mut states {
+                self.swap_state(state);
+                let swept = self.sweep(sample + 1);
+                self.swap_state(state);
+                swept?;
+            }
+        }
+        Ok(states
+            .iter_mut()
+            .map(|state| {
+                self.swap_state(state);
+                self.take_output()
+            })
+            .collect())
+    }
+
+    /// Makes `region` the job's, with empty accumulators and no samples taken.
+    fn start_region(&mut self, region: Region) {
         self.region = region;
         self.tiles = tile_grid(region);
         self.sums = PixelSums::new(region.width, region.height);
@@ -291,8 +343,36 @@ impl<'a> RenderJob<'a> {
             ..Default::default()
         };
         self.start = Instant::now();
-        self.render_pass(self.end - self.done)?;
-        Ok(self.take_output())
+    }
+
+    /// The job's current region and accumulators, moved out.
+    fn take_state(&mut self) -> RegionState {
+        // The job keeps empty accumulators of the same kinds, so the next region gets them too.
+        let layers = self.parts.is_some();
+        let splats = self
+            .splats
+            .is_some()
+            .then(|| FilmSplats::new((0, 0), 0, 0, layers));
+        RegionState {
+            region: self.region,
+            tiles: std::mem::take(&mut self.tiles),
+            sums: std::mem::replace(&mut self.sums, PixelSums::new(0, 0)),
+            splats: std::mem::replace(&mut self.splats, splats),
+            parts: std::mem::replace(&mut self.parts, layers.then(|| new_parts(0, 0))),
+            done: self.done,
+            stats: self.stats,
+        }
+    }
+
+    /// Exchanges the job's region and accumulators with `state`'s.
+    fn swap_state(&mut self, state: &mut RegionState) {
+        std::mem::swap(&mut self.region, &mut state.region);
+        std::mem::swap(&mut self.tiles, &mut state.tiles);
+        std::mem::swap(&mut self.sums, &mut state.sums);
+        std::mem::swap(&mut self.splats, &mut state.splats);
+        std::mem::swap(&mut self.parts, &mut state.parts);
+        std::mem::swap(&mut self.done, &mut state.done);
+        std::mem::swap(&mut self.stats, &mut state.stats);
     }
 
     /// Takes the remaining samples in one pass and returns the finished film.
@@ -346,6 +426,17 @@ impl<'a> RenderJob<'a> {
             .as_deref()
             .is_some_and(|c| c.load(Ordering::Relaxed))
     }
+}
+
+/// One region's part of a [`RenderJob::render_regions`] call: what the job holds per region.
+struct RegionState {
+    region: Region,
+    tiles: Vec<Region>,
+    sums: PixelSums,
+    splats: Option<FilmSplats>,
+    parts: Option<Vec<PixelSums>>,
+    done: u32,
+    stats: RenderStats,
 }
 
 impl Drop for RenderJob<'_> {

@@ -130,3 +130,58 @@ fn ron_and_toml_twins_parse_to_the_same_scene() {
         .scene;
     assert_eq!(a, b);
 }
+
+#[test]
+fn regions_rendered_together_equal_each_rendered_alone() {
+    // `RenderJob::render_regions` takes a progressive integrator's passes once for all the
+    // regions (the doc-image test's strips); the bytes must be those of each region's own
+    // render, with the layers, for path-ppm (progressive, with camera-path splits and splats
+    // of nothing) and for path.
+    use caustic::pipeline::prepare;
+    use caustic::render::RenderJob;
+    use caustic::settings::IntegratorKind;
+    let regions = [
+        Region {
+            x: 3,
+            y: 0,
+            width: 30,
+            height: 2,
+        },
+        Region {
+            x: 0,
+            y: 16,
+            width: 40,
+            height: 2,
+        },
+        Region {
+            x: 11,
+            y: 31,
+            width: 5,
+            height: 1,
+        },
+    ];
+    for integrator in [IntegratorKind::PathPpm, IntegratorKind::Path] {
+        let mut o = common::small(40, 32, 3);
+        o.integrator = Some(integrator);
+        let p = prepare(&common::root().join("scenes/refraction.ron"), &o).expect("scene");
+        let options = RenderOptions {
+            light_paths: true,
+            ..Default::default()
+        };
+        let mut together = RenderJob::new(&p.render_scene, &options).expect("job");
+        let outs = together.render_regions(&regions).expect("renders");
+        assert_eq!(outs.len(), regions.len());
+        for (region, out) in regions.iter().zip(&outs) {
+            let alone = caustic::render::render(
+                &p.render_scene,
+                &RenderOptions {
+                    region: Some(*region),
+                    ..options.clone()
+                },
+            )
+            .expect("render");
+            assert_eq!(out.sums, alone.sums, "{integrator:?} {region:?}");
+            assert_eq!(out.parts, alone.parts, "{integrator:?} {region:?}");
+        }
+    }
+}

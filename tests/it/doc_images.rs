@@ -259,16 +259,22 @@ fn compare_rows(e: &Entry, images: &[RgbImage]) -> Vec<Comparison> {
     };
     let mut job = RenderJob::new(&prepared.render_scene, &options)
         .unwrap_or_else(|err| panic!("{at}: {err}"));
-    for y0 in (0..crop.height).step_by(STRIDE as usize) {
-        let region = Region {
+    // Every strip in one call: a progressive integrator traces each pass's photons once for
+    // all of them.
+    let strips: Vec<Region> = (0..crop.height)
+        .step_by(STRIDE as usize)
+        .map(|y0| Region {
             x: crop.x,
             y: crop.y + y0,
             width: crop.width,
             height: STRIP.min(crop.height - y0),
-        };
-        let out = job
-            .render_region(region)
-            .unwrap_or_else(|err| panic!("{at}: {err}"));
+        })
+        .collect();
+    let outs = job
+        .render_regions(&strips)
+        .unwrap_or_else(|err| panic!("{at}: {err}"));
+    for (region, out) in strips.iter().zip(outs) {
+        let y0 = region.y - crop.y;
         let parts = out.parts.as_deref().unwrap_or_default();
         let layer_films = call.layers.iter().map(|&kind| {
             parts
