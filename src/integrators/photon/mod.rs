@@ -31,14 +31,13 @@ pub use passes::{PassTotals, ProgressivePhotons, RadiusSchedule};
 use glam::Vec3;
 
 use super::context::{Context, PathObserver};
+use super::light_guide::LightGuide;
 use super::shadow::{RayCone, connect_light};
 use super::trace_log::RayKind;
 use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{
-    Interaction, LightSampler, Medium, RenderScene, SurfaceHit, SurfacePoint,
-};
+use crate::render_scene::{Interaction, Medium, RenderScene, SurfaceHit, SurfacePoint};
 use crate::sampling::Sampler;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
@@ -105,7 +104,8 @@ const SHORT_GATHER_BOUNCES: u32 = 3;
 #[derive(Debug)]
 pub struct PhotonMapper<'a> {
     scene: &'a RenderScene,
-    lights: LightSampler,
+    /// Next-event estimation's light choice, the path tracer's ([`LightGuide`]).
+    lights: LightGuide,
     pixel_spread: f32,
     /// Final-gather rays per camera hit (0: read the global map directly).
     final_gather: u32,
@@ -125,7 +125,7 @@ impl<'a> PhotonMapper<'a> {
     ) -> Self {
         Self {
             scene,
-            lights: LightSampler::new(&scene.lights),
+            lights: LightGuide::learn(scene),
             pixel_spread: scene.pixel_spread(),
             final_gather: scene.params.photons.final_gather,
             maps: cache::build_or_load(scene, cache, cancel),
@@ -393,7 +393,8 @@ impl<'a> PhotonMapper<'a> {
         (r, note)
     }
 
-    /// Direct light at a vertex by one shadow ray to a light chosen in proportion to power.
+    /// Direct light at a vertex by one shadow ray to a light chosen as the path tracer chooses
+    /// it (per voxel, learned by a pilot; by power where it learned nothing).
     fn direct(
         &self,
         sp: &SurfacePoint,
@@ -405,7 +406,7 @@ impl<'a> PhotonMapper<'a> {
     ) -> Vec3 {
         let u_light = sampler.next_1d();
         let u_point = sampler.next_2d();
-        let Some((index, pmf)) = self.lights.sample(u_light) else {
+        let Some((index, pmf)) = self.lights.choose(sp.p, || u_light) else {
             return Vec3::ZERO;
         };
         match connect_light(self.scene, index, sp, &bsdf.at(wo, fr), u_point, counters) {
