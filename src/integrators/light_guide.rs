@@ -1,5 +1,7 @@
 //! Next-event estimation's light choice, made per region of space from what each light
-//! actually delivers there, learned once per render from a pilot.
+//! actually delivers there, learned once per render from a pilot. Used by every integrator
+//! that samples one light per shading point (`path` and so `path-ppm`, `ppm` and the default
+//! estimator; `photon`'s direct light); Whitted lights every point from every light.
 //!
 //! Choosing lights by power alone ([`LightSampler`]) spends most shadow rays on the brightest
 //! light even where it is hidden: in the bathroom the sun and the sky (whose power counts over
