@@ -22,7 +22,7 @@
 # of equal power-of-4 counts ≤ 1024 (seeds 1, 2, …); its time is the sum of their `render_s`
 # (kernels warm, process start excluded). Caustic and Mitsuba renders alternate, level by level.
 # RMSE everywhere is `caustic compare`'s (√ mean (a − b)² over pixels and channels).
-# Slopes: least squares of ln RMSE against ln time over all points (scripts/mitsuba/loglog_plot.py),
+# Slopes: least squares of ln RMSE against ln time over all points (`caustic plot`),
 # also with the reference's own noise σ taken out (√(RMSE² − σ²)): σ = 0.005 for the Mitsuba
 # reference (its README), and for the pool reference the RMSE of its halves' mean noise.
 # Quick check that it runs: scripts/convergence_slopes.sh 8
@@ -152,15 +152,15 @@ echo
 echo "slopes of RMSE against time (target for caustic: ≤ −0.4 on both scenes):"
 curves=("caustic default=$OUT/caustic_cbox.csv")
 [ "${SKIP_MITSUBA:-0}" = 1 ] || curves+=("Mitsuba 3 path+ldsampler=$OUT/mitsuba_cbox.csv")
-python3 scripts/mitsuba/loglog_plot.py "$OUT/cbox.svg" "${curves[@]}" --ref-noise "$CB_REF_NOISE" \
-  --title "cbox_caustic 256x256, 2 threads: RMSE against render time" --json "$OUT/cbox_slopes.json"
+"$caustic" plot "${curves[@]}" -o "$OUT/cbox" --ref-noise "$CB_REF_NOISE" \
+  --title "cbox_caustic 256x256, 2 threads: RMSE against render time"
 if [ "${SKIP_POOL:-0}" != 1 ]; then
   pool_noise=0
   if [ -f "$POOL_REF_DIR/pool_ref_h1.exr" ] && [ -f "$POOL_REF_DIR/pool_ref_h2.exr" ]; then
     pool_noise=$("$PY" scripts/mitsuba/z8.py "$POOL_REF_DIR/pool_ref_h1.exr" "$POOL_REF_DIR/pool_ref_h2.exr" "$POOL_REF" \
       --light 1000 --noise | grep -o 'noise_rmse=[0-9.]*' | cut -d= -f2)
   fi
-  python3 scripts/mitsuba/loglog_plot.py "$OUT/pool.svg" "caustic default=$OUT/caustic_pool.csv" --ref-noise "$pool_noise" \
-    --title "pool 320x240, 2 threads: RMSE against render time" --json "$OUT/pool_slopes.json"
+  "$caustic" plot "caustic default=$OUT/caustic_pool.csv" -o "$OUT/pool" --ref-noise "$pool_noise" \
+    --title "pool 320x240, 2 threads: RMSE against render time"
 fi
-echo "wrote into $OUT: the CSVs (seconds,rmse,rel_mse,spp,…), the SVG plots, the slopes as JSON, machine.txt and the images"
+echo "wrote into $OUT: the CSVs (seconds,rmse,rel_mse,spp,…), the plots (SVG, PNG), the slopes as JSON, machine.txt and the images"

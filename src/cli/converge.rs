@@ -77,7 +77,7 @@ struct Series {
 /// Least-squares slope of log y against log x over the points where both are positive and
 /// finite; `None` with fewer than two such points or no spread in x.
 #[must_use]
-fn log_log_slope(points: impl Iterator<Item = (f64, f64)>) -> Option<f64> {
+pub(super) fn log_log_slope(points: impl Iterator<Item = (f64, f64)>) -> Option<f64> {
     let v: Vec<(f64, f64)> = points
         .filter(|(x, y)| x.is_finite() && y.is_finite() && *x > 0.0 && *y > 0.0)
         .map(|(x, y)| (x.ln(), y.ln()))
@@ -233,7 +233,7 @@ fn measure(
     Ok((series, out.film, exposure))
 }
 
-fn fmt_slope(s: Option<f64>) -> String {
+pub(super) fn fmt_slope(s: Option<f64>) -> String {
     s.map_or_else(|| "n/a".into(), |s| format!("{s:.3}"))
 }
 

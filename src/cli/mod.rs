@@ -15,6 +15,7 @@ mod photons;
 mod pixel_font;
 mod plot;
 mod plot_backend;
+mod plot_csv;
 mod preview;
 mod render;
 
@@ -57,6 +58,9 @@ enum Command {
     /// samples per pixel until its share of `--time` is spent; writes DIR/convergence.csv,
     /// .json (with the machine and settings), .png and .svg (log-log RMSE against time).
     Converge(converge::ConvergeArgs),
+    /// Draw `converge`'s log-log plot of RMSE against time, with fitted slopes, for curves read
+    /// from CSV files (`seconds,rmse` columns): another renderer's beside caustic's.
+    Plot(plot_csv::PlotArgs),
     /// Draw the photon maps over a dim render of the scene (caustic photons orange, global
     /// blue, brighter where more power landed).
     Photons(photons::PhotonsArgs),
@@ -88,6 +92,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::DebugPixel(args) => debug_pixel::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Converge(args) => converge::run(&args),
+        Command::Plot(args) => plot_csv::run(&args),
         Command::Photons(args) => photons::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::Farm(args) => farm::run(&args),

@@ -484,3 +484,59 @@ fn integrator_names_are_accepted_in_both_spellings_everywhere() {
         );
     }
 }
+
+#[test]
+fn plot_draws_curves_from_csv_files_with_their_slopes() {
+    // Two curves of known power laws: RMSE = 0.1·t^−½ and 0.2·t^−¼ (by hand: slopes −0.5 and
+    // −0.25); with the reference's noise σ = 0.01 taken out of the first, √(RMSE² − σ²) is
+    // steeper than −0.5. A CSV without a `seconds` column is refused with its file and line.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let write = |name: &str, f: &dyn Fn(f64) -> f64| {
+        let mut text = String::from("seconds,rmse,spp\n");
+        for t in [1.0f64, 4.0, 16.0, 64.0] {
+            text.push_str(&format!("{t},{},8\n", f(t)));
+        }
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).expect("csv");
+        p.to_string_lossy().into_owned()
+    };
+    let a = write("a.csv", &|t| 0.1 / t.sqrt());
+    let b = write("b.csv", &|t| 0.2 / t.powf(0.25));
+    let out = dir.path().join("plot");
+    let o = out.to_str().expect("utf-8");
+    let run = common::caustic(&[
+        "plot",
+        &format!("ours={a}"),
+        &format!("theirs={b}"),
+        "-o",
+        o,
+        "--ref-noise",
+        "0.01",
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(
+        stdout.contains("ours: 4 points") && stdout.contains("slope -0.500"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("theirs: 4 points") && stdout.contains("slope -0.250"),
+        "{stdout}"
+    );
+    for ext in ["svg", "png", "json"] {
+        assert!(out.with_extension(ext).is_file(), "{ext}");
+    }
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, "time,rmse\n1,0.1\n").expect("csv");
+    let run = common::caustic(&["plot", &format!("x={}", bad.display()), "-o", o]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("bad.csv:1") && stderr.contains("seconds"),
+        "{stderr}"
+    );
+}
