@@ -32,6 +32,23 @@ pub struct PathMaps<'m> {
     /// `global` holds caustic photons too (landings after any first bounce): the vertex that
     /// reads it does not read `caustic`.
     pub global_has_caustics: bool,
+    /// The maps were traced with near-specular surfaces as specular ones (GGX α up to this,
+    /// [`crate::integrators::photon::MapSet::near_specular`]): such a vertex reads no
+    /// map and is not a diffuse bounce; it samples lights as any glossy vertex does, unless a
+    /// vertex before it read the caustic map with only specular and near-specular bounces
+    /// between (then the map holds that light).
+    pub near_specular: Option<f32>,
+    /// Per light: whether `caustic` holds its caustic photons (a light given no caustic photons
+    /// this pass leaves its caustics to the camera paths). Empty: none.
+    pub caustic_lights: &'m [bool],
+}
+
+impl PathMaps<'_> {
+    /// True if the caustic map carries light `index`'s caustics.
+    #[inline]
+    fn carries(&self, index: usize) -> bool {
+        self.caustic.is_some() && self.caustic_lights.get(index).copied().unwrap_or(false)
+    }
 }
 
 /// The path tracer over a compiled scene.
@@ -60,9 +77,10 @@ struct Branch {
     prev_pdf: f32,
     prev_p: Vec3,
     diffuse_bounces: u32,
-    /// Delta bounces since the last non-delta one (`None` before any): an emitter hit with at
-    /// least one is a caustic path, which `caustics` accounts for when it was read at that
-    /// non-delta vertex (`map_read`).
+    /// Delta (and near-specular, [`PathMaps::near_specular`]) bounces since the last other
+    /// non-delta one (`None` before any): an emitter hit with at least one is a caustic path,
+    /// which the caustic map accounts for when it was read at that non-delta vertex
+    /// (`map_read`).
     since_local: Option<u32>,
     map_read: bool,
     /// After a non-delta bounce from a vertex that read the global map, the emitters' light is
@@ -214,9 +232,12 @@ impl<'a> PathTracer<'a> {
                         .is_some_and(|env| e.light == Some(env.light)),
                     Interaction::Surface(_) => false,
                 };
-                if escaping && !background_only && !(map_read && since_local.is_some_and(|n| n > 0))
-                {
-                    let sun = self.suns(&ray, specular, prev_pdf, prev_p);
+                // After a vertex that read the caustic map and at least one specular bounce, the
+                // map holds the light of the lights it carries.
+                let in_map =
+                    |i: usize| map_read && since_local.is_some_and(|n| n > 0) && maps.carries(i);
+                if escaping && !background_only {
+                    let sun = self.suns(&ray, specular, prev_pdf, prev_p, in_map);
                     let via = since_local.is_some_and(|n| n > 0);
                     l.add(LightPath::classify(diffuse_bounces, via), beta * sun);
                 }
@@ -234,7 +255,7 @@ impl<'a> PathTracer<'a> {
                         let le = match e.light {
                             None => Vec3::ZERO,
                             Some(_) if background_only => Vec3::ZERO,
-                            Some(_) if map_read && since_local.is_some_and(|n| n > 0) => Vec3::ZERO,
+                            Some(i) if in_map(i as usize) => Vec3::ZERO,
                             Some(i) => {
                                 let le = e.le(scene);
                                 if le == Vec3::ZERO {
@@ -272,7 +293,11 @@ impl<'a> PathTracer<'a> {
                 let at = bsdf.at(wo, &fr);
                 let may_scatter = diffuse_bounces < params.diffuse_depth;
                 let local = bsdf.has_local() && !background_only;
-                let read_global = local
+                // A near-specular vertex is part of caustic paths: after a vertex that read the
+                // caustic map, the light it passes on is in that map.
+                let near = maps.near_specular.is_some_and(|a| bsdf.is_near_specular(a));
+                let reads = local && !near;
+                let read_global = reads
                     && may_scatter
                     && maps.global.is_some()
                     && diffuse_bounces == maps.global_at;
@@ -283,13 +308,14 @@ impl<'a> PathTracer<'a> {
                 if local
                     && let Some((index, pmf)) =
                         self.lights.choose(sp.p, || cx.sampler.get_1d(u_light))
+                    && !(near && map_read && maps.carries(index))
                 {
                     let u = cx.sampler.get_2d(u_point);
                     let scatter = may_scatter && !read_global;
                     let c = self.direct(sp, &at, index, pmf, u, scatter, cx, node);
                     l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
                 }
-                let read_caustic = local
+                let read_caustic = reads
                     && may_scatter
                     && maps.caustic.is_some()
                     && !(read_global && maps.global_has_caustics);
@@ -380,8 +406,10 @@ impl<'a> PathTracer<'a> {
                         cx.observer.note(node, "diffuse depth reached");
                         break;
                     }
-                    diffuse_bounces += 1;
+                    // A near-specular bounce is a specular one for the maps' parts.
+                    diffuse_bounces += u32::from(!near);
                 }
+                let specular_like = s.delta || near;
                 beta *= s.weight;
                 if s.transmitted {
                     eta_scale *= s.eta_scale;
@@ -410,7 +438,7 @@ impl<'a> PathTracer<'a> {
                     cone.scatter(&ray, hit.t, s.pdf)
                 };
                 specular = s.delta;
-                since_local = if s.delta {
+                since_local = if specular_like {
                     since_local.map(|n| n + 1)
                 } else {
                     map_read = read_caustic;
@@ -443,10 +471,18 @@ impl PathTracer<'_> {
     /// Radiance of the suns (distant lights with a disc) that the escaping `ray` sees, each
     /// weighted as an emitter hit: fully after a delta bounce (`specular`) or from the camera,
     /// else by the power heuristic between the BSDF sample that chose the ray (`prev_pdf`,
-    /// from `prev_p`) and the light's own samples.
-    fn suns(&self, ray: &Ray, specular: bool, prev_pdf: f32, prev_p: Vec3) -> Vec3 {
+    /// from `prev_p`) and the light's own samples. Suns for which `in_map` is true are left
+    /// out (the caustic map holds their light).
+    fn suns(
+        &self,
+        ray: &Ray,
+        specular: bool,
+        prev_pdf: f32,
+        prev_p: Vec3,
+        in_map: impl Fn(usize) -> bool,
+    ) -> Vec3 {
         let mut sum = Vec3::ZERO;
-        for (i, le) in self.scene.suns_seen(ray) {
+        for (i, le) in self.scene.suns_seen(ray).filter(|&(i, _)| !in_map(i)) {
             let w = if specular {
                 1.0
             } else {

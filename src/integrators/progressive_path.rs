@@ -25,6 +25,7 @@ use super::photon::{MapSet, ProgressivePhotons};
 use super::{PathTracer, Radiance};
 use crate::geometry::Ray;
 use crate::render_scene::RenderScene;
+use crate::shading::NEAR_SPECULAR_ALPHA;
 
 /// Specular vertices at which the progressive integrators split their camera paths
 /// ([`PathTracer::with_specular_splits`]): at most 4 branches per camera sample. Light reaching
@@ -41,6 +42,10 @@ pub struct ProgressivePath<'a> {
     global_at: u32,
     /// The global map holds caustics too (`path-ppm`).
     global_has_caustics: bool,
+    /// The maps' near-specular width ([`MapSet::near_specular`]).
+    near_specular: Option<f32>,
+    /// Per light: the current pass's caustic map holds its photons.
+    caustic_lights: Vec<bool>,
 }
 
 impl<'a> ProgressivePath<'a> {
@@ -52,6 +57,7 @@ impl<'a> ProgressivePath<'a> {
             caustic: true,
             global: true,
             global_any_bounce: false,
+            near_specular: Some(NEAR_SPECULAR_ALPHA),
         };
         Self::new(scene, set, 0)
     }
@@ -64,6 +70,7 @@ impl<'a> ProgressivePath<'a> {
             caustic: true,
             global: scene.params.photons.global > 0,
             global_any_bounce: true,
+            near_specular: Some(NEAR_SPECULAR_ALPHA),
         };
         Self::new(scene, set, 1)
     }
@@ -74,6 +81,8 @@ impl<'a> ProgressivePath<'a> {
             path: PathTracer::new(scene).with_specular_splits(SPECULAR_SPLITS),
             global_at,
             global_has_caustics: set.global_any_bounce,
+            near_specular: set.near_specular,
+            caustic_lights: Vec::new(),
         }
     }
 
@@ -97,6 +106,10 @@ impl<'a> ProgressivePath<'a> {
     /// Makes the maps those of pass `pass` (the sample index about to be taken).
     pub fn begin_pass(&mut self, pass: u32) {
         self.photons.begin_pass(pass);
+        let m = self.photons.maps();
+        self.caustic_lights.clear();
+        self.caustic_lights
+            .extend(m.summary.caustic.iter().map(|c| c.emitted > 0));
     }
 
     /// Radiance along camera ray `ray` from the current pass's maps.
@@ -107,6 +120,8 @@ impl<'a> ProgressivePath<'a> {
             global: m.global.as_ref(),
             global_at: self.global_at,
             global_has_caustics: self.global_has_caustics,
+            near_specular: self.near_specular,
+            caustic_lights: &self.caustic_lights,
         };
         self.path.li_with_maps(maps, ray, cx)
     }

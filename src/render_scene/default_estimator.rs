@@ -4,10 +4,12 @@
 //! The choice is made once, when the scene is compiled, from what the scene can do:
 //!
 //! - A **specular caster** is an object whose material has a delta (mirror or smooth
-//!   dielectric) part, asked through `Bsdf::has_delta` — exactly the objects the caustic
-//!   photons are aimed at (`integrators::photon::aim`), so "no caster" means "an empty caustic
-//!   map". Only such an object can focus light onto a diffuse surface (a caustic: light →
-//!   specular⁺ → diffuse), the paths a path tracer finds only by chance.
+//!   dielectric) part, asked through `Bsdf::has_delta`, or is near-specular (a glossy metal or
+//!   glass at most [`NEAR_SPECULAR_ALPHA`] wide, `Bsdf::is_near_specular`) — exactly the objects
+//!   the progressive integrators' caustic photons are aimed at (`integrators::photon::aim`), so
+//!   "no caster" means "an empty caustic map". Only such an object can focus light onto a
+//!   diffuse surface (a caustic: light → specular⁺ → diffuse), the paths a path tracer finds
+//!   only by chance.
 //! - With at least one caster the default is `path-ppm` (path tracing whose caustics come from
 //!   a progressive caustic photon map, Knaus & Zwicker 2011): consistent, and free of the
 //!   caustic fireflies of path tracing.
@@ -21,6 +23,7 @@
 //! line states them (`--set photons.caustic=…`, `--caustic-photons`, …), which then win.
 
 use super::{IntegratorKind, ObjectInfo, SurfaceMaterial};
+use crate::shading::NEAR_SPECULAR_ALPHA;
 
 /// Caustic photons emitted per pass per image pixel. The issue's measurement on the caustic
 /// Cornell box (256 × 256 pixels) found 20 000 per pass (≈ 0.3 per pixel) the best of the
@@ -73,7 +76,7 @@ impl PassPhotons {
 /// `RenderParams::default_estimator` for the summary line).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DefaultEstimator {
-    /// Objects whose material has a mirror or glass part.
+    /// Objects whose material has a mirror or glass part or is near-specular.
     pub specular_casters: usize,
     /// The per-pass photon budget chosen (`None` when the choice is `path`, or when the command
     /// line stated the counts, which then stand as given).
@@ -93,7 +96,11 @@ impl DefaultEstimator {
         let specular_casters = objects
             .iter()
             .filter_map(|o| o.material)
-            .filter(|&m| material(m as usize).is_some_and(|m| m.bsdf.has_delta()))
+            .filter(|&m| {
+                material(m as usize).is_some_and(|m| {
+                    m.bsdf.has_delta() || m.bsdf.is_near_specular(NEAR_SPECULAR_ALPHA)
+                })
+            })
             .count();
         if specular_casters == 0 {
             let choice = Self {

@@ -36,6 +36,15 @@ pub use super::scattering::{
 use super::specular_conductor::SpecularConductor;
 use super::specular_reflection::{SpecularReflection, mirror_above};
 
+/// The widest GGX α (perceptual roughness 0.4) at which the progressive integrators
+/// (`integrators::progressive_path`) treat a glossy surface with no diffuse part as specular
+/// ([`Bsdf::is_near_specular`]): light it throws onto diffuse surfaces (a glossy caustic: the sun's highlight on brushed
+/// chrome lighting a wall) comes from the caustic map, whose photons pass through it, instead
+/// of from camera paths that meet the light's sharp highlight by chance (issue #27: the bath's
+/// worst pixels). Below this width the highlight is sharp enough for that chance to be rare;
+/// wider lobes are left to camera paths, which find their broad highlights easily.
+pub const NEAR_SPECULAR_ALPHA: f32 = 0.16;
+
 /// Parts of the mixture (each a weight and its lobes).
 pub(super) const PARTS: usize = 3;
 /// A compiled material's scattering function: a tint (the colour; texture lookups replace it)
@@ -63,6 +72,10 @@ pub struct Bsdf {
     choice_matters: bool,
     /// [`Bsdf::is_diffuse_only`], derived likewise (asked at every final-gather landing).
     diffuse_only: bool,
+    /// The widest GGX α of the microfacet lobes when every lobe of non-zero weight is a delta
+    /// or a microfacet lobe and at least one is a microfacet lobe (`None` otherwise), derived
+    /// likewise ([`Bsdf::is_near_specular`]).
+    glossy_alpha: Option<f32>,
 }
 
 impl std::fmt::Debug for Bsdf {
@@ -183,6 +196,7 @@ impl Bsdf {
             flags,
             choice_matters: choice_matters(&parts, tint),
             diffuse_only: diffuse_only(&parts, tint),
+            glossy_alpha: glossy_alpha(&parts),
         }
     }
 
@@ -333,6 +347,19 @@ impl Bsdf {
     #[must_use]
     pub fn is_diffuse_only(&self) -> bool {
         self.diffuse_only
+    }
+
+    /// True when the BSDF is **near-specular** at GGX width `max_alpha`: it has a microfacet
+    /// (rough conductor or rough dielectric) lobe, none wider than `max_alpha` (α = r², r the
+    /// scene's perceptual roughness), and no diffuse or Phong lobe of non-zero weight. The
+    /// progressive integrators treat such a surface (brushed chrome, say) as part of caustic
+    /// paths: photons pass through it as through a mirror, and camera paths leave to the caustic
+    /// map what reaches a diffuse surface by way of it (a glossy caustic: the sun's highlight on
+    /// a chrome tap thrown onto a wall), which a camera path finds only by rare chance.
+    #[inline]
+    #[must_use]
+    pub fn is_near_specular(&self, max_alpha: f32) -> bool {
+        self.glossy_alpha.is_some_and(|a| a <= max_alpha)
     }
 
     /// True if the BSDF has mirror or dielectric parts.
@@ -576,6 +603,29 @@ fn diffuse_only(parts: &[Part; PARTS], tint: Vec3) -> bool {
         .filter(|p| p.weight > 0.0)
         .flat_map(Part::lobes)
         .all(|l| l.is_flat(tint))
+}
+
+/// The widest microfacet α of a mixture of `parts` whose lobes of non-zero weight are all delta
+/// or microfacet lobes, at least one of them a microfacet lobe ([`Bsdf::is_near_specular`]).
+fn glossy_alpha(parts: &[Part; PARTS]) -> Option<f32> {
+    let mut widest: Option<f32> = None;
+    for lobe in parts
+        .iter()
+        .filter(|p| p.weight > 0.0)
+        .flat_map(Part::lobes)
+    {
+        let g = match lobe {
+            Lobe::RoughConductor { lobe, .. } => lobe.distribution,
+            Lobe::RoughDielectric(d) => d.distribution,
+            Lobe::SpecularReflection(_) | Lobe::SpecularConductor(_) | Lobe::Dielectric(_) => {
+                continue;
+            }
+            Lobe::Lambert(_) | Lobe::Phong(_) | Lobe::Coated { .. } => return None,
+        };
+        let a = g.alpha_x.max(g.alpha_y);
+        widest = Some(widest.map_or(a, |w| w.max(a)));
+    }
+    widest
 }
 
 #[cfg(test)]

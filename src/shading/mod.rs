@@ -20,7 +20,7 @@ pub mod scattering;
 pub mod specular_conductor;
 pub mod specular_reflection;
 
-pub use bsdf::{Bsdf, DeltaLobes};
+pub use bsdf::{Bsdf, DeltaLobes, NEAR_SPECULAR_ALPHA};
 pub use bsdf_at::BsdfAt;
 pub use lobe::Lobe;
 pub use normals::usable_shading_normal;

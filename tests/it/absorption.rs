@@ -117,6 +117,7 @@ fn photons_under_an_absorbing_slab_carry_exp_minus_sigma_d_times_the_fresnel_ter
         any_bounce: false,
         max_bounces: 64,
         pass: None,
+        near_specular: None,
     };
     let mut sampler = Sampler::new(scene.params.sampler, 3, 1);
     let (mut out, mut counts) = (Vec::new(), TraceCounts::default());

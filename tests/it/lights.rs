@@ -361,6 +361,7 @@ fn a_quad_lights_irradiance_through_the_global_photon_map_matches_lamberts_polyg
         any_bounce: false,
         max_bounces: 0,
         pass: None,
+        near_specular: None,
     };
     let (photons, counts) = trace_map(
         &scene,

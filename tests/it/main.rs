@@ -17,6 +17,7 @@ mod doc_images;
 mod doc_snippets;
 mod estimator_agreement;
 mod farm;
+mod glossy_caustic;
 mod golden;
 mod hard_cases;
 mod interrupt;

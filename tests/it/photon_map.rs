@@ -43,6 +43,7 @@ fn direct_photons(scene: &RenderScene, n: u64) -> (Vec<Photon>, TraceCounts) {
         any_bounce: false,
         max_bounces: 0,
         pass: None,
+        near_specular: None,
     };
     let (photons, counts) = trace_map(
         scene,

@@ -137,6 +137,7 @@ fn direct_photons(scene: &RenderScene, n: u64) -> Vec<Photon> {
         any_bounce: false,
         max_bounces: 0,
         pass: None,
+        near_specular: None,
     };
     trace_map(
         scene,

@@ -78,16 +78,24 @@ fn ellipsoid_box(m: &DAffine3) -> (Vec3, Vec3) {
 
 impl CausticTargets {
     /// The bounding sphere of every object whose material reflects or transmits (has a delta
-    /// lobe). Emitters and purely diffuse objects are not targets.
+    /// lobe), and, with `near_specular` (a GGX width), of every object whose material is
+    /// near-specular ([`crate::shading::Bsdf::is_near_specular`]), whole. Emitters and purely
+    /// diffuse objects are not targets.
     #[must_use]
-    pub fn new(scene: &RenderScene) -> Self {
+    pub fn new(scene: &RenderScene, near_specular: Option<f32>) -> Self {
         // The specular share of each object's material (0: not a target).
         let share: Vec<f32> = scene
             .objects
             .iter()
             .map(|o| {
-                o.material
-                    .map_or(0.0, |m| scene.materials[m as usize].bsdf.delta_share())
+                o.material.map_or(0.0, |m| {
+                    let bsdf = &scene.materials[m as usize].bsdf;
+                    if near_specular.is_some_and(|a| bsdf.is_near_specular(a)) {
+                        1.0
+                    } else {
+                        bsdf.delta_share()
+                    }
+                })
             })
             .collect();
         let is_target: Vec<bool> = share.iter().map(|&s| s > 0.0).collect();

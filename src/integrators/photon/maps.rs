@@ -335,8 +335,9 @@ pub fn build_maps_cancellable(scene: &RenderScene, cancel: Option<Arc<AtomicBool
         caustic: true,
         global: true,
         global_any_bounce: false,
+        near_specular: None,
     };
-    let mut prepared = MapScene::new(scene);
+    let mut prepared = MapScene::new(scene, all);
     prepared.cancel = cancel;
     build_maps_with(scene, &prepared, None, all)
 }
@@ -355,11 +356,12 @@ pub struct MapScene {
 }
 
 impl MapScene {
-    /// Finds the targets and sums the diffuse area of `scene`.
+    /// Finds the targets (with near-specular objects when `set` says so) and sums the diffuse
+    /// area of `scene`.
     #[must_use]
-    pub fn new(scene: &RenderScene) -> Self {
+    pub fn new(scene: &RenderScene, set: MapSet) -> Self {
         Self {
-            targets: CausticTargets::new(scene),
+            targets: CausticTargets::new(scene, set.near_specular),
             area: diffuse_area(scene),
             cancel: None,
         }
@@ -367,7 +369,7 @@ impl MapScene {
 }
 
 /// Which maps to build.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MapSet {
     /// Light → specular⁺ → diffuse photons.
     pub caustic: bool,
@@ -377,6 +379,9 @@ pub struct MapSet {
     /// ones too): it then also holds the caustics, and is read alone where all the light that
     /// arrives after a bounce is wanted (`path-ppm`'s second diffuse vertex).
     pub global_any_bounce: bool,
+    /// Near-specular surfaces (GGX α up to this) are specular for photon paths
+    /// ([`TraceSettings::near_specular`]); `None`: only delta lobes are.
+    pub near_specular: Option<f32>,
 }
 
 /// Traces and builds the caustic and/or global maps of the scene's `photons` settings from the
@@ -452,6 +457,7 @@ pub fn build_maps_with(
             any_bounce: false,
             max_bounces: p.max_bounces,
             pass,
+            near_specular: set.near_specular,
         };
         let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
         summary.caustic = counts;
@@ -489,6 +495,7 @@ pub fn build_maps_with(
             any_bounce: set.global_any_bounce,
             max_bounces: p.max_bounces,
             pass,
+            near_specular: set.near_specular,
         };
         let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
         summary.global = counts;

@@ -94,7 +94,7 @@ impl<'a> ProgressivePhotons<'a> {
     pub fn new(scene: &'a RenderScene, set: MapSet) -> Self {
         Self {
             scene,
-            prepared: MapScene::new(scene),
+            prepared: MapScene::new(scene, set),
             set,
             schedule: RadiusSchedule {
                 alpha: f64::from(scene.params.photons.alpha),

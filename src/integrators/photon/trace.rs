@@ -26,7 +26,8 @@ pub const MAX_FLUX_GROWTH: f32 = 10.0;
 /// Which map a photon path feeds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MapKind {
-    /// Light → specular⁺ → diffuse: stored once, where it first lands on a diffuse surface.
+    /// Light → specular⁺ → diffuse: stored once, where it first lands on a diffuse surface
+    /// (with [`TraceSettings::near_specular`], near-specular glossy surfaces count as specular).
     Caustic,
     /// Every diffuse landing after at least `min_bounces` diffuse bounces.
     Global,
@@ -76,6 +77,21 @@ pub struct TraceSettings {
     /// The progressive pass whose independent photon streams to draw (`None`: the photon
     /// integrator's one set of maps).
     pub pass: Option<u32>,
+    /// The widest GGX α at which a glossy surface is near-specular
+    /// ([`crate::shading::Bsdf::is_near_specular`]): photons pass through such surfaces as
+    /// through mirrors (caustic paths go on, nothing is stored there, the bounce is not a
+    /// diffuse one). `None`: only delta lobes are specular (the photon integrator).
+    pub near_specular: Option<f32>,
+}
+
+impl TraceSettings {
+    /// True if photons pass a surface of BSDF `bsdf` as a specular one although it is glossy
+    /// (near-specular under [`TraceSettings::near_specular`]).
+    #[inline]
+    #[must_use]
+    pub fn treats_as_specular(&self, bsdf: &crate::shading::Bsdf) -> bool {
+        self.near_specular.is_some_and(|a| bsdf.is_near_specular(a))
+    }
 }
 
 /// Traces one photon from `ray` carrying `power`, appending what it stores to `out` and
@@ -105,13 +121,14 @@ pub fn trace_photon(
         };
         let (sp, wo, fr, bsdf) = (v.sp, v.wo, v.frame, v.bsdf);
         let dir = -wo;
+        let near = settings.treats_as_specular(bsdf);
         if bounces == 0 && settings.kind == MapKind::Caustic {
-            if !bsdf.has_delta() {
+            if !bsdf.has_delta() && !near {
                 return; // Aimed at a target but blocked by a diffuse object.
             }
             counts.reached_specular += 1;
         }
-        if bsdf.has_local() {
+        if bsdf.has_local() && !near {
             let store = match settings.kind {
                 MapKind::Caustic => bounces > 0,
                 MapKind::Global if settings.any_bounce => bounces >= settings.min_bounces,
@@ -130,7 +147,7 @@ pub fn trace_photon(
         let Some(s) = bsdf.sample(wo, u_lobe, u, &fr, TransportMode::Importance) else {
             return;
         };
-        if !s.delta {
+        if !s.delta && !near {
             if settings.kind == MapKind::Caustic {
                 return; // No longer a caustic path (and it was stored above if it landed).
             }
