@@ -13,7 +13,7 @@
 //! small (zero where no sample found it), which would reject the null on `path`'s account.
 //!
 //! `path-ppm` runs with the default estimator's per-pass budget for a 64² image (1 000 caustic
-//! photons per pass, k = 20, no global map), not the scene's counts (sized for `photon`, which
+//! photons per pass, k = 10, no global map), not the scene's counts (sized for `photon`, which
 //! traces once). Point, spot and distant lights emit no caustic photons here
 //! (`caustic_photons: 0`), and distant lights are made delta (`angular_radius: 0`): the path
 //! tracer never hits a point or a spot, and a sun's 0.27° disc (which escaping rays do see) so
@@ -62,7 +62,7 @@ fn path_ppm_and_path_agree_within_noise_on_every_scene() {
                 prepare(&file, &overrides).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
             let mut scene = p.scene.clone();
             scene.photons.caustic = 1000;
-            scene.photons.caustic_gather = 20;
+            scene.photons.caustic_gather = 10;
             scene.photons.global = 0;
             for light in &mut scene.lights {
                 match light {
