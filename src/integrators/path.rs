@@ -149,7 +149,11 @@ impl<'a> PathTracer<'a> {
     /// - `maps.caustic` (light → specular⁺ → diffuse photons) at every vertex with a non-delta
     ///   part where the path may still scatter; an emitter reached by delta bounces after such
     ///   a vertex is then not counted, since the map holds exactly those paths (left to
-    ///   chance hits, such paths through water or glass are the fireflies of path tracing);
+    ///   chance hits, such paths through water or glass are the fireflies of path tracing).
+    ///   With `maps.near_specular`, near-specular glossy vertices count as specular ones here:
+    ///   they read no map, and after a vertex that read the caustic map they make no
+    ///   next-event estimate of the lights it carries. Only lights the map carries
+    ///   (`maps.caustic_lights`) are left out; the others' caustics stay in the camera path;
     /// - `maps.global` at the vertices after `maps.global_at` diffuse bounces: there direct
     ///   light (next-event estimation, without MIS), caustics and the global map (light that
     ///   made at least one diffuse bounce; or any bounce, caustics included, with
