@@ -18,7 +18,7 @@
 //!    non-delta part, each light is sampled [`PILOT_SAMPLES`] times by next-event estimation's
 //!    own step and its unoccluded contribution `f·L·|cos θ|/pdf` (shadow rays traced) is added
 //!    to the vertex's voxel
-//!    (a [`HashGrid`] cell of side [`VOXELS_PER_DIAGONAL`]⁻¹ of the scene's diagonal).
+//!    (a [`VoxelTable`] voxel of side [`VOXELS_PER_DIAGONAL`]⁻¹ of the scene's diagonal).
 //! 2. **Distribution.** In a voxel the pilot reached, light `l` is chosen with probability
 //!    `(1 − δ)·Eₗ/ΣE + δ·dₗ` (`Eₗ` its mean pilot contribution, δ = [`POWER_SHARE`], `dₗ`
 //!    the default choice: half `Φₗ/ΣΦ` by power, half uniform over the lights that emit);
@@ -40,7 +40,7 @@ use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{Interaction, LightSampler, RenderScene};
 use crate::sampling::Rng;
 use crate::shading::TransportMode;
-use crate::spatial::{HasPosition, HashGrid};
+use crate::spatial::VoxelTable;
 
 /// Camera rays of the pilot (on a grid of about this many pixels, the image's aspect ratio).
 pub const PILOT_PIXELS: u32 = 96 * 72;
@@ -56,38 +56,18 @@ pub const VOXELS_PER_DIAGONAL: f32 = 32.0;
 /// and cannot turn into rare, huge next-event estimates.
 pub const POWER_SHARE: f32 = 0.5;
 
-/// The voxel grid's offset, in voxel sides: a non-round fraction, so that the planes of
-/// axis-aligned walls (often at round coordinates, 0 above all) do not fall on voxel faces,
-/// where a wall's points would be split between two voxels by rounding.
-const VOXEL_OFFSET: [f32; 3] = [0.3719, 0.6180, 0.2113];
 /// Fewest pilot vertices a voxel needs for a learned distribution (fewer: chosen by power).
 pub const MIN_PILOT_VERTICES: usize = 4;
 /// Most lights a guide is built for.
 pub const MAX_GUIDED_LIGHTS: usize = 16;
-
-/// One voxel the pilot reached: a pilot vertex's position in it and its row of the table.
-#[derive(Debug, Clone, Copy)]
-struct Voxel {
-    position: [f32; 3],
-    row: u32,
-}
-
-impl HasPosition for Voxel {
-    #[inline]
-    fn position(&self) -> [f32; 3] {
-        self.position
-    }
-}
 
 /// The light choice of next-event estimation: per voxel where a pilot learned it, by power
 /// elsewhere (see the module docs).
 #[derive(Debug, Clone)]
 pub struct LightGuide {
     power: LightSampler,
-    /// The pilot's voxels (empty: no guidance), keyed by position plus `offset`.
-    voxels: HashGrid<Voxel>,
-    /// [`VOXEL_OFFSET`] in scene units.
-    offset: Vec3,
+    /// The pilot's voxels (empty: no guidance), each with its row of the tables below.
+    voxels: VoxelTable,
     /// Per voxel row, `lights` cumulative probabilities (the last is 1) …
     cdf: Vec<f32>,
     /// … and the probabilities themselves.
@@ -101,8 +81,7 @@ impl LightGuide {
     pub fn by_power(scene: &RenderScene) -> Self {
         Self {
             power: LightSampler::new(&scene.lights),
-            voxels: HashGrid::default(),
-            offset: Vec3::ZERO,
+            voxels: VoxelTable::default(),
             cdf: Vec::new(),
             pmf: Vec::new(),
             lights: scene.lights.len(),
@@ -135,20 +114,9 @@ impl LightGuide {
             .into_par_iter()
             .map(|i| pilot_path(scene, i, gw, gh, w, h))
             .collect();
-        let inv = 1.0 / side;
-        let offset = Vec3::from_array(VOXEL_OFFSET) * side;
-        let mut keyed: Vec<([i32; 3], [f32; 3], &[f32])> = records
-            .iter()
-            .flatten()
-            .map(|(p, e)| {
-                let p = (Vec3::from_array(*p) + offset).to_array();
-                (p.map(|x| (x * inv).floor() as i32), p, e.as_slice())
-            })
-            .collect();
-        if keyed.is_empty() {
+        if records.iter().all(Vec::is_empty) {
             return guide;
         }
-        keyed.sort_by_key(|k| k.0);
         let power: Vec<f32> = (0..n).map(|l| guide.power.pmf(l)).collect();
         let emitting = power.iter().filter(|&&p| p > 0.0).count().max(1) as f32;
         let default: Vec<f32> = power
@@ -161,14 +129,16 @@ impl LightGuide {
                 }
             })
             .collect();
-        let mut voxels = Vec::new();
-        let (mut cdf, mut pmf) = (Vec::new(), Vec::new());
-        for run in keyed.chunk_by(|a, b| a.0 == b.0) {
+        let vertices = records
+            .iter()
+            .flatten()
+            .map(|(p, e)| (Vec3::from_array(*p), e.as_slice()));
+        let Ok((voxels, rows)) = VoxelTable::build(side, vertices, |run| {
             if run.len() < MIN_PILOT_VERTICES {
-                continue;
+                return None;
             }
             let mut e = vec![0.0f64; n];
-            for (_, _, est) in run {
+            for est in run.iter() {
                 for (s, v) in e.iter_mut().zip(est.iter()) {
                     *s += f64::from(*v);
                 }
@@ -190,29 +160,22 @@ impl LightGuide {
                 })
                 .collect();
             let sum: f32 = row.iter().sum();
-            if !(sum > 0.0) {
-                continue;
-            }
+            (sum > 0.0).then(|| row.into_iter().map(|p| p / sum).collect::<Vec<f32>>())
+        }) else {
+            return guide;
+        };
+        let mut cdf = Vec::with_capacity(rows.len() * n);
+        for row in &rows {
             let mut acc = 0.0f32;
-            voxels.push(Voxel {
-                position: run[0].1,
-                row: (voxels.len()) as u32,
-            });
             for (l, p) in row.iter().enumerate() {
-                let p = p / sum;
-                pmf.push(p);
                 acc += p;
                 cdf.push(if l + 1 == n { 1.0 } else { acc });
             }
         }
-        let Ok(voxels) = HashGrid::build(voxels, side) else {
-            return guide;
-        };
         Self {
             voxels,
-            offset,
             cdf,
-            pmf,
+            pmf: rows.concat(),
             ..guide
         }
     }
@@ -226,14 +189,7 @@ impl LightGuide {
     /// The table row of the voxel containing `p`, if the pilot learned one.
     #[inline]
     fn row(&self, p: Vec3) -> Option<usize> {
-        if self.voxels.is_empty() {
-            return None;
-        }
-        let mut row = None;
-        let c = self.voxels.cell_of((p + self.offset).to_array());
-        self.voxels
-            .in_cell(c, |i| row = Some(self.voxels.items()[i].row as usize));
-        row
+        self.voxels.get(p)
     }
 
     /// Chooses a light for next-event estimation at `p` (`u` drawn only when there is a choice):

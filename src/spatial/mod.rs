@@ -1,4 +1,5 @@
-//! Spatial search: the uniform [`HashGrid`] of per-pass photon lookups, the balanced 3-d [`KdTree`] that stores any positioned item
+//! Spatial search: the uniform [`HashGrid`] of per-pass photon lookups, the sparse per-voxel
+//! [`VoxelTable`] built on it, the balanced 3-d [`KdTree`] that stores any positioned item
 //! ([`HasPosition`]) in flat arrays and answers k-nearest and fixed-radius
 //! queries without allocating (Jensen, "Realistic Image Synthesis Using Photon Mapping", 2001,
 //! ch. 6), its bounded k-nearest heap, and the packed [`Photon`] record the photon maps store in
@@ -24,8 +25,10 @@ pub mod hash_grid;
 pub mod kdtree;
 pub mod knn;
 pub mod packing;
+pub mod voxel_table;
 
 pub use hash_grid::{CellIndex, HashGrid, HashGridError};
 pub use kdtree::{BuildOptions, HasPosition, KdTree, KdTreeError, SplitAxis, distance2};
 pub use knn::{KnnHeap, Neighbor};
 pub use packing::Photon;
+pub use voxel_table::{VOXEL_OFFSET, VoxelTable};

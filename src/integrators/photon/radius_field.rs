@@ -13,7 +13,7 @@
 //!
 //! This field takes the k-nearest radius from a **pilot** map — photons traced once, from their
 //! own streams, never used for estimates — at every pilot photon, and stores the median per
-//! cell of a coarse grid (cells of half the map's largest radius) in a [`HashGrid`]. `R(x)` is
+//! cell of a coarse grid (cells of half the map's largest radius) in a [`VoxelTable`]. `R(x)` is
 //! then one hash lookup: the median of `x`'s cell, or the largest radius where the pilot left no
 //! photon (space photons rarely reach, where any estimate finds few). The field follows the
 //! photon density at the scale of its cells, like the k-nearest radius, and leaves each pass a
@@ -23,38 +23,18 @@
 use glam::Vec3;
 
 use super::estimate::PhotonMap;
-use crate::spatial::{HasPosition, HashGrid};
+use crate::spatial::VoxelTable;
 
 /// Coarse cells per largest radius (the field's cell side is `max_radius / CELLS_PER_RADIUS`).
 pub const CELLS_PER_RADIUS: f32 = 2.0;
 
-/// The coarse grid's offset, in cell sides: a non-round fraction, so that axis-aligned walls at
-/// round coordinates (0 above all) do not lie on cell faces, where rounding would split a
-/// wall's photons between two cells and leave queries on it in empty ones.
-const CELL_OFFSET: [f32; 3] = [0.3719, 0.6180, 0.2113];
-
-/// One occupied cell of the field: a pilot photon's position (in the cell) and the median
-/// k-nearest radius over the cell's pilot photons.
-#[derive(Debug, Clone, Copy)]
-struct FieldCell {
-    position: [f32; 3],
-    radius: f32,
-}
-
-impl HasPosition for FieldCell {
-    #[inline]
-    fn position(&self) -> [f32; 3] {
-        self.position
-    }
-}
-
 /// `R(x)`: the initial estimate radius at every point, from a pilot map (see the module docs).
 #[derive(Debug, Clone)]
 pub struct RadiusField {
-    /// Occupied cells, keyed by position plus `offset`.
-    cells: HashGrid<FieldCell>,
-    /// [`CELL_OFFSET`] in scene units.
-    offset: Vec3,
+    /// Occupied cells (the index of each one's median radius in `medians`).
+    cells: VoxelTable,
+    /// Per occupied cell, the median k-nearest radius of its pilot photons.
+    medians: Vec<f32>,
     /// `R` in cells without pilot photons: the pilot map's largest radius.
     fallback: f32,
     /// Smallest radius returned (`max_radius · MIN_RADIUS_FRACTION`: coincident photons).
@@ -84,33 +64,25 @@ impl RadiusField {
             .par_iter()
             .map(|ph| pilot.knn_radius(ph.position()).max(floor))
             .collect();
-        let inv = 1.0 / side;
-        let offset = Vec3::from_array(CELL_OFFSET) * side;
-        let mut keyed: Vec<([i32; 3], f32, [f32; 3])> = pilot
-            .photons()
-            .iter()
-            .zip(&radii)
-            .map(|(ph, &r)| {
-                let p = (ph.position() + offset).to_array();
-                (p.map(|x| (x * inv).floor() as i32), r, p)
-            })
-            .collect();
-        keyed.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-        let mut cells = Vec::new();
-        for run in keyed.chunk_by(|a, b| a.0 == b.0) {
-            let median = run[run.len() / 2].1;
-            cells.push(FieldCell {
-                position: run[0].2,
-                radius: median,
-            });
-        }
+        let (cells, medians) = VoxelTable::build(
+            side,
+            pilot
+                .photons()
+                .iter()
+                .map(|ph| ph.position())
+                .zip(radii.iter().copied()),
+            |group| {
+                group.sort_by(f32::total_cmp);
+                Some(group[group.len() / 2])
+            },
+        )
+        .ok()?;
         let mut sorted = radii;
         sorted.sort_by(f32::total_cmp);
         let typical = sorted[sorted.len() / 2];
-        let cells = HashGrid::build(cells, side).ok()?;
         Some(Self {
             cells,
-            offset,
+            medians,
             fallback: max_radius,
             floor,
             typical,
@@ -122,9 +94,7 @@ impl RadiusField {
     #[inline]
     #[must_use]
     pub fn radius(&self, p: Vec3) -> f32 {
-        let mut r = self.fallback;
-        let c = self.cells.cell_of((p + self.offset).to_array());
-        self.cells.in_cell(c, |i| r = self.cells.items()[i].radius);
+        let r = self.cells.get(p).map_or(self.fallback, |i| self.medians[i]);
         r.max(self.floor)
     }
 
