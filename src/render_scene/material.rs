@@ -1,9 +1,9 @@
 //! Scene materials (BSDF parameters plus optional colour and bump textures) and their
 //! resolution at a hit into the exact BSDF and normals every integrator shades with.
 
-use super::MIN_SPREAD_FRACTION;
 use glam::{Vec2, Vec3};
 
+use super::MIN_SPREAD_FRACTION;
 use super::texture::Lookup;
 use super::{RenderScene, SurfacePoint, TextureFilter};
 use crate::geometry::Frame;

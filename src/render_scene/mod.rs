@@ -27,12 +27,12 @@ use glam::Vec3;
 
 use crate::sampling::SamplerKind;
 pub use crate::settings::{IntegratorKind, TextureFilter, Tonemap};
+use crate::shading::LobeFlags;
 
 /// The smallest camera spread, as a fraction of a pixel's angular size: the spread of one
 /// sample at 64 samples per pixel and above ([`RenderScene::pixel_spread`]), and the footprint
 /// bump and normal maps are always looked up at.
 pub const MIN_SPREAD_FRACTION: f32 = 0.125;
-use crate::shading::LobeFlags;
 
 /// Rendering parameters after command-line overrides.
 #[derive(Debug, Clone, PartialEq)]
@@ -149,8 +149,8 @@ impl RenderScene {
     }
 
     /// The angle one camera sample's footprint subtends: the pixel's angular size, shrunk by
-    /// `1/√spp` (down to [`MIN_SPREAD_FRACTION`]) since samples are spread over the pixel. The ray cones that size
-    /// texture footprints start from this.
+    /// `1/√spp` (down to [`MIN_SPREAD_FRACTION`]) since samples are spread over the pixel. The
+    /// ray cones that size texture footprints start from this.
     #[must_use]
     pub fn pixel_spread(&self) -> f32 {
         let pixel = 2.0 * self.camera.up.length() / self.params.height.max(1) as f32;
