@@ -7,20 +7,23 @@
 //! cell the query's box overlaps plus the items in those cells — a small constant when the cell
 //! side is about the query diameter — with no tree to descend and nothing to do in empty space.
 //!
-//! **Exactness.** Two cells can share a bucket (a hash collision); every item also keeps its own
-//! cell's coordinates, and a query visiting cell `c` takes only the items whose cell is `c`. So
-//! each item is considered at most once and the result of [`HashGrid::within`] is exactly the
-//! brute-force set `{ i : distance2(q, pᵢ) ≤ r² }` ([`super::distance2`]), whatever the
-//! collisions. A query whose box spans more cells than the grid has items falls back to a scan
-//! of all items (a radius larger than the scene), which gives the same set.
+//! **Exactness.** Two cells can share a bucket (a hash collision); within a bucket the items are
+//! grouped into runs, one per cell, each run knowing its cell's coordinates, and a query
+//! visiting cell `c` reads only `c`'s run. So each item is considered at most once and the result
+//! of [`HashGrid::within`] is exactly the brute-force set `{ i : distance2(q, pᵢ) ≤ r² }`
+//! ([`super::distance2`], computed the same way eight items at a time), whatever the collisions.
+//! A query whose box spans more cells than the grid has items falls back to a scan of all items
+//! (a radius larger than the scene), which gives the same set.
 //!
-//! **Determinism.** The counting sort is stable, so the item order, and with it every query's
-//! visiting order, depends only on the input order.
+//! **Determinism.** The counting sort and the grouping by cell are stable, so the item order,
+//! and with it every query's visiting order (cells in z, y, x order, each cell's items in input
+//! order), depends only on the input order.
 //!
 //! **Positions must be finite** and the cell side finite and positive ([`HashGridError`]).
 
-use super::kdtree::{HasPosition, distance2};
+use super::kdtree::HasPosition;
 use super::knn::Neighbor;
+use wide::f32x8;
 
 /// Why a [`HashGrid`] cannot be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -40,15 +43,21 @@ pub enum HashGridError {
 pub type CellIndex = [i32; 3];
 
 /// A static spatial hash grid over `T`; see the module documentation.
-/// Memory: `size_of::<T>()` + 12 bytes per item, 4 bytes per bucket (about one per item).
+/// Memory: `size_of::<T>()` + 12 bytes per item (positions again, one array per axis, for the
+/// eight-wide distance test), 16 bytes per occupied cell, 4 bytes per bucket (about one per item).
 #[derive(Debug, Clone)]
 pub struct HashGrid<T> {
-    /// Items sorted by bucket (stable).
+    /// Items grouped by bucket, then by cell within a bucket; a cell's items keep their input
+    /// order.
     items: Vec<T>,
-    /// Each item's cell, in the same order.
-    cells: Vec<CellIndex>,
-    /// `starts[b]..starts[b + 1]` are bucket `b`'s items.
-    starts: Vec<u32>,
+    /// The items' coordinates per axis, in the same order, followed by [`LANES`] NaNs so that an
+    /// eight-wide load starting at any item stays in bounds (a NaN is never within a radius).
+    axes: [Vec<f32>; 3],
+    /// The occupied cells (runs of items), grouped by bucket, then a sentinel whose `start` is
+    /// the item count: run `k`'s items are `runs[k].start .. runs[k + 1].start`.
+    runs: Vec<Run>,
+    /// `bucket_runs[b] .. bucket_runs[b + 1]` are bucket `b`'s runs.
+    bucket_runs: Vec<u32>,
     /// Cell side (scene units) and its reciprocal.
     cell: f32,
     inv_cell: f32,
@@ -56,12 +65,30 @@ pub struct HashGrid<T> {
     mask: u32,
 }
 
+/// One occupied cell of a [`HashGrid`]: its coordinates and the first of its items.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Run {
+    cell: CellIndex,
+    start: u32,
+}
+
+/// Items tested at once by the distance test (one AVX register).
+const LANES: usize = 8;
+
 impl<T> Default for HashGrid<T> {
     fn default() -> Self {
         Self {
             items: Vec::new(),
-            cells: Vec::new(),
-            starts: vec![0, 0],
+            axes: [
+                vec![f32::NAN; LANES],
+                vec![f32::NAN; LANES],
+                vec![f32::NAN; LANES],
+            ],
+            runs: vec![Run {
+                cell: [0; 3],
+                start: 0,
+            }],
+            bucket_runs: vec![0, 0],
             cell: 1.0,
             inv_cell: 1.0,
             mask: 0,
@@ -115,10 +142,12 @@ impl<T: HasPosition> HashGrid<T> {
             .iter()
             .map(|it| it.position().map(|x| cell_coord(x, inv_cell)))
             .collect();
-        // Counting sort by bucket (stable).
+        let bucket_of = |c: CellIndex| (hash(c) & mask) as usize;
+        // Counting sort by bucket (stable), then each bucket's items grouped by cell with a
+        // stable sort of its (short) slice: a cell's items keep their input order.
         let mut starts = vec![0u32; buckets + 1];
         for c in &cells_in {
-            starts[(hash(*c) & mask) as usize + 1] += 1;
+            starts[bucket_of(*c) + 1] += 1;
         }
         for b in 0..buckets {
             starts[b + 1] += starts[b];
@@ -126,11 +155,42 @@ impl<T: HasPosition> HashGrid<T> {
         let mut next = starts.clone();
         let mut order = vec![0u32; items.len()];
         for (i, c) in cells_in.iter().enumerate() {
-            let b = (hash(*c) & mask) as usize;
+            let b = bucket_of(*c);
             order[next[b] as usize] = i as u32;
             next[b] += 1;
         }
-        let cells = order.iter().map(|&i| cells_in[i as usize]).collect();
+        let mut runs = Vec::new();
+        let mut bucket_runs = vec![0u32; buckets + 1];
+        for b in 0..buckets {
+            let slice = &mut order[starts[b] as usize..starts[b + 1] as usize];
+            if slice.len() > 1 {
+                slice.sort_by_key(|&i| cells_in[i as usize]);
+            }
+            let mut last = None;
+            for (k, &i) in slice.iter().enumerate() {
+                let c = cells_in[i as usize];
+                if last != Some(c) {
+                    runs.push(Run {
+                        cell: c,
+                        start: starts[b] + k as u32,
+                    });
+                    last = Some(c);
+                }
+            }
+            bucket_runs[b + 1] = runs.len() as u32;
+        }
+        runs.push(Run {
+            cell: [0; 3],
+            start: items.len() as u32,
+        });
+        let axes = [0, 1, 2].map(|a| {
+            let mut v: Vec<f32> = order
+                .iter()
+                .map(|&i| items[i as usize].position()[a])
+                .collect();
+            v.extend([f32::NAN; LANES]);
+            v
+        });
         let mut slots: Vec<Option<T>> = items.into_iter().map(Some).collect();
         let items = order
             .iter()
@@ -138,8 +198,9 @@ impl<T: HasPosition> HashGrid<T> {
             .collect();
         Ok(Self {
             items,
-            cells,
-            starts,
+            axes,
+            runs,
+            bucket_runs,
             cell,
             inv_cell,
             mask,
@@ -176,8 +237,9 @@ impl<T: HasPosition> HashGrid<T> {
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
         self.items.capacity() * std::mem::size_of::<T>()
-            + self.cells.capacity() * std::mem::size_of::<CellIndex>()
-            + self.starts.capacity() * 4
+            + self.axes.iter().map(|a| a.capacity() * 4).sum::<usize>()
+            + self.runs.capacity() * std::mem::size_of::<Run>()
+            + self.bucket_runs.capacity() * 4
     }
 
     /// The cell that position `p` falls in.
@@ -187,16 +249,26 @@ impl<T: HasPosition> HashGrid<T> {
         p.map(|x| cell_coord(x, self.inv_cell))
     }
 
-    /// Calls `visit` with the index of every item in cell `c`, in grid order.
+    /// The items of cell `c`: a range of [`HashGrid::items`] (empty when no item lies in it).
     #[inline]
-    pub fn in_cell(&self, c: CellIndex, mut visit: impl FnMut(usize)) {
+    fn run(&self, c: CellIndex) -> std::ops::Range<usize> {
         let b = (hash(c) & self.mask) as usize;
-        let (lo, hi) = (self.starts[b] as usize, self.starts[b + 1] as usize);
-        for i in lo..hi {
-            if self.cells[i] == c {
-                visit(i);
+        let (lo, hi) = (
+            self.bucket_runs[b] as usize,
+            self.bucket_runs[b + 1] as usize,
+        );
+        for k in lo..hi {
+            if self.runs[k].cell == c {
+                return self.runs[k].start as usize..self.runs[k + 1].start as usize;
             }
         }
+        0..0
+    }
+
+    /// Calls `visit` with the index of every item in cell `c`, in grid order.
+    #[inline]
+    pub fn in_cell(&self, c: CellIndex, visit: impl FnMut(usize)) {
+        self.run(c).for_each(visit);
     }
 
     /// The lowest and highest cell of the box of the ball of radius `r` around `q`.
@@ -206,6 +278,48 @@ impl<T: HasPosition> HashGrid<T> {
             q.map(|x| cell_coord(x - r, self.inv_cell)),
             q.map(|x| cell_coord(x + r, self.inv_cell)),
         )
+    }
+
+    /// Calls `visit` for every item of `range` with `distance2(q, p) ≤ r2`, in item order,
+    /// testing [`LANES`] items at once. The distance is [`super::distance2`]'s, operation for
+    /// operation, so it is the same number.
+    #[inline(always)]
+    fn scan(
+        &self,
+        range: std::ops::Range<usize>,
+        q: [f32; 3],
+        r2: f32,
+        visit: &mut impl FnMut(Neighbor),
+    ) {
+        let [xs, ys, zs] = &self.axes;
+        let (qx, qy, qz) = (f32x8::splat(q[0]), f32x8::splat(q[1]), f32x8::splat(q[2]));
+        let limit = f32x8::splat(r2);
+        let load = |v: &[f32], i: usize| -> f32x8 {
+            let lanes: [f32; LANES] = v[i..i + LANES].try_into().unwrap_or([f32::NAN; LANES]);
+            f32x8::from(lanes)
+        };
+        let mut i = range.start;
+        while i < range.end {
+            let (dx, dy, dz) = (qx - load(xs, i), qy - load(ys, i), qz - load(zs, i));
+            let d2 = dx * dx + dy * dy + dz * dz;
+            let mut hits = d2.simd_le(limit).to_bitmask();
+            let left = range.end - i;
+            if left < LANES {
+                hits &= (1u32 << left) - 1;
+            }
+            if hits != 0 {
+                let d2 = d2.to_array();
+                while hits != 0 {
+                    let lane = hits.trailing_zeros() as usize;
+                    hits &= hits - 1;
+                    visit(Neighbor {
+                        index: (i + lane) as u32,
+                        dist2: d2[lane],
+                    });
+                }
+            }
+            i += LANES;
+        }
     }
 
     /// Calls `visit` for every item with `distance2(q, p) ≤ r²`, each once, in an order that
@@ -220,34 +334,15 @@ impl<T: HasPosition> HashGrid<T> {
         let (lo, hi) = self.cell_range(q, r);
         if cell_count(lo, hi) > self.items.len() as u64 {
             // More cells than items (a radius as large as the scene): scan everything.
-            for (i, it) in self.items.iter().enumerate() {
-                let dist2 = distance2(q, it.position());
-                if dist2 <= r2 {
-                    visit(Neighbor {
-                        index: i as u32,
-                        dist2,
-                    });
-                }
-            }
+            self.scan(0..self.items.len(), q, r2, &mut visit);
             return;
         }
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
-                    let c = [x, y, z];
-                    let b = (hash(c) & self.mask) as usize;
-                    let (s, e) = (self.starts[b] as usize, self.starts[b + 1] as usize);
-                    for i in s..e {
-                        if self.cells[i] != c {
-                            continue;
-                        }
-                        let dist2 = distance2(q, self.items[i].position());
-                        if dist2 <= r2 {
-                            visit(Neighbor {
-                                index: i as u32,
-                                dist2,
-                            });
-                        }
+                    let run = self.run([x, y, z]);
+                    if !run.is_empty() {
+                        self.scan(run, q, r2, &mut visit);
                     }
                 }
             }
@@ -259,6 +354,7 @@ impl<T: HasPosition> HashGrid<T> {
 mod tests {
     use super::*;
     use crate::sampling::Rng;
+    use crate::spatial::distance2;
 
     /// The brute-force answer: indices (into `grid.items()`) within `r` of `q`, sorted.
     fn brute(grid: &HashGrid<[f32; 3]>, q: [f32; 3], r: f32) -> Vec<u32> {
@@ -412,6 +508,34 @@ mod tests {
         assert!(query(&grid, [0.0; 3], f32::NAN).is_empty());
         let empty: HashGrid<[f32; 3]> = HashGrid::build(Vec::new(), 1.0).expect("grid");
         assert!(query(&empty, [0.0; 3], 1.0).is_empty());
+    }
+
+    #[test]
+    fn a_cells_items_are_visited_in_input_order_across_simd_blocks() {
+        // 21 items in one cell (three eight-wide blocks, the last partial) interleaved with items
+        // of a neighbouring cell: a query sees each cell's items in their input order, whatever
+        // lane they fell in, and the partial block's lanes beyond the cell are not read as hits.
+        let pts: Vec<[f32; 3]> = (0..42)
+            .map(|i| {
+                let x = if i % 2 == 0 { 0.1 } else { 1.1 };
+                [x, 0.01 * (i / 2) as f32, 0.5]
+            })
+            .collect();
+        let grid = HashGrid::build(pts.clone(), 1.0).expect("grid");
+        let mut seen = Vec::new();
+        grid.within([0.5, 0.1, 0.5], 0.7, |n| {
+            seen.push(grid.items()[n.index as usize]);
+        });
+        let expected: Vec<[f32; 3]> = pts
+            .iter()
+            .step_by(2)
+            .chain(pts.iter().skip(1).step_by(2))
+            .copied()
+            .collect();
+        assert_eq!(seen, expected);
+        let mut only_first = Vec::new();
+        grid.within([0.1, 0.1, 0.5], 0.5, |n| only_first.push(n.index));
+        assert_eq!(only_first.len(), 21);
     }
 
     #[test]

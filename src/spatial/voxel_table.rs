@@ -39,7 +39,8 @@ impl HasPosition for Entry {
 /// returned them.
 #[derive(Debug, Clone)]
 pub struct VoxelTable {
-    grid: HashGrid<Entry>,
+    /// Boxed: the table is a field of the path tracer, kept small.
+    grid: Box<HashGrid<Entry>>,
     /// [`VOXEL_OFFSET`] in scene units.
     offset: Vec3,
 }
@@ -47,7 +48,7 @@ pub struct VoxelTable {
 impl Default for VoxelTable {
     fn default() -> Self {
         Self {
-            grid: HashGrid::default(),
+            grid: Box::default(),
             offset: Vec3::ZERO,
         }
     }
@@ -96,7 +97,7 @@ impl VoxelTable {
                 values.push(value);
             }
         }
-        let grid = HashGrid::build(entries, side)?;
+        let grid = Box::new(HashGrid::build(entries, side)?);
         Ok((Self { grid, offset }, values))
     }
 
