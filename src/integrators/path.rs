@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use super::context::{Context, PathObserver};
 use super::light_guide::LightGuide;
-use super::photon::PhotonMap;
+use super::photon::{PhotonMap, SHORT_GATHER, SHORT_GATHER_BOUNCES};
 use super::shadow::{LightConnection, RayCone, connect_light};
 use super::trace_log::{RayKind, ShadowRecord};
 use super::{LightPath, Radiance};
@@ -86,6 +86,9 @@ struct Branch {
     /// After a non-delta bounce from a vertex that read the global map, the emitters' light is
     /// accounted for: only the background still counts.
     background_only: bool,
+    /// Diffuse bounces before the vertex that reads the global map: `maps.global_at`, one more
+    /// for each short gather ray ([`SHORT_GATHER`]) the path made.
+    global_at: u32,
     kind: RayKind,
     parent: Option<usize>,
     depth: u32,
@@ -154,7 +157,9 @@ impl<'a> PathTracer<'a> {
     ///   they read no map, and after a vertex that read the caustic map they make no
     ///   next-event estimate of the lights it carries. Only lights the map carries
     ///   (`maps.caustic_lights`) are left out; the others' caustics stay in the camera path;
-    /// - `maps.global` at the vertices after `maps.global_at` diffuse bounces: there direct
+    /// - `maps.global` at the vertices after `maps.global_at` diffuse bounces (one more for
+    ///   each short gather ray, at most [`SHORT_GATHER_BOUNCES`]: one shorter than
+    ///   [`SHORT_GATHER`] times the global estimate's radius where it lands): there direct
     ///   light (next-event estimation, without MIS), caustics and the global map (light that
     ///   made at least one diffuse bounce; or any bounce, caustics included, with
     ///   `global_has_caustics`) account for all the light of the scene's emitters
@@ -188,6 +193,7 @@ impl<'a> PathTracer<'a> {
             since_local: None,
             map_read: false,
             background_only: false,
+            global_at: maps.global_at,
             kind: RayKind::Camera,
             parent: None,
             depth: 0,
@@ -210,6 +216,7 @@ impl<'a> PathTracer<'a> {
                 mut since_local,
                 mut map_read,
                 mut background_only,
+                mut global_at,
                 mut kind,
                 mut parent,
                 mut depth,
@@ -301,10 +308,25 @@ impl<'a> PathTracer<'a> {
                 // caustic map, the light it passes on is in that map.
                 let near = maps.near_specular.is_some_and(|a| bsdf.is_near_specular(a));
                 let reads = local && !near;
-                let read_global = reads
-                    && may_scatter
-                    && maps.global.is_some()
-                    && diffuse_bounces == maps.global_at;
+                let at_global =
+                    reads && may_scatter && maps.global.is_some() && diffuse_bounces == global_at;
+                // A short gather ray (Jensen 2001, §9.3): its end is so near the vertex it left
+                // that the global estimate's disc there reaches past the corner between them,
+                // where it is partly empty (dark corners); the path takes one more diffuse bounce
+                // and reads the global map after it instead (at most SHORT_GATHER_BOUNCES times).
+                let short = at_global
+                    && !specular
+                    && global_at < maps.global_at + SHORT_GATHER_BOUNCES
+                    && diffuse_bounces + 1 < params.diffuse_depth
+                    && maps
+                        .global
+                        .is_some_and(|g| hit.t < SHORT_GATHER * g.radius_at(sp.p));
+                if short {
+                    global_at += 1;
+                    cx.observer
+                        .note(node, "short gather ray: global map read one bounce later");
+                }
+                let read_global = at_global && !short;
                 // Next-event estimation through the non-delta part. Every bounce reserves the same
                 // dimensions, whether or not it uses them, and computes only those it uses.
                 let u_light = cx.sampler.defer_1d();
@@ -378,6 +400,7 @@ impl<'a> PathTracer<'a> {
                             since_local: since_local.map(|n| n + 1),
                             map_read,
                             background_only,
+                            global_at,
                             kind: if transmitted {
                                 RayKind::Refract
                             } else {

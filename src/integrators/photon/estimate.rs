@@ -222,6 +222,17 @@ impl PhotonMap {
         })
     }
 
+    /// The radius of the disc an estimate at `p` reads (scene units): the pass's `shrink · R(p)`
+    /// with a pass lookup, else the largest radius (a k-nearest estimate's disc is at most
+    /// that). What the short-gather rule compares a gather ray's length with.
+    #[must_use]
+    pub fn radius_at(&self, p: Vec3) -> f32 {
+        match &self.pass {
+            Some(pass) => self.shrink * pass.field.radius(p),
+            None => self.max_radius,
+        }
+    }
+
     /// Makes every later estimate a progressive pass's: it reads only the photons within
     /// `shrink` ∈ (0, 1] times the k-nearest radius `r` (the largest radius when fewer than k
     /// are found), over the area of that smaller disc (see the module docs).

@@ -93,12 +93,13 @@ const GATHER_SPECULAR_DEPTH: u32 = 4;
 /// past the corner between them, where the other surface's photons are rejected and the disc
 /// is partly empty (−5 % 1 cm from a wall; issue 29, corner-final-gather). A short ray does
 /// not read that estimate: it gathers one more diffuse bounce instead (Jensen 2001, §9.3's
-/// path-traced step for short gather rays), whose own landing is usually far.
-const SHORT_GATHER: f32 = 2.0;
+/// path-traced step for short gather rays), whose own landing is usually far. `path-ppm`'s
+/// final gathering from its global map follows the same rule.
+pub const SHORT_GATHER: f32 = 2.0;
 
 /// Most short-ray bounces one final-gather ray takes (deep in a corner, each may land near the
 /// corner again); after them the estimate is read as it is.
-const SHORT_GATHER_BOUNCES: u32 = 3;
+pub const SHORT_GATHER_BOUNCES: u32 = 3;
 
 /// The photon-mapping integrator: the maps, built once, and the camera-side estimator.
 #[derive(Debug)]
