@@ -245,6 +245,26 @@ impl Noise {
 /// octave averages to.
 pub const MEAN_ABS_NOISE: f32 = 0.22;
 
+/// The variance of `|noise|` over space (measured: see the tests): how far an unresolved
+/// turbulence octave strays from [`MEAN_ABS_NOISE`], which a non-linear function of turbulence
+/// (marble's veins) needs to filter without changing its mean.
+pub const VAR_ABS_NOISE: f32 = 0.024;
+
+/// The variance that [`Noise::turbulence_octaves`] leaves out when it replaces octaves by their
+/// mean: `Σᵢ (ampᵢ · (1 − wᵢ))² · VAR_ABS_NOISE` over the octaves, `wᵢ` each octave's resolved
+/// share and `ampᵢ = 2⁻ⁱ` (octaves taken as independent). 0 when every octave is resolved.
+#[must_use]
+pub fn unresolved_turbulence_variance(octaves: u32, resolved: f32) -> f32 {
+    let mut sum = 0.0;
+    let mut amp = 1.0f32;
+    for i in 0..octaves {
+        let missing = amp * (1.0 - (resolved - i as f32).clamp(0.0, 1.0));
+        sum += missing * missing;
+        amp *= 0.5;
+    }
+    sum * VAR_ABS_NOISE
+}
+
 /// How many octaves of a fractal sum whose first octave has features about 1 unit wide (the
 /// lattice spacing) can be resolved by a pixel footprint `width` units wide: octave `i` (features
 /// `2^−i` wide) is kept while `2^i · width ≤ ¼` and fades out by `2^i · width = ½` (Nyquist).
@@ -323,10 +343,11 @@ mod tests {
     fn fractional_octaves_fade_detail_in_continuously_and_whole_ones_are_exact() {
         let n = Noise::new(9);
         let mut rng = Rng::new(7, 7);
-        let (mut abs_sum, mut count) = (0.0f64, 0u32);
+        let (mut abs_sum, mut sq_sum, mut count) = (0.0f64, 0.0f64, 0u32);
         for _ in 0..20_000 {
             let p = point(&mut rng, 40.0);
             abs_sum += f64::from(n.noise(p).abs());
+            sq_sum += f64::from(n.noise(p)).powi(2);
             count += 1;
             // Whole numbers of octaves are bit-identical to the plain sums.
             assert_eq!(n.fbm_octaves(p, 5.0).to_bits(), n.fbm(p, 5).to_bits());
@@ -347,6 +368,12 @@ mod tests {
         assert!(
             (mean - f64::from(MEAN_ABS_NOISE)).abs() < 0.01,
             "mean |noise| {mean}"
+        );
+        // And the variance that marble's filter restores is the measured variance of |noise|.
+        let var = sq_sum / f64::from(count) - mean * mean;
+        assert!(
+            (var - f64::from(VAR_ABS_NOISE)).abs() < 0.003,
+            "variance of |noise| {var}"
         );
         // Unresolved octaves keep turbulence's average: 0 resolved of 6 is the mean of 6.
         let mut rng = Rng::new(8, 8);
