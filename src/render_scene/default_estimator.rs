@@ -4,8 +4,8 @@
 //! The choice is made once, when the scene is compiled, from what the scene can do:
 //!
 //! - A **specular caster** is an object whose material has a delta (mirror or smooth
-//!   dielectric) part, asked through `Bsdf::has_delta`, or is near-specular (a glossy metal or
-//!   glass at most [`NEAR_SPECULAR_ALPHA`] wide, `Bsdf::is_near_specular`) — exactly the objects
+//!   dielectric) part of non-zero weight, or is near-specular (a glossy metal or glass at most
+//!   [`NEAR_SPECULAR_ALPHA`] wide), asked through `Bsdf::focusing_share` — exactly the objects
 //!   the progressive integrators' caustic photons are aimed at (`integrators::photon::aim`), so
 //!   "no caster" means "an empty caustic map". Only such an object can focus light onto a
 //!   diffuse surface (a caustic: light → specular⁺ → diffuse), the paths a path tracer finds
@@ -103,9 +103,8 @@ impl DefaultEstimator {
             .iter()
             .filter_map(|o| o.material)
             .filter(|&m| {
-                material(m as usize).is_some_and(|m| {
-                    m.bsdf.has_delta() || m.bsdf.is_near_specular(NEAR_SPECULAR_ALPHA)
-                })
+                material(m as usize)
+                    .is_some_and(|m| m.bsdf.focusing_share(Some(NEAR_SPECULAR_ALPHA)) > 0.0)
             })
             .count();
         if specular_casters == 0 {

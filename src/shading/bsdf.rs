@@ -383,6 +383,21 @@ impl Bsdf {
         s
     }
 
+    /// The share of the light this BSDF can focus into a caustic, with near-specular surfaces
+    /// (GGX α up to `near_specular`, [`Bsdf::is_near_specular`]) counting whole: what caustic
+    /// photons are aimed by ([`Bsdf::delta_share`] otherwise), and, when positive, what makes
+    /// an object a specular caster for the default estimator. The two read this one function so
+    /// that "no caster" stays "an empty caustic map".
+    #[inline]
+    #[must_use]
+    pub fn focusing_share(&self, near_specular: Option<f32>) -> f32 {
+        if near_specular.is_some_and(|a| self.is_near_specular(a)) {
+            1.0
+        } else {
+            self.delta_share()
+        }
+    }
+
     /// The relative index of refraction (inside over outside) of the transmitting part, if it
     /// has weight.
     #[must_use]

@@ -159,8 +159,7 @@ impl Marble {
     #[must_use]
     pub fn eval_filtered(&self, p: Vec3, width: f32) -> Vec3 {
         let resolved = self.resolved(width).max(self.min_resolved);
-        let q = p * self.scale;
-        let phi = q.x + self.turbulence * self.noise.turbulence_octaves(q, self.octaves, resolved);
+        let phi = self.phase(p, resolved);
         let var = self.turbulence
             * self.turbulence
             * unresolved_turbulence_variance(self.octaves, resolved);
@@ -176,13 +175,15 @@ impl Marble {
     /// Vein weight `w` at `p`, in [0, 1]; also a height for bump mapping.
     #[must_use]
     pub fn vein_weight(&self, p: Vec3) -> f32 {
-        self.vein_weight_resolved(p, self.octaves as f32)
+        ramp(1.0 - self.phase(p, self.octaves as f32).sin().abs()).0
     }
 
-    fn vein_weight_resolved(&self, p: Vec3, resolved: f32) -> f32 {
+    /// The vein phase `φ` at `p` with the first `resolved` turbulence octaves evaluated and the
+    /// rest at their mean.
+    #[inline]
+    fn phase(&self, p: Vec3, resolved: f32) -> f32 {
         let q = p * self.scale;
-        let phi = q.x + self.turbulence * self.noise.turbulence_octaves(q, self.octaves, resolved);
-        ramp(1.0 - phi.sin().abs()).0
+        q.x + self.turbulence * self.noise.turbulence_octaves(q, self.octaves, resolved)
     }
 
     /// Exact gradient of [`vein_weight`](Self::vein_weight) with respect to `p` (away from the

@@ -89,12 +89,9 @@ impl CausticTargets {
             .iter()
             .map(|o| {
                 o.material.map_or(0.0, |m| {
-                    let bsdf = &scene.materials[m as usize].bsdf;
-                    if near_specular.is_some_and(|a| bsdf.is_near_specular(a)) {
-                        1.0
-                    } else {
-                        bsdf.delta_share()
-                    }
+                    scene.materials[m as usize]
+                        .bsdf
+                        .focusing_share(near_specular)
                 })
             })
             .collect();
