@@ -4,6 +4,7 @@
 //! would for the samples taken so far.
 
 mod frame;
+mod http;
 mod save;
 mod server;
 mod session;
@@ -181,11 +182,13 @@ impl Settings {
 /// Serves the preview until Ctrl-C, which ends it with [`Error::Interrupted`] (exit code 130).
 pub fn run(args: &PreviewArgs) -> Result<(), Error> {
     let settings = Settings::new(&args.render)?;
-    let shared = Arc::new(Shared::new(settings.scene.display().to_string()));
+    // The page shows the scene's file name, not where it is: the status is readable by any
+    // local process, and the folder names can say who the user is.
+    let shared = Arc::new(Shared::new(scene_name(&settings.scene)));
     let (to_render, from_server) = channel::<Msg>();
     install_interrupt(&shared, &to_render);
     let address = format!("127.0.0.1:{}", args.port.unwrap_or(0));
-    let server = tiny_http::Server::http(&address).map_err(|e| {
+    let server = server::Server::bind(&address).map_err(|e| {
         Error::Usage(format!(
             "cannot serve the preview on {address}: {e}{}",
             if args.port.is_some() {
@@ -195,7 +198,7 @@ pub fn run(args: &PreviewArgs) -> Result<(), Error> {
             }
         ))
     })?;
-    let port = server.server_addr().to_ip().map_or(0, |a| a.port());
+    let port = server.port();
     let (s, tx) = (Arc::clone(&shared), to_render.clone());
     let mut watch = watch::FileWatch::new(move || {
         // Stop the pass in progress at once; the render thread then reads the scene again.
@@ -211,13 +214,7 @@ pub fn run(args: &PreviewArgs) -> Result<(), Error> {
     let renderer = std::thread::spawn(move || {
         session::run(&settings, &render_shared, &from_server, &mut watch);
     });
-    while !shared.quit.load(Ordering::SeqCst) && !renderer.is_finished() {
-        match server.recv_timeout(Duration::from_millis(100)) {
-            Ok(Some(request)) => server::handle(request, &shared, &to_render),
-            Ok(None) => {}
-            Err(e) => eprintln!("warning: the preview's server: {e}"),
-        }
-    }
+    server.serve(&shared, &to_render, || renderer.is_finished());
     // Ctrl-C: stop the pass in progress and let the render thread end: a save or checkpoint
     // under way finishes first, so no temporary file is left. While the scene loads or photons
     // are traced nothing is being written, and that work does not look at the cancel flag:
@@ -232,6 +229,13 @@ pub fn run(args: &PreviewArgs) -> Result<(), Error> {
     }
     let _ = renderer.join();
     Err(Error::Interrupted("interrupted: preview stopped".into()))
+}
+
+/// The scene's file name as the page shows it (never its folder).
+fn scene_name(scene: &std::path::Path) -> String {
+    scene
+        .file_name()
+        .map_or_else(|| scene.display().to_string(), |n| n.to_string_lossy().into_owned())
 }
 
 /// Ctrl-C (and SIGTERM/SIGHUP): ends the server loop and the render thread cleanly.

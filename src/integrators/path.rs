@@ -8,12 +8,13 @@ use glam::Vec3;
 use super::context::{Context, PathObserver};
 use super::light_guide::LightGuide;
 use super::photon::{PhotonMap, SHORT_GATHER, SHORT_GATHER_BOUNCES};
-use super::shadow::{LightConnection, RayCone, connect_light};
+use super::shadow::{LightConnection, RayCone, connect_light, shadow_ray};
 use super::trace_log::{RayKind, ShadowRecord};
+use super::whitted::shadow_transmittance;
 use super::{LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Interaction, Medium, RenderScene, SurfacePoint};
+use crate::render_scene::{Interaction, Medium, RenderScene, SurfaceHit, SurfacePoint};
 use crate::shading::{BsdfAt, TransportMode};
 
 /// Bounces after which Russian roulette may end a path.
@@ -338,7 +339,9 @@ impl<'a> PathTracer<'a> {
                 {
                     let u = cx.sampler.get_2d(u_point);
                     let scatter = may_scatter && !read_global;
-                    let c = self.direct(sp, &at, index, pmf, u, scatter, cx, node);
+                    // Where the diffuse depth ends, direct light is Whitted's: through glass too.
+                    let through = (!may_scatter).then_some((v, medium));
+                    let c = self.direct(sp, &at, index, pmf, u, scatter, through, cx, node);
                     l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
                 }
                 let read_caustic = reads
@@ -526,7 +529,11 @@ impl PathTracer<'_> {
     /// Next-event estimation at `sp` towards light `index` (chosen with probability `pmf`):
     /// the radiance it sends through the non-delta part of the BSDF, MIS-weighted against BSDF
     /// sampling when the path may still scatter diffusely (else the light sample alone stands
-    /// for direct light). Logged as a shadow record.
+    /// for direct light). `through`: the vertex and the medium its ray travelled in, where the
+    /// diffuse depth ends (no BSDF sample follows, so no light would come through glass):
+    /// there a blocked shadow ray crosses transmitting surfaces in a straight line as
+    /// Whitted's do ([`shadow_transmittance`]), which makes `diffuse_depth: 0` Whitted's
+    /// transport. Logged as a shadow record.
     #[allow(clippy::too_many_arguments)]
     fn direct<O: PathObserver>(
         &self,
@@ -536,6 +543,7 @@ impl PathTracer<'_> {
         pmf: f32,
         u: (f32, f32),
         may_scatter: bool,
+        through: Option<(&SurfaceHit, Medium)>,
         cx: &mut Context<'_, O>,
         node: Option<usize>,
     ) -> Vec3 {
@@ -552,12 +560,23 @@ impl PathTracer<'_> {
         } else {
             power_heuristic(ls.pdf * pmf, at.pdf(ls.wi))
         };
+        let transmittance = match through {
+            None if blocked => Vec3::ZERO,
+            None => Vec3::ONE,
+            Some(_) if !blocked => Vec3::ONE,
+            Some((v, medium)) => {
+                let shadow = shadow_ray(sp, at.frame().ng, ls.point);
+                let start = medium.after(self.scene, v, ls.wi);
+                shadow_transmittance(self.scene, true, &shadow, start, cx.counters)
+            }
+        };
+        let blocked = transmittance == Vec3::ZERO;
         let c = if blocked {
             Vec3::ZERO
         } else {
             // |cos θ|: a light seen through a transmitting non-delta lobe (rough glass) lies
             // below the shading normal, where the signed cosine would subtract its light.
-            f * (at.frame().ns.dot(ls.wi).abs() * w / (ls.pdf * pmf)) * ls.radiance
+            f * (at.frame().ns.dot(ls.wi).abs() * w / (ls.pdf * pmf)) * ls.radiance * transmittance
         };
         if O::ACTIVE {
             let record = ShadowRecord {

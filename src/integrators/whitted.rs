@@ -253,58 +253,71 @@ impl<'a> Whitted<'a> {
 }
 
 impl Whitted<'_> {
-    /// How much of the light travelling along `shadow` (up to its `t_max`) arrives: 0 when an
-    /// opaque surface is in the way, else the product of the straight-line transmittances of
-    /// the dielectric surfaces crossed (`Bsdf::straight_transmittance`) and of Beer–Lambert's
-    /// `exp(−σ t)` over each stretch inside an absorbing medium, the first in `start`.
+    /// [`shadow_transmittance`] in this integrator's scene.
     fn transmittance(&self, shadow: &Ray, start: Medium, counters: &mut Counters) -> Vec3 {
-        counters.rays += 1;
-        let scene = self.scene;
-        // Most shadow rays are unblocked, or blocked by something opaque: any-hit queries
-        // settle them; only rays that meet nothing but transmitters walk their crossings.
-        if !scene.geometry.occluded(shadow) {
-            return start.transmittance_over(shadow.dir.length() * shadow.t_max);
-        }
-        if !self.transmissive
-            || scene.geometry.occluded_by(shadow, |prim| {
-                scene.is_opaque(scene.geometry.object_of(prim))
-            })
-        {
+        shadow_transmittance(self.scene, self.transmissive, shadow, start, counters)
+    }
+}
+
+/// How much of the light travelling along `shadow` (up to its `t_max`) arrives: 0 when an
+/// opaque surface is in the way, else the product of the straight-line transmittances of
+/// the dielectric surfaces crossed (`Bsdf::straight_transmittance`) and of Beer–Lambert's
+/// `exp(−σ t)` over each stretch inside an absorbing medium, the first in `start`.
+/// `transmissive` false says no material of `scene` transmits (then any hit blocks). Whitted's
+/// shadow rays, and the path tracer's where its diffuse depth ends (`diffuse_depth`: there it
+/// computes Whitted's transport).
+pub(super) fn shadow_transmittance(
+    scene: &RenderScene,
+    transmissive: bool,
+    shadow: &Ray,
+    start: Medium,
+    counters: &mut Counters,
+) -> Vec3 {
+    counters.rays += 1;
+    // Most shadow rays are unblocked, or blocked by something opaque: any-hit queries
+    // settle them; only rays that meet nothing but transmitters walk their crossings.
+    if !scene.geometry.occluded(shadow) {
+        return start.transmittance_over(shadow.dir.length() * shadow.t_max);
+    }
+    if !transmissive
+        || scene.geometry.occluded_by(shadow, |prim| {
+            scene.is_opaque(scene.geometry.object_of(prim))
+        })
+    {
+        return Vec3::ZERO;
+    }
+    let end = shadow.origin + shadow.dir * shadow.t_max;
+    let mut ray = *shadow;
+    let mut t = Vec3::ONE;
+    let mut medium = start;
+    for _ in 0..MAX_SHADOW_CROSSINGS {
+        let mut textured = None;
+        let v = match scene.interact(&ray, |_| 0.0, &mut textured) {
+            // Nothing more before the light: the last stretch, in the current medium.
+            Interaction::Escaped => {
+                return t * medium.transmittance_over(ray.dir.length() * ray.t_max);
+            }
+            Interaction::Surface(v) if !scene.is_opaque(v.sp.object) => v,
+            Interaction::Surface(_) | Interaction::Emitter(_) => return Vec3::ZERO,
+        };
+        t *= medium.transmittance_over(v.hit.t * ray.dir.length());
+        t *= v
+            .bsdf
+            .straight_transmittance(v.frame.ns.dot(v.wo), v.frame.entering);
+        medium = medium.after(scene, &v, ray.dir);
+        if t.max_element() <= 0.0 {
             return Vec3::ZERO;
         }
-        let end = shadow.origin + shadow.dir * shadow.t_max;
-        let mut ray = *shadow;
-        let mut t = Vec3::ONE;
-        let mut medium = start;
-        for _ in 0..MAX_SHADOW_CROSSINGS {
-            let mut textured = None;
-            let v = match scene.interact(&ray, |_| 0.0, &mut textured) {
-                // Nothing more before the light: the last stretch, in the current medium.
-                Interaction::Escaped => {
-                    return t * medium.transmittance_over(ray.dir.length() * ray.t_max);
-                }
-                Interaction::Surface(v) if !scene.is_opaque(v.sp.object) => v,
-                Interaction::Surface(_) | Interaction::Emitter(_) => return Vec3::ZERO,
-            };
-            t *= medium.transmittance_over(v.hit.t * ray.dir.length());
-            t *= v
-                .bsdf
-                .straight_transmittance(v.frame.ns.dot(v.wo), v.frame.entering);
-            medium = medium.after(scene, &v, ray.dir);
-            if t.max_element() <= 0.0 {
-                return Vec3::ZERO;
-            }
-            let origin = offset_ray_origin(v.sp.p, v.sp.p_error, -v.frame.ng, ray.dir);
-            ray = Ray {
-                origin,
-                dir: end - origin,
-                t_max: 1.0,
-            };
-            counters.rays += 1;
-        }
-        // Still crossing surfaces after the limit: keep what has come through so far.
-        t
+        let origin = offset_ray_origin(v.sp.p, v.sp.p_error, -v.frame.ng, ray.dir);
+        ray = Ray {
+            origin,
+            dir: end - origin,
+            t_max: 1.0,
+        };
+        counters.rays += 1;
     }
+    // Still crossing surfaces after the limit: keep what has come through so far.
+    t
 }
 
 /// Radiance of an emitter or the background seen along a camera ray's mirror and glass chain.

@@ -13,6 +13,7 @@ pub mod pixel_sums;
 pub mod tiles;
 pub mod tonemap;
 pub mod trace_pixel;
+pub mod wide_sum;
 
 pub use film::Film;
 pub use job::{RenderJob, render};

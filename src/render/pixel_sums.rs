@@ -3,22 +3,57 @@
 //! scene over disjoint sample ranges therefore merge into the very bytes of one render of all
 //! the samples, in any order (the basis of `--checkpoint`, `--time` and farm shards). Written to
 //! disk losslessly (`.part` files) with a checksum.
+//!
+//! A sample channel of magnitude [`MAIN_LIMIT`] or more (a light of radiance 1e9 seen directly)
+//! would overflow the 128-bit sums over 2³² samples: such channels are summed, just as exactly,
+//! in 384-bit integers ([`WideSum`]) kept for the few pixels that have them, so any finite
+//! radiance keeps its value in the mean and in the variance (before, sums saturated at 2⁶³ and
+//! squares at 4e28, silently: issue 47, exr-huge-radiance).
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
 
 use super::Film;
+use super::wide_sum::WideSum;
 use crate::binfile::{Reader, fnv1a};
 use crate::integrators::splat::{SUM_SCALE as SCALE, SplatBuffer, to_fixed as fixed};
 
 // The fixed-point scale of the sums (`SCALE`, shared with the splat buffer): samples are rounded
 // to multiples of 2⁻⁶⁴ (about 5.4e-20) before summing, so even a light of a microwatt keeps 11
-// significant digits; sums saturate at 2⁶³ ≈ 9.2e18.
-/// Fixed-point scale of the sums of squares: 2⁻³² resolution, saturating at 4e28.
+// significant digits.
+/// Fixed-point scale of the sums of squares: 2⁻³² resolution.
 const SCALE_SQ: f64 = 4_294_967_296.0;
-/// File signature of a `.part` film.
+/// Sample channels of at least this magnitude (2³⁰ ≈ 1.07e9) go to the wide sums: below it,
+/// 2³² samples sum to less than 2¹²⁷ at both fixed-point scales.
+pub const MAIN_LIMIT: f64 = 1_073_741_824.0;
+/// File signature of a `.part` film without wide sums (as every film before them).
 const MAGIC: &[u8; 16] = b"caustic-film-v1\n";
+/// File signature of a `.part` film with wide sums: after the counts, the number of pixels with
+/// wide sums (u64) and, per such pixel in increasing order, its index (u32) and its three sums
+/// and three sums of squares (48 bytes each, little-endian two's complement).
+const MAGIC_WIDE: &[u8; 16] = b"caustic-film-v2\n";
+/// Bytes of one wide entry in a v2 file.
+const WIDE_ENTRY: usize = 4 + 6 * WideSum::BYTES;
+
+/// The exact sums of one pixel's sample channels too large for the 128-bit sums.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct WideSums {
+    /// Σ sample · 2⁶⁴ per channel.
+    sums: [WideSum; 3],
+    /// Σ sample² · 2³² per channel.
+    squares: [WideSum; 3],
+}
+
+impl WideSums {
+    fn add(&mut self, other: &WideSums) {
+        for c in 0..3 {
+            self.sums[c] = self.sums[c].add(other.sums[c]);
+            self.squares[c] = self.squares[c].add(other.squares[c]);
+        }
+    }
+}
 
 /// Why a film file could not be read or merged.
 #[derive(Debug, thiserror::Error)]
@@ -57,6 +92,8 @@ pub struct PixelSums {
     squares: Vec<[i128; 3]>,
     /// Samples added per pixel (finite samples only; NaN/Inf are counted by the renderer).
     counts: Vec<u32>,
+    /// The wide sums of the pixels (by index) that received a channel of [`MAIN_LIMIT`] or more.
+    wide: BTreeMap<u32, WideSums>,
 }
 
 impl PixelSums {
@@ -70,6 +107,7 @@ impl PixelSums {
             sums: vec![[0; 3]; n],
             squares: vec![[0; 3]; n],
             counts: vec![0; n],
+            wide: BTreeMap::new(),
         }
     }
 
@@ -79,8 +117,15 @@ impl PixelSums {
         let l = l.as_dvec3();
         let (s, q) = (&mut self.sums[index], &mut self.squares[index]);
         for c in 0..3 {
-            s[c] = s[c].saturating_add(fixed(l[c], SCALE));
-            q[c] = q[c].saturating_add(fixed(l[c] * l[c], SCALE_SQ));
+            if l[c].abs() < MAIN_LIMIT {
+                s[c] = s[c].saturating_add(fixed(l[c], SCALE));
+                q[c] = q[c].saturating_add(fixed(l[c] * l[c], SCALE_SQ));
+            } else {
+                // Integral at both scales (|l| ≥ 2³⁰), so the conversion is exact.
+                let w = self.wide.entry(index as u32).or_default();
+                w.sums[c] = w.sums[c].add(WideSum::from_integral_f64(l[c] * SCALE));
+                w.squares[c] = w.squares[c].add(WideSum::from_integral_f64(l[c] * l[c] * SCALE_SQ));
+            }
         }
         self.counts[index] += 1;
     }
@@ -93,6 +138,9 @@ impl PixelSums {
             self.squares[to][c] = self.squares[to][c].saturating_add(other.squares[from][c]);
         }
         self.counts[to] += other.counts[from];
+        if let Some(w) = other.wide.get(&(from as u32)) {
+            self.wide.entry(to as u32).or_default().add(w);
+        }
     }
 
     /// Adds every pixel of `other` (same size) into `self`. Exact: the order of merges never
@@ -153,8 +201,33 @@ impl PixelSums {
         if n == 0 {
             return Vec3::ZERO;
         }
-        let s = self.sums[index];
-        (DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64) / (SCALE * f64::from(n))).as_vec3()
+        let s = self.total(index, |w| w.sums, &self.sums);
+        (DVec3::new(s[0], s[1], s[2]) / (SCALE * f64::from(n))).as_vec3()
+    }
+
+    /// The fixed-point sums of pixel `index` in `main`, with its wide sums (`part` of them) if
+    /// any, as f64: `i128 as f64` when the total fits an i128 (so films without wide sums read
+    /// as they always did).
+    fn total(
+        &self,
+        index: usize,
+        part: impl Fn(&WideSums) -> [WideSum; 3],
+        main: &[[i128; 3]],
+    ) -> [f64; 3] {
+        let m = main[index];
+        match self.wide.get(&(index as u32)) {
+            None => m.map(|v| v as f64),
+            Some(w) => {
+                let w = part(w);
+                [0, 1, 2].map(|c| WideSum::from_i128(m[c]).add(w[c]).to_f64())
+            }
+        }
+    }
+
+    /// True when pixel `index` received a sample channel of [`MAIN_LIMIT`] or more.
+    #[must_use]
+    pub fn has_wide_sums(&self, index: usize) -> bool {
+        self.wide.contains_key(&(index as u32))
     }
 
     /// Unbiased sample variance of pixel `index`'s samples per channel (0 with fewer than two);
@@ -165,10 +238,11 @@ impl PixelSums {
         if n < 2.0 {
             return Vec3::ZERO;
         }
-        let (s, q) = (self.sums[index], self.squares[index]);
+        let s = self.total(index, |w| w.sums, &self.sums);
+        let q = self.total(index, |w| w.squares, &self.squares);
         let v = |c: usize| {
-            let mean = s[c] as f64 / SCALE / n;
-            ((q[c] as f64 / SCALE_SQ - n * mean * mean) / (n - 1.0)).max(0.0)
+            let mean = s[c] / SCALE / n;
+            ((q[c] / SCALE_SQ - n * mean * mean) / (n - 1.0)).max(0.0)
         };
         DVec3::new(v(0), v(1), v(2)).as_vec3()
     }
@@ -189,8 +263,9 @@ impl PixelSums {
     #[must_use]
     pub fn to_bytes(&self, metadata: &str) -> Vec<u8> {
         let n = self.counts.len();
-        let mut out = Vec::with_capacity(64 + metadata.len() + n * 100);
-        out.extend_from_slice(MAGIC);
+        let mut out =
+            Vec::with_capacity(72 + metadata.len() + n * 100 + self.wide.len() * WIDE_ENTRY);
+        out.extend_from_slice(if self.wide.is_empty() { MAGIC } else { MAGIC_WIDE });
         out.extend_from_slice(&self.width.to_le_bytes());
         out.extend_from_slice(&self.height.to_le_bytes());
         out.extend_from_slice(&(metadata.len() as u64).to_le_bytes());
@@ -208,6 +283,15 @@ impl PixelSums {
         for c in &self.counts {
             out.extend_from_slice(&c.to_le_bytes());
         }
+        if !self.wide.is_empty() {
+            out.extend_from_slice(&(self.wide.len() as u64).to_le_bytes());
+            for (index, w) in &self.wide {
+                out.extend_from_slice(&index.to_le_bytes());
+                for v in w.sums.iter().chain(&w.squares) {
+                    out.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+        }
         let sum = fnv1a(&out);
         out.extend_from_slice(&sum.to_le_bytes());
         out
@@ -223,9 +307,18 @@ impl PixelSums {
             path: name.to_string(),
             reason: reason.to_string(),
         };
-        if bytes.len() < MAGIC.len() + 24 || &bytes[..MAGIC.len()] != MAGIC {
+        if bytes.len() < MAGIC.len() + 24 || !bytes.starts_with(b"caustic-film-v") {
             return Err(bad("no caustic film signature"));
         }
+        let wide = match &bytes[..MAGIC.len()] {
+            m if m == MAGIC => false,
+            m if m == MAGIC_WIDE => true,
+            _ => {
+                return Err(bad(
+                    "a film version this caustic does not know (it reads v1 and v2): written by a newer caustic?",
+                ));
+            }
+        };
         let (body, tail) = bytes.split_at(bytes.len() - 8);
         let stored = u64::from_le_bytes(tail.try_into().map_err(|_| bad("truncated"))?);
         if fnv1a(body) != stored {
@@ -242,6 +335,29 @@ impl PixelSums {
             .checked_add(n.checked_mul(100).ok_or_else(|| bad("absurd size"))?)
             .and_then(|x| x.checked_add(r.position()))
             .ok_or_else(|| bad("absurd size"))?;
+        // v2: the wide entries follow, their number first.
+        let entries = if wide {
+            let at = expected;
+            let count = body
+                .get(at..at + 8)
+                .and_then(|b| b.try_into().ok())
+                .map(u64::from_le_bytes)
+                .ok_or_else(|| bad("truncated"))?;
+            if count == 0 || count > n as u64 {
+                return Err(bad("wrong number of wide pixel sums"));
+            }
+            count as usize
+        } else {
+            0
+        };
+        let expected = if wide {
+            expected
+                .checked_add(8)
+                .and_then(|x| x.checked_add(entries.checked_mul(WIDE_ENTRY)?))
+                .ok_or_else(|| bad("absurd size"))?
+        } else {
+            expected
+        };
         if expected != body.len() {
             return Err(bad("size does not match its header"));
         }
@@ -261,6 +377,25 @@ impl PixelSums {
         }
         for c in &mut film.counts {
             *c = r.u32().map_err(truncated)?;
+        }
+        if wide {
+            r.u64().map_err(truncated)?;
+            let mut last = None;
+            for _ in 0..entries {
+                let index = r.u32().map_err(truncated)?;
+                if index as usize >= n || last.is_some_and(|l| l >= index) {
+                    return Err(bad("wide pixel sums out of order or outside the film"));
+                }
+                last = Some(index);
+                let mut w = WideSums::default();
+                for v in w.sums.iter_mut().chain(w.squares.iter_mut()) {
+                    let b = r.take(WideSum::BYTES).map_err(truncated)?;
+                    let mut a = [0u8; WideSum::BYTES];
+                    a.copy_from_slice(b);
+                    *v = WideSum::from_le_bytes(a);
+                }
+                film.wide.insert(index, w);
+            }
         }
         Ok((film, meta))
     }

@@ -117,7 +117,7 @@ impl std::fmt::Display for PhotonSummary {
                     mean_flux(c.stored_flux),
                     if c.lost_at_depth > 0 {
                         format!(
-                            ", {} cut by max_bounces carrying {:.4} W, {:.2} % of the flux stored",
+                            ", {} cut by max_bounces, which would have stored {:.4} W more, {:.2} % of the flux stored",
                             c.lost_at_depth,
                             mean_flux(c.lost_flux),
                             100.0 * mean_flux(c.lost_flux)

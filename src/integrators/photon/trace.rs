@@ -46,7 +46,11 @@ pub struct TraceCounts {
     pub stored_flux: Vec3,
     /// Photon paths cut by `max_bounces` while they still carried flux.
     pub lost_at_depth: u64,
-    /// Flux of the paths cut by `max_bounces` (W per channel).
+    /// Flux the paths cut by `max_bounces` would have stored had they gone on (W per channel):
+    /// each cut path is traced on without storing, for up to another `max_bounces` bounces
+    /// ([`trace_photon`]), and what it would have stored is summed here. This is the light the
+    /// cap takes from the map (the flux a path carries when cut understates it: in a closed
+    /// room of albedo ρ that photon would have been stored about 1/(1 − ρ) more times).
     pub lost_flux: Vec3,
 }
 
@@ -96,6 +100,10 @@ impl TraceSettings {
 
 /// Traces one photon from `ray` carrying `power`, appending what it stores to `out` and
 /// counting into `counts`; random numbers come from `sampler` (started on this photon).
+/// Russian roulette ends paths (unbiased); `max_bounces` is a safety net against paths that
+/// never lose flux (closed white mirrors): a path still alive after it is counted as cut
+/// (`lost_at_depth`) and traced on, storing nothing, for up to another `max_bounces` bounces to
+/// measure what the cut takes away (`lost_flux`).
 pub fn trace_photon(
     scene: &RenderScene,
     mut ray: Ray,
@@ -109,6 +117,8 @@ pub fn trace_photon(
     let mut diffuse_bounces = 0u32;
     let mut bounces = 0u32;
     let mut medium = Medium::OUTSIDE;
+    // Past `max_bounces`: the path is only followed to account for what it would have stored.
+    let mut cut = false;
     loop {
         let mut textured = None;
         let it = scene.interact(&ray, |_| 0.0, &mut textured);
@@ -134,7 +144,9 @@ pub fn trace_photon(
                 MapKind::Global if settings.any_bounce => bounces >= settings.min_bounces,
                 MapKind::Global => diffuse_bounces >= settings.min_bounces,
             };
-            if store {
+            if store && cut {
+                counts.lost_flux += power;
+            } else if store {
                 out.push(Photon::new(sp.p, dir, fr.ng, power));
                 counts.stored += 1;
                 counts.stored_flux += power;
@@ -166,9 +178,11 @@ pub fn trace_photon(
             power *= max_flux / m;
         }
         bounces += 1;
-        if bounces > settings.max_bounces {
+        if bounces > settings.max_bounces && !cut {
+            cut = true;
             counts.lost_at_depth += 1;
-            counts.lost_flux += power;
+        }
+        if bounces > settings.max_bounces.saturating_mul(2) {
             return;
         }
         medium = medium.after(scene, &v, s.wi);

@@ -168,7 +168,7 @@ impl Default for PhotonSettings {
             caustic_filter: PhotonFilter::Cone { k: 1.1 },
             min_bounces: 1,
             final_gather: 16,
-            max_bounces: 16,
+            max_bounces: 256,
         }
     }
 }
