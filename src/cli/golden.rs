@@ -1,9 +1,10 @@
-//! `caustic golden`: noise-aware snapshot tests. `update` renders each scene and stores its
-//! per-pixel means with the variance of each mean and the settings hash
-//! ([`caustic::render::golden`]); `check` renders again with a fresh seed and decides "same
-//! scene within noise" or "changed" with the block z-test of
-//! [`caustic::render::golden::block_test`] (exit code 3 when a scene changed), writing an
-//! error image and listing the blocks that moved.
+//! `caustic golden`: noise-aware snapshot tests, the command-line side only. `update` renders
+//! each scene batch by batch and stores the golden ([`caustic::render::golden`]: block means
+//! per batch, per-pixel means, the settings) and states its detection floor; `check` renders
+//! again with a fresh seed and decides "same scene within noise" or "changed" by the
+//! batch-means test of [`caustic::render::golden::batch_means`] (exit code 3 when a scene
+//! changed). This file parses the flags, finds the scenes, applies the recorded flags and
+//! prints; the report's words are [`caustic::render::golden::report`]'s.
 
 use std::path::{Path, PathBuf};
 
@@ -12,11 +13,14 @@ use clap::{Args, Subcommand};
 use caustic::Error;
 use caustic::farm::part_meta::settings_hash;
 use caustic::pipeline::{SceneOverrides, prepare};
-use caustic::render::golden::{BlockTest, GoldenImage, GoldenMeta, PixelEstimates};
-use caustic::render::{RenderOptions, render};
+use caustic::render::RenderOptions;
+use caustic::render::golden::floor::{self, DetectionFloor};
+use caustic::render::golden::{
+    BatchBlocks, BatchTest, GoldenImage, GoldenMeta, PixelEstimates, render_batches, report,
+};
 use caustic::settings::{IntegratorKind, SamplerKind};
 
-use super::golden_report::{self as report, Outcome};
+use super::golden_report::{self as verdict, Outcome};
 use super::{SceneArgs, print_warnings};
 
 /// Arguments of `caustic golden`.
@@ -48,6 +52,21 @@ struct UpdateArgs {
     /// The folder of golden images (created if missing).
     #[arg(short, long, value_name = "DIR")]
     output: PathBuf,
+    /// Block side in pixels (the finest scale of the test; coarser scales are squares of
+    /// 2×2, 4×4, … blocks).
+    #[arg(long, default_value = "8", value_name = "PIXELS")]
+    block: u32,
+    /// The smallest change to catch, e.g. `2%`: render at the samples per pixel that catch a
+    /// change of that size over a square of 5 % of the image in 95 % of checks (recorded as
+    /// `--spp`).
+    #[arg(long, value_name = "PERCENT", value_parser = parse_percent)]
+    detect: Option<f64>,
+    /// Most samples per pixel `--detect` may choose.
+    #[arg(long, default_value = "4096", value_name = "SPP")]
+    detect_limit: u32,
+    /// The checks' false-alarm rate, for the detection floor stated.
+    #[arg(long, default_value = "0.01", value_parser = parse_alpha)]
+    alpha: f64,
     /// Worker threads (default: all cores); never changes the pixels.
     #[arg(long)]
     threads: Option<usize>,
@@ -71,9 +90,6 @@ struct CheckArgs {
     /// called changed.
     #[arg(long, default_value = "0.01", value_parser = parse_alpha)]
     alpha: f64,
-    /// Block side in pixels.
-    #[arg(long, default_value = "8", value_name = "PIXELS")]
-    block: u32,
     /// Where error images of changed scenes go (default: the golden folder), as
     /// <file>.error.png.
     #[arg(long, value_name = "DIR")]
@@ -84,6 +100,18 @@ struct CheckArgs {
     /// No warnings.
     #[arg(short, long)]
     quiet: bool,
+}
+
+fn parse_percent(text: &str) -> Result<f64, String> {
+    let t = text.trim();
+    t.strip_suffix('%')
+        .unwrap_or(t)
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|p| *p > 0.0 && *p < 100.0)
+        .map(|p| p / 100.0)
+        .ok_or_else(|| format!("expected a percentage between 0 and 100, e.g. 2%, found `{text}`"))
 }
 
 fn parse_alpha(text: &str) -> Result<f64, String> {
@@ -238,15 +266,19 @@ fn combined(
 /// A scene rendered for the golden test.
 struct Rendered {
     estimates: PixelEstimates,
+    batches: BatchBlocks,
     meta: GoldenMeta,
     /// The settings hash as if rendered with `hash_seed` instead of its own seed.
     hash_at_seed: u64,
+    progressive_alpha: Option<f64>,
 }
 
-/// Prepares and renders `path`; refuses fewer than 2 samples per pixel (no variance).
+/// Prepares and renders `path` batch by batch; refuses fewer than 2 samples per pixel (no
+/// noise estimate).
 fn render_scene(
     path: &Path,
     overrides: &SceneOverrides,
+    block: u32,
     threads: Option<usize>,
     quiet: bool,
     hash_seed: Option<u64>,
@@ -278,15 +310,16 @@ fn render_scene(
         threads,
         ..RenderOptions::default()
     };
-    let out = render(&prepared.render_scene, &options)?;
-    if out.stats.nan_samples > 0 && !quiet {
+    let out = render_batches(&prepared.render_scene, &options, block)?;
+    if out.output.stats.nan_samples > 0 && !quiet {
         eprintln!(
             "warning: `{}`: {} samples were NaN or infinite and were dropped",
             path.display(),
-            out.stats.nan_samples
+            out.output.stats.nan_samples
         );
     }
     let p = &prepared.render_scene.params;
+    let scene_value = serde_json::to_value(&prepared.scene).unwrap_or_default();
     let meta = GoldenMeta {
         hash,
         seed,
@@ -296,34 +329,79 @@ fn render_scene(
         exposure: p.exposure,
         scene: path.display().to_string(),
         overrides: record(overrides),
-        settings: report::settings(&prepared.scene),
+        settings: report::settings(&scene_value),
     };
     Ok(Rendered {
-        estimates: PixelEstimates::from_sums(&out.sums),
+        estimates: PixelEstimates::from_sums(&out.output.sums),
+        batches: out.batches,
         meta,
         hash_at_seed,
+        progressive_alpha: out.progressive_alpha,
     })
 }
 
 fn update(a: &UpdateArgs) -> Result<(), Error> {
     let scenes = scene_list(&a.scene.scene, &a.more)?;
+    if a.block == 0 {
+        return Err(usage("--block must be at least 1 pixel".into()));
+    }
     std::fs::create_dir_all(&a.output)
         .map_err(|e| usage(format!("cannot create `{}`: {e}", a.output.display())))?;
     let overrides = a.scene.overrides();
     for path in &scenes {
-        let r = render_scene(path, &overrides, a.threads, a.quiet, None)?;
+        let mut r = render_scene(path, &overrides, a.block, a.threads, a.quiet, None)?;
+        let mut floor = DetectionFloor::of(&r.batches, a.alpha);
+        if let Some(target) = a.detect {
+            let (w, h) = (r.estimates.width, r.estimates.height);
+            let scale = floor.detect_scale(w, h);
+            let side = floor.scales[scale].side;
+            let advice = floor::recommend_spp(
+                &floor,
+                scale,
+                r.meta.spp,
+                target,
+                a.alpha,
+                r.progressive_alpha,
+                a.detect_limit,
+            );
+            match advice {
+                None => println!(
+                    "{}: a change of {} over {side}×{side} px needs more than {} samples per pixel (--detect-limit); keeping {}",
+                    path.display(),
+                    report::number(100.0 * target) + " %",
+                    a.detect_limit,
+                    r.meta.spp
+                ),
+                Some(spp) if spp != r.meta.spp => {
+                    println!(
+                        "{}: {} samples per pixel catch a change of {} % over {side}×{side} px (≈ {} % of the image) in 95 % of checks; rendering at {spp}",
+                        path.display(),
+                        spp,
+                        report::number(100.0 * target),
+                        report::number((100.0 * floor::DETECT_AREA).round())
+                    );
+                    let mut more = overrides.clone();
+                    more.samples_per_pixel = Some(spp);
+                    r = render_scene(path, &more, a.block, a.threads, a.quiet, None)?;
+                    floor = DetectionFloor::of(&r.batches, a.alpha);
+                }
+                Some(_) => {}
+            }
+        }
         let target = a.output.join(golden_name(path));
         let (w, h) = (r.estimates.width, r.estimates.height);
         let (spp, integrator) = (r.meta.spp, r.meta.integrator.clone());
         GoldenImage {
             estimates: r.estimates,
+            batches: r.batches,
             meta: r.meta,
         }
         .write(&target)?;
         println!(
-            "{}: {w}×{h}, {spp} spp, {integrator}: golden written to `{}`",
+            "{}: {w}×{h}, {spp} spp, {integrator}: golden written to `{}`; {}",
             path.display(),
-            target.display()
+            target.display(),
+            report::describe_floor(&floor)
         );
     }
     Ok(())
@@ -331,13 +409,7 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
 
 fn check(a: &CheckArgs) -> Result<(), Error> {
     let scenes = scene_list(&a.scene.scene, &a.more)?;
-    let test = BlockTest {
-        block: a.block,
-        alpha: a.alpha,
-    };
-    if a.block == 0 {
-        return Err(usage("--block must be at least 1 pixel".into()));
-    }
+    let test = BatchTest { alpha: a.alpha };
     let own = a.scene.overrides();
     let error_dir = a.error_dir.clone().unwrap_or_else(|| a.golden.clone());
     let (mut changed, mut failed) = (0usize, 0usize);
@@ -375,7 +447,7 @@ fn check_one(
     path: &Path,
     a: &CheckArgs,
     own: &SceneOverrides,
-    test: &BlockTest,
+    test: &BatchTest,
     error_dir: &Path,
 ) -> Result<Outcome, Error> {
     let golden_path = a.golden.join(golden_name(path));
@@ -388,13 +460,24 @@ fn check_one(
         ))
     })?;
     let overrides = combined(&golden.meta, own, &golden_path)?;
-    let r = render_scene(path, &overrides, a.threads, a.quiet, Some(golden.meta.seed))?;
-    report::report(
+    let block = golden.batches.block;
+    let r = render_scene(
+        path,
+        &overrides,
+        block,
+        a.threads,
+        a.quiet,
+        Some(golden.meta.seed),
+    )?;
+    verdict::report(
         path,
         &golden,
-        &r.estimates,
-        &r.meta,
-        r.hash_at_seed,
+        &verdict::Now {
+            estimates: &r.estimates,
+            batches: &r.batches,
+            meta: &r.meta,
+            hash_at_golden_seed: r.hash_at_seed,
+        },
         test,
         error_dir,
     )

@@ -230,6 +230,15 @@ impl PixelSums {
         self.wide.contains_key(&(index as u32))
     }
 
+    /// Sum of pixel `index`'s samples (and splats) per channel, exact to the fixed-point
+    /// resolution: differences of sums taken between passes are each pass's own sums (the
+    /// golden test's batch means, `render::golden::batch_means`).
+    #[must_use]
+    pub fn sum(&self, index: usize) -> DVec3 {
+        let s = self.sums[index];
+        DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64) / SCALE
+    }
+
     /// Unbiased sample variance of pixel `index`'s samples per channel (0 with fewer than two);
     /// the variance of the pixel's mean is this over its count.
     #[must_use]

@@ -1,19 +1,29 @@
 //! Golden images for noise-aware snapshot tests (`caustic golden`): a render's per-pixel means
-//! **with the variance of each mean**, so that a later render (any seed, thread count or
-//! machine) can be judged "the same scene within noise" or "changed" by a statistical test
-//! ([`block_test`]) instead of a fixed RMSE threshold.
+//! and, for every batch of its passes, each block's mean ([`batch_means`]), so that a later
+//! render (any seed, thread count or machine) can be judged "the same scene within noise" or
+//! "changed" by a statistical test instead of a fixed RMSE threshold — a test whose noise
+//! estimate holds for every integrator, the progressive ones included (docs/golden.md).
 //!
 //! A golden file stores, after a signature, the image size, a metadata text (the settings hash
-//! of [`super::part_meta::settings_hash`], the seed, samples per pixel, integrator, sampler,
+//! of `farm::part_meta::settings_hash`, the seed, samples per pixel, integrator, sampler,
 //! exposure, the command-line overrides of `golden update`, and the scene's settings as
-//! `path=value` lines so a check can say which settings changed) and, per pixel, the mean and
-//! the variance of the mean per channel as little-endian `f32`, then an FNV-1a checksum:
-//! 24 bytes a pixel. (The mergeable `.part` film carries the same information as exact
-//! fixed-point sums at 100 bytes a pixel; a golden is never merged, so it keeps only what the
-//! test needs.)
+//! `path=value` lines so a check can say which settings changed), per pixel the mean and the
+//! variance of the mean per channel as little-endian `f32` (24 bytes a pixel, for the error
+//! image), then the block side, the batch count, each batch's samples per pixel and each
+//! batch's block means as `f64`, and an FNV-1a checksum.
+//!
+//! The modules: [`batch_means`] (the batches and the test), [`floor`] (the smallest change a
+//! golden catches and the samples per pixel for a requested one), [`record`] (rendering a scene
+//! batch by batch), [`report`] (the verdict in words, the settings that changed),
+//! [`pixel_variance`] (the older per-pixel-variance block test, valid for estimators whose
+//! pixels err independently, used to compare two estimators' images) and [`quantile`].
 
-pub mod block_test;
+pub mod batch_means;
+pub mod floor;
+pub mod pixel_variance;
 pub mod quantile;
+pub mod record;
+pub mod report;
 
 use std::path::Path;
 
@@ -23,12 +33,17 @@ use super::PixelSums;
 use super::output::{OutputError, write_atomic};
 use crate::binfile::fnv1a;
 
-pub use block_test::{BlockTest, BlockZ, Verdict};
+pub use batch_means::{BatchBlocks, BatchTest, BatchVerdict};
+pub use floor::DetectionFloor;
+pub use pixel_variance::{BlockTest, BlockZ, Verdict};
+pub use record::{GoldenRender, render_batches};
 
 /// File signature of a golden image.
-const MAGIC: &[u8; 16] = b"caustic-golden1\n";
+const MAGIC: &[u8; 16] = b"caustic-golden2\n";
+/// Signature of the first format (per-pixel variances only), refused with a clear message.
+const MAGIC_V1: &[u8; 16] = b"caustic-golden1\n";
 /// First line of the metadata text.
-const HEADER: &str = "caustic-golden 1";
+const HEADER: &str = "caustic-golden 2";
 
 /// Why a golden file could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -189,11 +204,13 @@ impl GoldenMeta {
     }
 }
 
-/// A golden image: the estimates of a render and what it was rendered from.
+/// A golden image: the estimates of a render, its batches and what it was rendered from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GoldenImage {
-    /// Means and variances of the means.
+    /// Means and variances of the means per pixel (for the error image).
     pub estimates: PixelEstimates,
+    /// Each block's mean in each batch of passes (for the test).
+    pub batches: BatchBlocks,
     /// Settings hash, seed, overrides and settings.
     pub meta: GoldenMeta,
 }
@@ -215,6 +232,17 @@ impl GoldenImage {
                 out.extend_from_slice(&x.to_le_bytes());
             }
         }
+        let b = &self.batches;
+        out.extend_from_slice(&b.block.to_le_bytes());
+        out.extend_from_slice(&(b.batches() as u32).to_le_bytes());
+        for s in &b.samples {
+            out.extend_from_slice(&s.to_le_bytes());
+        }
+        for m in &b.means {
+            for x in m {
+                out.extend_from_slice(&x.to_le_bytes());
+            }
+        }
         let sum = fnv1a(&out);
         out.extend_from_slice(&sum.to_le_bytes());
         out
@@ -230,6 +258,11 @@ impl GoldenImage {
             path: name.to_string(),
             reason: reason.to_string(),
         };
+        if bytes.len() >= MAGIC_V1.len() && &bytes[..MAGIC_V1.len()] == MAGIC_V1 {
+            return Err(bad(
+                "it was written by an older caustic (per-pixel variances, no batches); write it again with `caustic golden update`",
+            ));
+        }
         if bytes.len() < MAGIC.len() + 24 || &bytes[..MAGIC.len()] != MAGIC {
             return Err(bad(
                 "no caustic golden signature (write it with `caustic golden update`)",
@@ -253,12 +286,12 @@ impl GoldenImage {
         let meta_len = usize::try_from(u64::from_le_bytes(len)).map_err(|_| bad("absurd size"))?;
         let start = at + 16;
         let n = width as usize * height as usize;
-        let expected = n
+        let pixels_end = n
             .checked_mul(24)
             .and_then(|p| p.checked_add(meta_len))
             .and_then(|p| p.checked_add(start))
             .ok_or_else(|| bad("absurd size"))?;
-        if expected != body.len() {
+        if pixels_end.checked_add(8).is_none_or(|e| e > body.len()) {
             return Err(bad("size does not match its header"));
         }
         let text = std::str::from_utf8(&body[start..start + meta_len])
@@ -272,6 +305,35 @@ impl GoldenImage {
             mean.push(Vec3::new(f(p), f(p + 4), f(p + 8)));
             variance.push(Vec3::new(f(p + 12), f(p + 16), f(p + 20)));
         }
+        let block = u32::from_le_bytes(word(pixels_end));
+        let count = u32::from_le_bytes(word(pixels_end + 4)) as usize;
+        if block == 0 {
+            return Err(bad("its block side is 0"));
+        }
+        let mut batches = BatchBlocks::new(width, height, block);
+        let blocks = batches.blocks();
+        let expected = count
+            .checked_mul(4)
+            .and_then(|s| s.checked_add(count.checked_mul(blocks)?.checked_mul(24)?))
+            .and_then(|s| s.checked_add(pixels_end + 8))
+            .ok_or_else(|| bad("absurd size"))?;
+        if expected != body.len() {
+            return Err(bad("size does not match its header"));
+        }
+        let mut at = pixels_end + 8;
+        for _ in 0..count {
+            batches.samples.push(u32::from_le_bytes(word(at)));
+            at += 4;
+        }
+        let d = |at: usize| {
+            let mut w = [0; 8];
+            w.copy_from_slice(&body[at..at + 8]);
+            f64::from_le_bytes(w)
+        };
+        for _ in 0..count * blocks {
+            batches.means.push([d(at), d(at + 8), d(at + 16)]);
+            at += 24;
+        }
         Ok(Self {
             estimates: PixelEstimates {
                 width,
@@ -279,6 +341,7 @@ impl GoldenImage {
                 mean,
                 variance,
             },
+            batches,
             meta,
         })
     }
@@ -313,8 +376,12 @@ mod tests {
         for (i, v) in [(0, 0.5), (0, 1.5), (0, 1.0), (4, 2.0), (4, 4.0), (5, 7.0)] {
             sums.add(i, Vec3::new(v, v * 2.0, 0.25));
         }
+        let mut batches = BatchBlocks::new(3, 2, 2);
+        batches.push_batch(&[glam::DVec3::splat(0.5); 6], 1);
+        batches.push_batch(&[glam::DVec3::new(1.0, 2.0, 3.0); 6], 2);
         GoldenImage {
             estimates: PixelEstimates::from_sums(&sums),
+            batches,
             meta: GoldenMeta {
                 hash: 0xfeed_0000_beef,
                 seed: 7,
@@ -360,6 +427,10 @@ mod tests {
                 "{cut}"
             );
         }
+        let mut old = bytes.clone();
+        old[..16].copy_from_slice(MAGIC_V1);
+        let e = GoldenImage::from_bytes(&old, "g.golden").unwrap_err();
+        assert!(e.to_string().contains("older caustic"), "{e}");
         let mut flipped = bytes.clone();
         flipped[bytes.len() - 30] ^= 4;
         let e = GoldenImage::from_bytes(&flipped, "g.golden").unwrap_err();

@@ -1,0 +1,233 @@
+//! The detection floor of a golden: the smallest change that a check catches in 95 % of its
+//! runs, per block scale, and the samples per pixel that reach a floor the user asks for.
+//!
+//! A block whose golden mean is m with batch-means variance v is compared with a render whose
+//! noise is assumed the same (same settings, another seed): the difference has standard error
+//! √(2v) with ν = 2(K − 1) degrees of freedom for K batches a side. A relative change δ of the
+//! block is caught with probability ≥ 95 % when δ·m ≥ (t* + t₀.₀₅)·√(2v), t* the scale's
+//! Bonferroni limit and t₀.₀₅ the 95 % quantile of Student's t (the usual normal approximation
+//! of the noncentral t's power, Cohen 1988 §2.3, with t quantiles for the few-batch case). A
+//! block's floor is the smallest over its channels (a change of every channel by δ); a scale's
+//! floor is the median over its lit blocks (black blocks have no relative change), so "caught
+//! in 95 % of checks" holds for at least half the blocks of that size.
+
+use super::batch_means::{BatchBlocks, MAX_BATCHES, scale_spans};
+use super::quantile::student_upper_quantile;
+use crate::integrators::photon::RadiusSchedule;
+
+/// Probability of catching a change at the floor.
+pub const POWER: f64 = 0.95;
+
+/// Fraction of the image the `--detect` advice aims at: a change over a square this share of
+/// the image (the scale whose blocks are closest to it in area).
+pub const DETECT_AREA: f64 = 0.05;
+
+/// The floor of one block scale.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScaleFloor {
+    /// Side of this scale's blocks in pixels.
+    pub side: u32,
+    /// Blocks of this scale (the last scale has one: the whole image).
+    pub blocks: usize,
+    /// The median over lit blocks of the smallest relative change caught in 95 % of checks
+    /// (0.03: 3 %); infinite when no block is lit.
+    pub median: f64,
+}
+
+/// The detection floor of a golden at every scale, finest first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DetectionFloor {
+    /// Batches of the golden.
+    pub batches: usize,
+    /// Per scale, finest first; the last is the whole image.
+    pub scales: Vec<ScaleFloor>,
+}
+
+/// (t* + t₀.₀₅) for a scale of `blocks` blocks at false-alarm rate `alpha` split over
+/// `scales` scales, with `k` batches a side.
+fn critical(alpha: f64, scales: usize, blocks: usize, k: usize) -> f64 {
+    let nu = 2.0 * (k as f64 - 1.0);
+    let p = alpha / scales as f64 / (3.0 * blocks as f64);
+    student_upper_quantile(0.5 * p, nu) + student_upper_quantile(1.0 - POWER, nu)
+}
+
+impl DetectionFloor {
+    /// The floor of `golden` for checks at false-alarm rate `alpha`.
+    #[must_use]
+    pub fn of(golden: &BatchBlocks, alpha: f64) -> Self {
+        let k = golden.batches();
+        let spans = scale_spans(golden.blocks_x(), golden.blocks_y());
+        let scales = spans
+            .iter()
+            .map(|&span| {
+                let (nx, ny) = (
+                    golden.blocks_x().div_ceil(span),
+                    golden.blocks_y().div_ceil(span),
+                );
+                let blocks = (nx * ny) as usize;
+                let c = if k >= 2 {
+                    critical(alpha, spans.len(), blocks, k)
+                } else {
+                    f64::INFINITY
+                };
+                let mut floors: Vec<f64> = (0..ny)
+                    .flat_map(|y| (0..nx).map(move |x| (x, y)))
+                    .filter_map(|(x, y)| {
+                        let (m, v) = golden.block_mean_variance(x * span, y * span, span);
+                        (0..3)
+                            .filter(|&c| m[c] > 0.0)
+                            .map(|ch| c * (2.0 * v[ch]).sqrt() / m[ch])
+                            .min_by(f64::total_cmp)
+                    })
+                    .collect();
+                floors.sort_by(f64::total_cmp);
+                let median = if floors.is_empty() {
+                    f64::INFINITY
+                } else {
+                    floors[floors.len() / 2]
+                };
+                ScaleFloor {
+                    side: span * golden.block,
+                    blocks,
+                    median,
+                }
+            })
+            .collect();
+        Self { batches: k, scales }
+    }
+
+    /// The scale the `--detect` advice aims at: blocks closest in area to [`DETECT_AREA`] of
+    /// a `width`×`height` image.
+    #[must_use]
+    pub fn detect_scale(&self, width: u32, height: u32) -> usize {
+        let target = DETECT_AREA * f64::from(width) * f64::from(height);
+        let mut best = 0;
+        for (i, s) in self.scales.iter().enumerate() {
+            let d = |s: &ScaleFloor| (f64::from(s.side).powi(2) / target).ln().abs();
+            if d(s) < d(&self.scales[best]) {
+                best = i;
+            }
+        }
+        best
+    }
+}
+
+/// The mean over the first `n` passes of the per-pass variance relative to the first pass:
+/// 1 for estimators whose passes are alike; for a progressive one the radius of pass i is
+/// sᵢ·R, a density estimate's variance grows as 1/sᵢ², so the mean of 1/sᵢ² (an upper bound
+/// for `path-ppm`, whose path-traced part does not grow).
+#[must_use]
+pub fn variance_growth(progressive_alpha: Option<f64>, n: u32) -> f64 {
+    let Some(alpha) = progressive_alpha else {
+        return 1.0;
+    };
+    let schedule = RadiusSchedule { alpha };
+    let n = n.max(1);
+    (0..n)
+        .map(|i| 1.0 / f64::from(schedule.scale(i)).powi(2))
+        .sum::<f64>()
+        / f64::from(n)
+}
+
+/// The floor at scale `scale` predicted for `spp` samples per pixel from a golden's `floor`
+/// rendered at `golden_spp`: the standard error scales as √(growth(spp)/spp), and the critical
+/// value follows the batch count `min(spp, MAX_BATCHES)`.
+#[must_use]
+pub fn predicted_floor(
+    floor: &DetectionFloor,
+    scale: usize,
+    golden_spp: u32,
+    spp: u32,
+    alpha: f64,
+    progressive_alpha: Option<f64>,
+) -> f64 {
+    let s = &floor.scales[scale];
+    let k0 = floor.batches;
+    let k1 = spp.min(MAX_BATCHES) as usize;
+    if k0 < 2 || k1 < 2 {
+        return f64::INFINITY;
+    }
+    let n = floor.scales.len();
+    let c0 = critical(alpha, n, s.blocks, k0);
+    let c1 = critical(alpha, n, s.blocks, k1);
+    let g0 = variance_growth(progressive_alpha, golden_spp) / f64::from(golden_spp);
+    let g1 = variance_growth(progressive_alpha, spp) / f64::from(spp);
+    s.median * c1 / c0 * (g1 / g0).sqrt()
+}
+
+/// The fewest samples per pixel (at least 2, at most `limit`) whose predicted floor at `scale`
+/// is at most `target` (0.02 for 2 %); `None` when even `limit` does not reach it.
+#[must_use]
+pub fn recommend_spp(
+    floor: &DetectionFloor,
+    scale: usize,
+    golden_spp: u32,
+    target: f64,
+    alpha: f64,
+    progressive_alpha: Option<f64>,
+    limit: u32,
+) -> Option<u32> {
+    let reaches = |spp: u32| {
+        predicted_floor(floor, scale, golden_spp, spp, alpha, progressive_alpha) <= target
+    };
+    let (mut lo, mut hi) = (2u32, 2u32);
+    while !reaches(hi) {
+        if hi >= limit {
+            return None;
+        }
+        lo = hi;
+        hi = hi.saturating_mul(2).min(limit);
+    }
+    // The predicted floor falls with spp (fewer-batch t quantiles and 1/√spp both help).
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if reaches(mid) { hi = mid } else { lo = mid + 1 }
+    }
+    Some(hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn the_floor_is_the_hand_computed_one_and_the_advice_reaches_it() {
+        // One 4×4 block, K = 2 batches with block means 1 and 3: mean 2, variance of the mean
+        // ((1−2)² + (3−2)²)/4 · 2/1 = 1, so the difference's standard error is √2. One scale,
+        // one block: t* is Student's t (ν = 2) at (0.01/3)/2, t₀.₀₅ at 0.05.
+        let mut b = BatchBlocks::new(4, 4, 4);
+        b.push_batch(&[DVec3::splat(1.0); 16], 1);
+        b.push_batch(&[DVec3::splat(3.0); 16], 1);
+        let f = DetectionFloor::of(&b, 0.01);
+        assert_eq!(f.scales.len(), 1);
+        let c = student_upper_quantile(0.01 / 3.0 / 2.0, 2.0) + student_upper_quantile(0.05, 2.0);
+        let want = c * 2f64.sqrt() / 2.0;
+        assert!(
+            (f.scales[0].median - want).abs() < 1e-9,
+            "{:?} {want}",
+            f.scales
+        );
+        // Without progressive growth the floor falls as 1/√spp times the ratio of quantiles.
+        let at8 = predicted_floor(&f, 0, 2, 8, 0.01, None);
+        let c8 =
+            student_upper_quantile(0.01 / 3.0 / 2.0, 14.0) + student_upper_quantile(0.05, 14.0);
+        assert!((at8 - want * c8 / c * 0.5).abs() < 1e-9);
+        let spp = recommend_spp(&f, 0, 2, at8, 0.01, None, 1 << 20).unwrap();
+        assert_eq!(spp, 8);
+        assert!(predicted_floor(&f, 0, 2, 7, 0.01, None) > at8);
+        assert_eq!(recommend_spp(&f, 0, 2, 1e-9, 0.01, None, 64), None);
+    }
+
+    #[test]
+    fn progressive_variance_grows_as_the_radius_shrinks() {
+        assert_eq!(variance_growth(None, 100), 1.0);
+        // One pass: radius R, no growth; α → 1 keeps the radius.
+        assert_eq!(variance_growth(Some(0.7), 1), 1.0);
+        assert!((variance_growth(Some(1.0), 50) - 1.0).abs() < 1e-12);
+        // Two passes at α: r₂²/r₁² = (1 + α)/2, so the mean of 1/s² is (1 + 2/(1 + α))/2.
+        let a = 0.7;
+        let want = 0.5 * (1.0 + 2.0 / (1.0 + a));
+        assert!((variance_growth(Some(a), 2) - want).abs() < 1e-6);
+    }
+}
