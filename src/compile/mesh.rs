@@ -7,20 +7,16 @@ use std::rc::Rc;
 
 use glam::{Vec2, Vec3};
 
+use super::mesh_file::{MAX_MESH_FILE_BYTES, MeshFileError, MeshFormat, read_mesh_file};
 use super::polygon::triangulate;
 
-/// Why an OBJ file could not be loaded. Each message names the file (and the line, where the
-/// fault is on one) and is a user-facing sentence.
+/// Why a mesh file (OBJ, or PLY through [`super::ply`]) could not be loaded. Each message names
+/// the file (and the line, where the fault is on one) and is a user-facing sentence.
 #[derive(Debug, thiserror::Error)]
 pub enum ObjError {
-    /// The file could not be read.
-    #[error("cannot read OBJ file `{}`: {source}", path.display())]
-    Read {
-        /// The OBJ file.
-        path: PathBuf,
-        /// The OS error.
-        source: std::io::Error,
-    },
+    /// The file could not be read, is not a regular file, is too large, or is of another kind.
+    #[error(transparent)]
+    File(#[from] MeshFileError),
     /// The file is not UTF-8 text.
     #[error("`{}` is not a text OBJ file (invalid UTF-8 at byte {at})", path.display())]
     NotText {
@@ -41,6 +37,9 @@ pub enum ObjError {
         /// What is wrong with it.
         problem: LineProblem,
     },
+    /// The PLY reader refused the file.
+    #[error(transparent)]
+    Ply(#[from] super::ply::PlyError),
     /// `tobj` refused the file.
     #[error("`{}` is not a valid OBJ file: {source}", path.display())]
     Invalid {
@@ -93,6 +92,14 @@ pub enum LineProblem {
     /// A face corner that is not `v`, `v/t`, `v//n` or `v/t/n` with integer indices.
     #[error("`{0}` is not a face corner")]
     NotACorner(String),
+    /// A face corner's index is 0, which OBJ does not use.
+    #[error(
+        "the face uses {what} index 0, but OBJ indices start at 1 (negative ones count back from the last {what})"
+    )]
+    IndexZero {
+        /// `vertex`, `texture coordinate` or `normal`.
+        what: &'static str,
+    },
     /// A face corner's index refers to a record not defined above the face.
     #[error("the face uses {what} {index}, but only {count} {} defined above it", defined(what, *count))]
     Undefined {
@@ -192,19 +199,49 @@ impl MeshCache {
         if let Some(m) = self.meshes.get(path) {
             return Ok((Rc::clone(m), false));
         }
-        let mesh = Rc::new(read_obj(path)?);
+        let mesh = Rc::new(read_mesh(path)?);
         self.meshes.insert(path.to_path_buf(), Rc::clone(&mesh));
         Ok((mesh, true))
     }
 }
 
-/// Reads and parses the OBJ file at `path`.
-fn read_obj(path: &Path) -> Result<ObjMesh, ObjError> {
-    let bytes = std::fs::read(path).map_err(|source| ObjError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse_obj(&bytes, path)
+/// Reads the mesh file at `path` (a regular file within [`MAX_MESH_FILE_BYTES`]) and parses it
+/// by its kind.
+fn read_mesh(path: &Path) -> Result<ObjMesh, ObjError> {
+    let (format, bytes) = read_mesh_file(path, MAX_MESH_FILE_BYTES)?;
+    match format {
+        MeshFormat::Obj => parse_obj(&bytes, path),
+        MeshFormat::Ply => Ok(super::ply::parse_ply(&bytes, path)?),
+        MeshFormat::Gltf
+        | MeshFormat::Glb
+        | MeshFormat::Stl
+        | MeshFormat::Fbx
+        | MeshFormat::Blend => Err(MeshFileError::WrongKind {
+            path: path.to_path_buf(),
+            format,
+            what: wrong_kind_help(format),
+        }
+        .into()),
+    }
+}
+
+/// What to do with a file of `format` given to a `Mesh` node.
+fn wrong_kind_help(format: MeshFormat) -> &'static str {
+    match format {
+        MeshFormat::Obj | MeshFormat::Ply => "a `Mesh` node reads OBJ and PLY files",
+        MeshFormat::Gltf | MeshFormat::Glb => {
+            "a `Mesh` node reads OBJ and PLY files; caustic does not read glTF yet: export an OBJ"
+        }
+        MeshFormat::Stl => {
+            "a `Mesh` node reads OBJ and PLY files: convert it (e.g. Blender's import STL, export PLY)"
+        }
+        MeshFormat::Fbx => {
+            "a `Mesh` node reads OBJ and PLY files: export it as one from the program that made it"
+        }
+        MeshFormat::Blend => {
+            "a `Mesh` node reads OBJ and PLY files: export the object from Blender as one"
+        }
+    }
 }
 
 /// Parses OBJ bytes (`path` only names the file in messages).
@@ -281,11 +318,6 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, ObjError> {
             let line = record.map(|f| f.line);
             let names = record.map(|f| f.names).unwrap_or_default();
             faces_seen += 1;
-            if corners.len() == 3 {
-                mesh.triangles.push([corners[0], corners[1], corners[2]]);
-                mesh.triangle_names.push(names);
-                continue;
-            }
             // Indices are checked against the file's records above, so positions exist.
             let shape: Vec<Vec3> = corners
                 .iter()
@@ -296,24 +328,8 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, ObjError> {
                         .map_or(Vec3::ZERO, Vec3::from_slice)
                 })
                 .collect();
-            let t = triangulate(&shape);
             let at = line.map_or_else(|| format!("face {faces_seen}"), |l| format!("line {l}"));
-            if let Some(off) = t.non_planar {
-                mesh.warnings.push(format!(
-                    "{at}: the {}-corner face is not planar (a corner is {:.1}% of its size off its best-fit plane); it is triangulated as projected on that plane",
-                    corners.len(),
-                    off * 100.0
-                ));
-            }
-            if t.self_intersecting {
-                mesh.warnings.push(format!(
-                    "{at}: the {}-corner face crosses itself, so it has no well-defined inside; its triangles may cover too much or too little",
-                    corners.len()
-                ));
-            }
-            mesh.triangles
-                .extend(t.triangles.iter().map(|tri| tri.map(|k| corners[k])));
-            mesh.triangle_names.resize(mesh.triangles.len(), names);
+            push_polygon(&mut mesh, &corners, &shape, names, &at);
         }
     }
     if let Some(face) = missing_record(&mesh) {
@@ -334,6 +350,41 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, ObjError> {
         });
     }
     Ok(mesh)
+}
+
+/// Adds a face of `corners` (at positions `shape`) to `mesh` as triangles: a triangle as it is,
+/// a larger polygon triangulated by its shape (ear clipping on its best-fit plane,
+/// [`triangulate`]), with a warning naming the face (`at`: `line 12`, `face 3`) if it is not
+/// planar or crosses itself. Shared by the OBJ and PLY readers, so both triangulate alike.
+pub(super) fn push_polygon(
+    mesh: &mut ObjMesh,
+    corners: &[Corner],
+    shape: &[Vec3],
+    names: FaceNames,
+    at: &str,
+) {
+    if let [a, b, c] = *corners {
+        mesh.triangles.push([a, b, c]);
+        mesh.triangle_names.push(names);
+        return;
+    }
+    let t = triangulate(shape);
+    if let Some(off) = t.non_planar {
+        mesh.warnings.push(format!(
+            "{at}: the {}-corner face is not planar (a corner is {:.1}% of its size off its best-fit plane); it is triangulated as projected on that plane",
+            corners.len(),
+            off * 100.0
+        ));
+    }
+    if t.self_intersecting {
+        mesh.warnings.push(format!(
+            "{at}: the {}-corner face crosses itself, so it has no well-defined inside; its triangles may cover too much or too little",
+            corners.len()
+        ));
+    }
+    mesh.triangles
+        .extend(t.triangles.iter().map(|tri| tri.map(|k| corners[k])));
+    mesh.triangle_names.resize(mesh.triangles.len(), names);
 }
 
 /// `text` with every line ending made `\n`: CRLF (Windows) and a lone CR (classic Mac OS) each
@@ -425,6 +476,9 @@ fn check_obj_text(
                         let index: i64 = part
                             .parse()
                             .map_err(|_| at(LineProblem::NotACorner(corner.to_string())))?;
+                        if index == 0 {
+                            return Err(at(LineProblem::IndexZero { what }));
+                        }
                         let resolved = if index < 0 { count + index + 1 } else { index };
                         if resolved < 1 || resolved > count {
                             return Err(at(LineProblem::Undefined { what, index, count }));

@@ -5,7 +5,9 @@
 pub mod lights;
 mod materials;
 pub mod mesh;
+pub mod mesh_file;
 mod nodes;
+pub mod ply;
 pub mod polygon;
 
 use std::path::Path;

@@ -20,6 +20,7 @@ mod farm;
 mod glossy_caustic;
 mod golden;
 mod hard_cases;
+mod import;
 mod interrupt;
 mod kdtree;
 mod layers;
