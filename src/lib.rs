@@ -25,6 +25,7 @@ pub mod analysis;
 pub mod bench;
 pub mod binfile;
 pub mod compile;
+pub mod denoise;
 pub mod error;
 pub mod farm;
 pub mod geometry;

@@ -18,6 +18,7 @@ use caustic::render::output::{OutputFormat, write_image};
 use caustic::render::passes::{CheckpointPlan, PassPlan, render_in_passes};
 use caustic::render::tonemap::Display;
 use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, write_with_layers};
+use caustic::render::{LayerExtras, write_with_extras};
 
 use super::{SceneArgs, count, layers_flag, print_warnings};
 
@@ -99,6 +100,13 @@ pub struct RenderArgs {
     /// `out.direct.png` and `out.caustic.png`; variance and samples need an `.exr`).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_layers)]
     pub(super) layers: Vec<Vec<Layer>>,
+    /// Denoise the image (docs/denoise.md): a feature-guided filter that keeps caustics. The
+    /// render is taken in two halves of its samples per pixel (at least 2) and albedo, normal
+    /// and depth are traced beside it. A `.png` output is the denoised image; an `.exr` holds
+    /// the denoised image and the noisy one as the `noisy` layer. Not with `--time` (the
+    /// halves need the samples per pixel in advance) or a `.part` output.
+    #[arg(long, conflicts_with_all = ["time", "shard"])]
+    pub(super) denoise: bool,
 }
 
 fn parse_layers(text: &str) -> Result<Vec<Layer>, String> {
@@ -287,6 +295,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         caustic::render::output::check_writable(path)?;
     }
     let layers = layers_flag::listed(&args.layers);
+    if args.denoise && is_part(&output) {
+        return Err(Error::Usage(format!(
+            "--denoise writes an image: the output `{}` must end in `.png` or `.exr`, not `.part`",
+            output.display()
+        )));
+    }
+    let trace_features = args.denoise || layers_flag::features_needed(&layers);
     let pictures = layers_flag::check(&output, &layers, args.checkpoint.as_deref())?;
     let region = args.region.as_deref().map(parse_region).transpose()?;
     let reference = super::max_rmse::load(args.compare.as_deref())?;
@@ -338,9 +353,18 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         cancel: Some(interrupt.start_rendering()),
         photon_cache: args.photon_cache.clone(),
         samples: samples_taken,
-        light_paths: layers.iter().any(|l| matches!(l, Layer::Part(_))),
+        light_paths: args.denoise || layers.iter().any(|l| matches!(l, Layer::Part(_))),
     };
-    let job = match RenderJob::new(&prepared.render_scene, &options) {
+    let taken = samples.clone().unwrap_or(0..spp);
+    // `--denoise`: the samples below `split` are the first half-buffer.
+    let split = taken.start + (taken.end - taken.start) / 2;
+    if args.denoise && split == taken.start {
+        return Err(Error::Usage(format!(
+            "--denoise needs at least 2 samples per pixel (it compares two halves of them); this render takes {}",
+            taken.end - taken.start
+        )));
+    }
+    let mut job = match RenderJob::new(&prepared.render_scene, &options) {
         // Ctrl-C during photon tracing.
         Err(RenderError::Cancelled) => {
             return Err(Error::Interrupted("interrupted: no image written".into()));
@@ -381,6 +405,20 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         time_budget: args.time,
         progress: terminal,
     };
+    let first_half = if args.denoise {
+        match job.render_pass(split - taken.start) {
+            Err(RenderError::Cancelled) => {
+                return Err(Error::Interrupted("interrupted: no image written".into()));
+            }
+            other => other?,
+        }
+        Some(caustic::render::denoised::FirstHalf {
+            sums: job.sums().clone(),
+            parts: job.parts().map(<[_]>::to_vec),
+        })
+    } else {
+        None
+    };
     let outcome = render_in_passes(job, &plan);
     let saved = outcome.checkpoint_spp;
     let interrupted = || {
@@ -402,6 +440,49 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if interrupt.raised() {
         return Err(interrupted());
     }
+    let features = if trace_features {
+        let started = std::time::Instant::now();
+        let traced = caustic::render::Features::trace(
+            &prepared.render_scene,
+            region,
+            taken.clone(),
+            split,
+            args.threads,
+            options.cancel.as_deref(),
+        );
+        let f = match traced {
+            Err(RenderError::Cancelled) => return Err(interrupted()),
+            other => other?,
+        };
+        if !args.quiet {
+            eprintln!(
+                "features: albedo, normal and depth traced in {:.2} s",
+                started.elapsed().as_secs_f64()
+            );
+        }
+        Some(f)
+    } else {
+        None
+    };
+    let denoised = match (&first_half, &features) {
+        (Some(first), Some(f)) => {
+            let started = std::time::Instant::now();
+            let film = caustic::render::denoised::denoise_render(
+                &out.sums,
+                out.parts.as_deref(),
+                first,
+                f,
+                &caustic::denoise::DenoiseParams::default(),
+                args.threads,
+            )
+            .map_err(|e| Error::Usage(e.to_string()))?;
+            if !args.quiet {
+                eprintln!("denoised in {:.2} s", started.elapsed().as_secs_f64());
+            }
+            Some(film)
+        }
+        _ => None,
+    };
     if let Some(hash) = hash {
         let p = &prepared.render_scene.params;
         let taken =
@@ -425,6 +506,19 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             seconds: out.stats.elapsed.as_secs_f64(),
         };
         out.sums.write(&output, &meta.to_text())?;
+    } else if features.is_some() || denoised.is_some() {
+        let extras = LayerExtras {
+            features: features.as_ref(),
+            denoised: denoised.as_ref(),
+        };
+        write_with_extras(
+            &out.sums,
+            out.parts.as_deref(),
+            extras,
+            &layers,
+            &output,
+            display,
+        )?;
     } else if !layers.is_empty() {
         write_with_layers(&out.sums, out.parts.as_deref(), &layers, &output, display)?;
     } else {
@@ -514,7 +608,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if let Some(reference) = &reference {
         super::max_rmse::check(
             reference,
-            &out.film,
+            denoised.as_ref().unwrap_or(&out.film),
             &output,
             exposure,
             region,

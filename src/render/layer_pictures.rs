@@ -4,13 +4,15 @@
 //! the same [`to_srgb8`]), so the pictures show side by side what each kind of light adds to
 //! the image. The image and its pictures are written together: all are encoded and written to
 //! temporary files before any is renamed into place. The statistics layers (variance, samples)
-//! are numbers, not pictures: they go only into EXR files ([`super::layers`]).
+//! are numbers, not pictures: they go only into EXR files ([`super::layers`]), as do the
+//! feature layers (albedo, normal, depth). A denoised render (`--denoise`) writes the denoised
+//! image as the PNG; its layer pictures stay the noisy light layers.
 //! [`write_with_layers`] picks between the two by the output's extension.
 
 use std::path::{Path, PathBuf};
 
-use super::PixelSums;
-use super::layers::{Layer, write_layers};
+use super::layers::{Layer, LayerExtras, write_layers_with};
+use super::{Film, PixelSums};
 use super::output::{OutputError, OutputFormat, encode, write_atomic_all};
 use super::tonemap::Display;
 use crate::integrators::LightPath;
@@ -37,7 +39,9 @@ pub fn picture_layers(layers: &[Layer]) -> Result<Vec<LightPath>, NotAPicture> {
         match layer {
             Layer::Part(kind) if !kinds.contains(&kind) => kinds.push(kind),
             Layer::Part(_) => {}
-            Layer::Variance | Layer::Samples => return Err(NotAPicture(layer)),
+            Layer::Variance | Layer::Samples | Layer::Albedo | Layer::Normal | Layer::Depth => {
+                return Err(NotAPicture(layer));
+            }
         }
     }
     Ok(kinds)
@@ -70,15 +74,24 @@ pub fn encode_layer_pictures(
     output: &Path,
     display: Display,
 ) -> Result<Vec<(PathBuf, Vec<u8>)>, OutputError> {
+    encode_pictures_of(&sums.to_film(), parts, layers, output, display)
+}
+
+/// [`encode_layer_pictures`] with the image `image` (e.g. the denoised one) instead of the
+/// sums' mean.
+fn encode_pictures_of(
+    image: &Film,
+    parts: Option<&[PixelSums]>,
+    layers: &[Layer],
+    output: &Path,
+    display: Display,
+) -> Result<Vec<(PathBuf, Vec<u8>)>, OutputError> {
     let fail = |reason: String| OutputError::Pictures {
         path: output.to_path_buf(),
         reason,
     };
     let kinds = picture_layers(layers).map_err(|e| fail(e.to_string()))?;
-    let mut files = vec![(
-        output.to_path_buf(),
-        encode(&sums.to_film(), output, display)?,
-    )];
+    let mut files = vec![(output.to_path_buf(), encode(image, output, display)?)];
     for kind in kinds {
         let Some(part) = parts.and_then(|p| p.get(kind as usize)) else {
             return Err(fail(format!(
@@ -94,12 +107,12 @@ pub fn encode_layer_pictures(
 }
 
 /// Writes the image of `sums` with its `layers` to `output`, by its extension: an EXR holds
-/// the layers as channels ([`write_layers`]; linear, `display` unused), a PNG gets each
+/// the layers as channels ([`super::layers::write_layers`]; linear, `display` unused), a PNG gets each
 /// light-path layer as a picture beside it ([`encode_layer_pictures`]), all written
 /// atomically.
 ///
 /// # Errors
-/// As [`write_layers`] or [`encode_layer_pictures`], [`OutputError::UnknownFormat`] for
+/// As [`super::layers::write_layers`] or [`encode_layer_pictures`], [`OutputError::UnknownFormat`] for
 /// another extension, and when a file cannot be written.
 pub fn write_with_layers(
     sums: &PixelSums,
@@ -108,11 +121,46 @@ pub fn write_with_layers(
     output: &Path,
     display: Display,
 ) -> Result<(), OutputError> {
+    write_with_extras(
+        sums,
+        parts,
+        LayerExtras::default(),
+        layers,
+        output,
+        display,
+    )
+}
+
+/// [`write_with_layers`] with the feature buffers and the denoised image of `extras`: an EXR
+/// gets the denoised image as `R, G, B`, the noisy one as the `noisy` layer and any feature
+/// layer ([`super::layers::encode_layers_with`]); a PNG is the denoised image, its layer
+/// pictures the noisy light layers.
+///
+/// # Errors
+/// As [`write_with_layers`]; a feature layer without features.
+pub fn write_with_extras(
+    sums: &PixelSums,
+    parts: Option<&[PixelSums]>,
+    extras: LayerExtras<'_>,
+    layers: &[Layer],
+    output: &Path,
+    display: Display,
+) -> Result<(), OutputError> {
     match OutputFormat::for_path(output)? {
-        OutputFormat::Exr => write_layers(sums, parts, layers, output),
-        OutputFormat::Png => write_atomic_all(&encode_layer_pictures(
-            sums, parts, layers, output, display,
-        )?),
+        OutputFormat::Exr => write_layers_with(sums, parts, extras, layers, output),
+        OutputFormat::Png => {
+            let noisy;
+            let image = match extras.denoised {
+                Some(film) => film,
+                None => {
+                    noisy = sums.to_film();
+                    &noisy
+                }
+            };
+            write_atomic_all(&encode_pictures_of(
+                image, parts, layers, output, display,
+            )?)
+        }
     }
 }
 

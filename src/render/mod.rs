@@ -1,6 +1,8 @@
 //! Rendering: the render job and its tile loop, the film and its mergeable sums, image output.
 
+pub mod denoised;
 pub mod exr;
+pub mod features;
 pub mod film;
 pub mod golden;
 pub mod job;
@@ -17,8 +19,14 @@ pub mod wide_sum;
 
 pub use film::Film;
 pub use job::{RenderJob, render};
-pub use layer_pictures::{NotAPicture, layer_path, picture_layers, write_with_layers};
-pub use layers::{Layer, UnknownLayer, encode_layers, write_layers};
+pub use features::{FeatureSample, Features};
+pub use layer_pictures::{
+    NotAPicture, layer_path, picture_layers, write_with_extras, write_with_layers,
+};
+pub use layers::{
+    Layer, LayerExtras, UnknownLayer, encode_layers, encode_layers_with, write_layers,
+    write_layers_with,
+};
 pub use options::{
     ProgressiveStats, Region, RenderError, RenderOptions, RenderOutput, RenderStats,
 };

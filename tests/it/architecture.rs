@@ -22,6 +22,9 @@ const RULES: &[(&str, &[&str])] = &[
     ("src/accel", &["geometry", "sampling"]),
     ("src/spatial", &["geometry", "sampling"]),
     ("src/bench", &["geometry", "sampling", "accel"]),
+    // Plain image arrays in, an image out: the denoiser knows no scene or render, so the
+    // render job (and every layer above it) may call it.
+    ("src/denoise", &[]),
     (
         "src/render_scene",
         &[
@@ -53,6 +56,7 @@ const RULES: &[(&str, &[&str])] = &[
             "spatial",
             "render_scene",
             "integrators",
+            "denoise",
         ],
     ),
     (
@@ -67,6 +71,7 @@ const RULES: &[(&str, &[&str])] = &[
             "spatial",
             "render_scene",
             "integrators",
+            "denoise",
             "render",
         ],
     ),
@@ -82,6 +87,7 @@ const RULES: &[(&str, &[&str])] = &[
             "spatial",
             "render_scene",
             "integrators",
+            "denoise",
             "render",
         ],
     ),

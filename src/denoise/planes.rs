@@ -1,0 +1,81 @@
+//! Image planes (one float per pixel, row-major) and the box filter the patch distances and
+//! error estimates are averaged with.
+
+/// Box-filters rows `rows` of the `w`-wide plane `src` (holding rows `first..`) with radius
+/// `r`, clamped at the image edges (each output is the mean of the in-image values), into
+/// `out` (rows `rows`, row-major from `rows.start`). `h` is the image height: rows of the
+/// window outside `first..first + src.len() / w` must not be needed (the caller gives
+/// `first ≤ rows.start − r` or 0, and enough rows below). `scratch` holds one row per source
+/// row.
+pub fn box_rows(
+    src: &[f32],
+    first: usize,
+    w: usize,
+    h: usize,
+    r: usize,
+    rows: std::ops::Range<usize>,
+    scratch: &mut Vec<f32>,
+    out: &mut [f32],
+) {
+    let have = src.len() / w;
+    scratch.clear();
+    scratch.resize(src.len(), 0.0);
+    // Horizontal sums, each over its own window (no running sum: a huge value leaving the
+    // window would take the small ones added after it with it).
+    for (row, hs) in src.chunks_exact(w).zip(scratch.chunks_exact_mut(w)) {
+        for (x, o) in hs.iter_mut().enumerate() {
+            *o = row[x.saturating_sub(r)..=(x + r).min(w - 1)].iter().sum();
+        }
+    }
+    for y in rows.clone() {
+        let top = y.saturating_sub(r).max(first);
+        let bottom = (y + r).min(h - 1).min(first + have - 1);
+        let o = &mut out[(y - rows.start) * w..(y - rows.start + 1) * w];
+        o.fill(0.0);
+        for yy in top..=bottom {
+            let hs = &scratch[(yy - first) * w..(yy - first + 1) * w];
+            for (o, v) in o.iter_mut().zip(hs) {
+                *o += v;
+            }
+        }
+        let ny = (bottom + 1 - top) as f32;
+        for (x, o) in o.iter_mut().enumerate() {
+            let nx = ((x + r).min(w - 1) + 1 - x.saturating_sub(r)) as f32;
+            *o /= nx * ny;
+        }
+    }
+}
+
+/// The whole plane `src` (`w × h`) box-filtered with radius `r`.
+#[must_use]
+pub fn box_filter(src: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
+    let mut out = vec![0.0; src.len()];
+    let mut scratch = Vec::new();
+    box_rows(src, 0, w, h, r, 0..h, &mut scratch, &mut out);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::box_filter;
+
+    /// Against a direct sum over the clamped window.
+    #[test]
+    fn box_filter_is_the_mean_over_the_clamped_window() {
+        let (w, h, r) = (7, 5, 2);
+        let src: Vec<f32> = (0..w * h).map(|i| ((i * 37) % 11) as f32).collect();
+        let got = box_filter(&src, w, h, r);
+        for y in 0..h {
+            for x in 0..w {
+                let (mut s, mut n) = (0.0, 0.0);
+                for yy in y.saturating_sub(r)..=(y + r).min(h - 1) {
+                    for xx in x.saturating_sub(r)..=(x + r).min(w - 1) {
+                        s += src[yy * w + xx];
+                        n += 1.0;
+                    }
+                }
+                assert!((got[y * w + x] - s / n).abs() < 1e-5, "({x}, {y})");
+            }
+        }
+    }
+}
