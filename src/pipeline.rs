@@ -8,7 +8,6 @@ use crate::error::Error;
 use crate::render_scene::RenderScene;
 use crate::scene::load::SourceFile;
 use crate::scene::overrides::apply_overrides;
-use crate::scene::schema::LightSpec;
 use crate::scene::validate::validate;
 use crate::scene::{Diagnostic, SceneError, SceneFile};
 use crate::settings::{IntegratorKind, SamplerKind};
@@ -52,23 +51,7 @@ impl SceneOverrides {
         if let Some(n) = self.caustic_photons {
             s.photons.caustic = n;
             for l in &mut s.lights {
-                match l {
-                    LightSpec::Point {
-                        caustic_photons, ..
-                    }
-                    | LightSpec::Sphere {
-                        caustic_photons, ..
-                    }
-                    | LightSpec::Spot {
-                        caustic_photons, ..
-                    }
-                    | LightSpec::Distant {
-                        caustic_photons, ..
-                    }
-                    | LightSpec::Environment {
-                        caustic_photons, ..
-                    } => *caustic_photons = None,
-                }
+                *l.caustic_photons_mut() = None;
             }
         }
         Ok(s)

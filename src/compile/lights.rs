@@ -22,11 +22,12 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use crate::render_scene::Light;
-use crate::render_scene::geometry::GeometryBuilder;
+use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
+use crate::render_scene::light::escape::InfinityRef;
 use crate::render_scene::light::{
     DistantLight, EnvironmentLight, MeshLight, RectLight, SceneSphere, SpotLight,
 };
+use crate::render_scene::{Light, ObjectInfo};
 use crate::scene::Diagnostic;
 use crate::scene::schema::{EmissionSpec, LightSpec};
 
@@ -237,28 +238,57 @@ pub(super) fn scene_sphere(b: &GeometryBuilder, more: &[(Vec3, f32)]) -> SceneSp
     SceneSphere::new((lo + hi) * 0.5, 0.5 * (hi - lo).length())
 }
 
-/// A spot, distant or environment light of the `lights` list (`index`), with the scene's
-/// bounding sphere for lights at infinity; `None` for point and sphere lights (compiled by the
-/// caller, which keeps their code as it was). Errors: an environment map that cannot be read
-/// or holds a negative or non-finite texel, named by file.
+/// The light `lights[index]` compiles to, with the scene's bounding sphere for lights at
+/// infinity. A sphere light smaller than [`min_sphere_light_radius`] allows (from every point of
+/// `builder`'s primitives and the camera at `eye`) becomes a point light of the same power, with
+/// a warning. Errors: a spot or distant light out of range, an environment map that cannot be
+/// read or holds a negative or non-finite texel, named by file.
 #[allow(
     clippy::result_large_err,
     reason = "a Diagnostic is built once per bad light on a cold path and joins the compile's list of diagnostics by value"
 )]
-pub(super) fn spec_light(
+fn spec_light(
     index: usize,
     l: &LightSpec,
     scene: SceneSphere,
     base_dir: &Path,
-) -> Result<Option<Light>, Diagnostic> {
+    builder: &GeometryBuilder,
+    eye: Vec3,
+) -> Result<SpecLight, Diagnostic> {
     let bad = |what: &str| {
         Diagnostic::error(
             format!("lights[{index}]"),
             format!("cannot build this light: {what}"),
         )
     };
-    Ok(Some(match l {
-        LightSpec::Point { .. } | LightSpec::Sphere { .. } => return Ok(None),
+    Ok(SpecLight::Light(match l {
+        LightSpec::Point {
+            position, power, ..
+        } => Light::point((*position).into(), (*power).into()),
+        LightSpec::Sphere {
+            center,
+            radius,
+            power,
+            ..
+        } => {
+            let (center, power): (Vec3, Vec3) = ((*center).into(), (*power).into());
+            let reach = reach(builder, center, eye);
+            let min = min_sphere_light_radius(power, reach);
+            if f64::from(*radius) < min {
+                return Ok(SpecLight::Point {
+                    light: Light::point(center, power),
+                    warning: point_fallback_warning(index, *radius, power, reach),
+                });
+            }
+            return Ok(SpecLight::Sphere(
+                Light::sphere(center, *radius, power),
+                SpherePrim {
+                    center,
+                    radius: *radius,
+                    object: u32::MAX,
+                },
+            ));
+        }
         LightSpec::Spot {
             position,
             direction,
@@ -312,6 +342,138 @@ pub(super) fn spec_light(
             Light::Environment(Arc::new(env))
         }
     }))
+}
+
+/// What [`compile_lights`] writes besides the light list: the primitives of sphere lights, the
+/// objects of emitters and of the light filling the sky, and the diagnostics.
+pub(super) struct Targets<'a> {
+    /// Sphere lights add their sphere here.
+    pub builder: &'a mut GeometryBuilder,
+    /// Emitting objects (sphere lights, the light filling the sky) are added here.
+    pub objects: &'a mut Vec<ObjectInfo>,
+    /// Lights that cannot be built.
+    pub errors: &'a mut Vec<Diagnostic>,
+    /// Sphere lights compiled as point lights.
+    pub warnings: &'a mut Vec<Diagnostic>,
+}
+
+/// The compiled lights of a scene.
+#[derive(Debug)]
+pub(super) struct Compiled {
+    /// The `lights` list's lights in order (those that compiled), then the emissive shapes'.
+    pub lights: Vec<Light>,
+    /// Indices of the lights at infinity, in order (what escaping rays loop over).
+    pub infinite_lights: Vec<u32>,
+    /// The first light that fills the sky and its object (ray trees name escapes after it).
+    pub infinity: Option<InfinityRef>,
+}
+
+/// Compiles the `lights` list (in order, so a light's index stays its place in the list when
+/// every light before it compiled) and then the emissive shapes `emitters` collected while
+/// flattening the nodes, after every primitive is built (lights at infinity cover them all with
+/// the scene's bounding sphere). `eye` is the camera's position (how far a sphere light must be
+/// sampled from).
+pub(super) fn compile_lights(
+    list: &[LightSpec],
+    emitters: &[NodeEmitter],
+    t: Targets<'_>,
+    eye: Vec3,
+    base_dir: &Path,
+) -> Compiled {
+    let Targets {
+        builder,
+        objects,
+        errors,
+        warnings,
+    } = t;
+    // The sphere lights of the list are geometry too: the bounding sphere covers them.
+    let light_spheres: Vec<(Vec3, f32)> = list.iter().filter_map(light_sphere).collect();
+    let scene_sphere = scene_sphere(builder, &light_spheres);
+    let mut out = Compiled {
+        lights: Vec::with_capacity(list.len()),
+        infinite_lights: Vec::new(),
+        infinity: None,
+    };
+    for (i, l) in list.iter().enumerate() {
+        let light = match spec_light(i, l, scene_sphere, base_dir, builder, eye) {
+            Ok(SpecLight::Light(light)) => light,
+            Ok(SpecLight::Point { light, warning }) => {
+                warnings.push(warning);
+                light
+            }
+            Ok(SpecLight::Sphere(light, prim)) => {
+                let index = out.lights.len() as u32;
+                out.lights.push(light);
+                let object = objects.len() as u32;
+                objects.push(ObjectInfo {
+                    name: format!("lights[{i}]"),
+                    material: None,
+                    light: Some(index),
+                });
+                builder.spheres.push(SpherePrim { object, ..prim });
+                continue;
+            }
+            Err(d) => {
+                errors.push(d);
+                continue;
+            }
+        };
+        let index = out.lights.len() as u32;
+        if light.is_infinite() {
+            out.infinite_lights.push(index);
+        }
+        if light.fills_sky() && out.infinity.is_none() {
+            let object = objects.len() as u32;
+            objects.push(ObjectInfo {
+                name: format!("lights[{i}]"),
+                material: None,
+                light: Some(index),
+            });
+            out.infinity = Some(InfinityRef {
+                light: index,
+                object,
+            });
+        }
+        out.lights.push(light);
+    }
+    // Shapes with `emission` come after the list's lights (whose indices stay the list's).
+    for e in emitters {
+        match node_light(builder, e) {
+            Ok(light) => {
+                objects[e.object as usize].light = Some(out.lights.len() as u32);
+                out.lights.push(light);
+            }
+            Err(d) => errors.push(d),
+        }
+    }
+    out
+}
+
+/// The sphere a light of the list puts into the scene (a sphere light's centre and radius),
+/// which the scene's bounding sphere covers.
+fn light_sphere(l: &LightSpec) -> Option<(Vec3, f32)> {
+    match *l {
+        LightSpec::Sphere { center, radius, .. } => Some((center.into(), radius)),
+        LightSpec::Point { .. }
+        | LightSpec::Spot { .. }
+        | LightSpec::Distant { .. }
+        | LightSpec::Environment { .. } => None,
+    }
+}
+
+/// A light of the `lights` list as [`spec_light`] compiles it.
+enum SpecLight {
+    /// A light without geometry.
+    Light(Light),
+    /// A sphere light too small to sample, compiled as the point light it tends to.
+    Point {
+        /// The point light.
+        light: Light,
+        /// Why.
+        warning: Diagnostic,
+    },
+    /// A sphere light and its sphere (whose object the caller sets).
+    Sphere(Light, SpherePrim),
 }
 
 /// Reads an equirectangular OpenEXR map (linear RGB) and makes the environment light of its

@@ -15,9 +15,8 @@ use std::time::{Duration, Instant};
 
 use crate::accel::BvhStats;
 use crate::render_scene::PhotonParams;
-use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
-use crate::render_scene::light::escape::EnvironmentRef;
-use crate::render_scene::{Camera, DefaultEstimator, Light, ObjectInfo, RenderParams, RenderScene};
+use crate::render_scene::geometry::GeometryBuilder;
+use crate::render_scene::{Camera, DefaultEstimator, RenderParams, RenderScene};
 use crate::scene::Diagnostic;
 use crate::scene::schema::{self, LightSpec, SceneFile};
 
@@ -105,94 +104,23 @@ pub fn compile(
     if !errors.is_empty() {
         return Err(errors);
     }
-    // The sphere lights of the list are geometry too: the bounding sphere covers them.
-    let light_spheres: Vec<(glam::Vec3, f32)> = (scene.lights.iter())
-        .filter_map(|l| match *l {
-            LightSpec::Sphere { center, radius, .. } => Some((center.into(), radius)),
-            LightSpec::Point { .. }
-            | LightSpec::Spot { .. }
-            | LightSpec::Distant { .. }
-            | LightSpec::Environment { .. } => None,
-        })
-        .collect();
-    let scene_sphere = lights::scene_sphere(&builder, &light_spheres);
-    let mut environment = None;
-
-    let mut lights = Vec::with_capacity(scene.lights.len());
-    for (i, l) in scene.lights.iter().enumerate() {
-        match lights::spec_light(i, l, scene_sphere, base_dir) {
-            Ok(None) => {}
-            Ok(Some(light)) => {
-                if matches!(light, Light::Environment(_)) {
-                    let object = objects.len() as u32;
-                    objects.push(ObjectInfo {
-                        name: format!("lights[{i}]"),
-                        material: None,
-                        light: Some(lights.len() as u32),
-                    });
-                    environment = Some(EnvironmentRef {
-                        light: lights.len() as u32,
-                        object,
-                    });
-                }
-                lights.push(light);
-                continue;
-            }
-            Err(d) => {
-                errors.push(d);
-                continue;
-            }
-        }
-        match *l {
-            LightSpec::Point {
-                position, power, ..
-            } => lights.push(Light::point(position.into(), power.into())),
-            LightSpec::Sphere {
-                center,
-                radius,
-                power,
-                ..
-            } => {
-                let eye = scene.camera.view().0.into();
-                let reach = lights::reach(&builder, center.into(), eye);
-                let min = lights::min_sphere_light_radius(power.into(), reach);
-                if f64::from(radius) < min {
-                    stats.warnings.push(lights::point_fallback_warning(
-                        i,
-                        radius,
-                        power.into(),
-                        reach,
-                    ));
-                    lights.push(Light::point(center.into(), power.into()));
-                    continue;
-                }
-                let light = lights.len() as u32;
-                lights.push(Light::sphere(center.into(), radius, power.into()));
-                let object = objects.len() as u32;
-                objects.push(ObjectInfo {
-                    name: format!("lights[{i}]"),
-                    material: None,
-                    light: Some(light),
-                });
-                builder.spheres.push(SpherePrim {
-                    center: center.into(),
-                    radius,
-                    object,
-                });
-            }
-            LightSpec::Spot { .. } | LightSpec::Distant { .. } | LightSpec::Environment { .. } => {}
-        }
-    }
-    // Shapes with `emission` come after the list's lights (whose indices stay the list's).
-    for e in &emitters {
-        match lights::node_light(&builder, e) {
-            Ok(light) => {
-                objects[e.object as usize].light = Some(lights.len() as u32);
-                lights.push(light);
-            }
-            Err(d) => errors.push(d),
-        }
-    }
+    let eye = scene.camera.view().0.into();
+    let lights::Compiled {
+        lights,
+        infinite_lights,
+        infinity,
+    } = lights::compile_lights(
+        &scene.lights,
+        &emitters,
+        lights::Targets {
+            builder: &mut builder,
+            objects: &mut objects,
+            errors: &mut errors,
+            warnings: &mut stats.warnings,
+        },
+        eye,
+        base_dir,
+    );
     if !errors.is_empty() {
         return Err(errors);
     }
@@ -275,7 +203,8 @@ pub fn compile(
             textures,
             material_names,
             lights,
-            environment,
+            infinite_lights,
+            infinity,
             objects,
             geometry,
         },

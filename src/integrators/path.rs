@@ -235,31 +235,32 @@ impl<'a> PathTracer<'a> {
                 let it = scene.interact(&ray, |t| cone.width_at(&ray, t), &mut textured);
                 // Beer–Lambert absorption along the segment just travelled (1 outside media).
                 beta *= medium.transmittance(&ray, &it);
-                // A ray leaving the scene (to the background or the environment) also sees the
-                // suns whose disc it points into, counted as an emitter hit is.
-                let escaping = match &it {
-                    Interaction::Escaped => true,
-                    Interaction::Emitter(e) => scene
-                        .environment
-                        .is_some_and(|env| e.light == Some(env.light)),
-                    Interaction::Surface(_) => false,
-                };
                 // After a vertex that read the caustic map and at least one specular bounce, the
                 // map holds the light of the lights it carries.
                 let in_map =
                     |i: usize| map_read && since_local.is_some_and(|n| n > 0) && maps.carries(i);
-                if escaping && !background_only {
-                    let sun = self.suns(&ray, specular, prev_pdf, prev_p, in_map);
-                    let via = since_local.is_some_and(|n| n > 0);
-                    l.add(LightPath::classify(diffuse_bounces, via), beta * sun);
-                }
                 let v = match &it {
                     Interaction::Escaped => {
+                        // Leaving the scene: the lights at infinity the ray sees, each counted
+                        // as an emitter hit is, then the background.
                         let via = since_local.is_some_and(|n| n > 0);
-                        l.add(
-                            LightPath::classify(diffuse_bounces, via),
-                            beta * params.background,
-                        );
+                        let class = LightPath::classify(diffuse_bounces, via);
+                        if !background_only {
+                            for (i, e) in scene.lights_escaped(&ray).filter(|&(i, _)| !in_map(i)) {
+                                let w = if specular {
+                                    1.0
+                                } else {
+                                    let light_pdf = self.lights.pmf(prev_p, i)
+                                        * scene.lights[i].pdf_li(prev_p, e.wi);
+                                    power_heuristic(prev_pdf, light_pdf)
+                                };
+                                l.add(class, beta * (e.le * w));
+                            }
+                        }
+                        l.add(class, beta * params.background);
+                        if let Some(e) = scene.escape_record(&ray) {
+                            cx.observer.hit(node, scene, &e.hit, &e.sp, "light");
+                        }
                         break;
                     }
                     Interaction::Emitter(e) => {
@@ -498,34 +499,6 @@ impl<'a> PathTracer<'a> {
 }
 
 impl PathTracer<'_> {
-    /// Radiance of the suns (distant lights with a disc) that the escaping `ray` sees, each
-    /// weighted as an emitter hit: fully after a delta bounce (`specular`) or from the camera,
-    /// else by the power heuristic between the BSDF sample that chose the ray (`prev_pdf`,
-    /// from `prev_p`) and the light's own samples. Suns for which `in_map` is true are left
-    /// out (the caustic map holds their light).
-    fn suns(
-        &self,
-        ray: &Ray,
-        specular: bool,
-        prev_pdf: f32,
-        prev_p: Vec3,
-        in_map: impl Fn(usize) -> bool,
-    ) -> Vec3 {
-        let mut sum = Vec3::ZERO;
-        for (i, le) in self.scene.suns_seen(ray).filter(|&(i, _)| !in_map(i)) {
-            let w = if specular {
-                1.0
-            } else {
-                let wi = ray.dir.normalize();
-                let light_pdf =
-                    self.lights.pmf(prev_p, i) * self.scene.lights[i].pdf_li(prev_p, wi);
-                power_heuristic(prev_pdf, light_pdf)
-            };
-            sum += le * w;
-        }
-        sum
-    }
-
     /// Next-event estimation at `sp` towards light `index` (chosen with probability `pmf`):
     /// the radiance it sends through the non-delta part of the BSDF, MIS-weighted against BSDF
     /// sampling when the path may still scatter diffusely (else the light sample alone stands

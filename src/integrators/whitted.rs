@@ -101,11 +101,21 @@ impl<'a> Whitted<'a> {
         // Beer–Lambert absorption along this ray (exactly 1 outside media).
         let tr = path.medium.transmittance(ray, &it);
         let v = match it {
-            // Leaving the scene: the background or the environment, and the suns whose disc
-            // the ray points into.
+            // Leaving the scene: the background and the lights at infinity the ray sees.
             Interaction::Escaped => {
-                let suns = scene.suns_seen(ray).map(|(_, le)| le).sum::<Vec3>();
-                return (seen((scene.params.background + suns) * tr), None);
+                let mut le = scene.params.background;
+                for (_, e) in scene.lights_escaped(ray) {
+                    le += e.le;
+                }
+                let info = scene.escape_record(ray).filter(|_| O::ACTIVE).map(|e| TraceHit {
+                    t: e.hit.t,
+                    point: e.sp.p,
+                    normal: e.sp.ns,
+                    object: scene.objects[e.sp.object as usize].name.clone(),
+                    material: "light".into(),
+                    entering: true,
+                });
+                return (seen(le * tr), info);
             }
             Interaction::Emitter(e) => {
                 let entering = e.wo.dot(e.sp.ng) > 0.0;
@@ -117,16 +127,8 @@ impl<'a> Whitted<'a> {
                     material: "light".into(),
                     entering,
                 });
-                // An emitter: its radiance is seen from outside only; the environment with the
-                // suns in front of it.
-                let mut le = e.le(scene);
-                if scene
-                    .environment
-                    .is_some_and(|env| e.light == Some(env.light))
-                {
-                    le += scene.suns_seen(ray).map(|(_, le)| le).sum::<Vec3>();
-                }
-                return (seen(le * tr), info);
+                // An emitter: its radiance is seen from outside only.
+                return (seen(e.le(scene) * tr), info);
             }
             Interaction::Surface(v) => v,
         };

@@ -38,7 +38,8 @@ pub fn photon_key(scene: &RenderScene) -> u64 {
         textures,
         material_names: _,
         lights,
-        environment: _,
+        infinite_lights: _,
+        infinity: _,
         objects,
         geometry,
     } = scene;

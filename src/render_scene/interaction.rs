@@ -16,9 +16,8 @@ use crate::shading::{Bsdf, ShadingFrame};
     reason = "one per path vertex, on the stack and matched at once: never stored in arrays, so boxing would only add an allocation per hit"
 )]
 pub enum Interaction<'s> {
-    /// The ray left the scene (it sees the background). With an environment light, unbounded
-    /// rays that leave the scene are [`Interaction::Emitter`] hits on it instead
-    /// ([`RenderScene::escape`]).
+    /// The ray left the scene: it sees the background and, if it is unbounded, the lights at
+    /// infinity ([`RenderScene::lights_escaped`]).
     Escaped,
     /// The ray hit an emitter's surface (an object without a material: it absorbs what reaches
     /// it and emits [`EmitterHit::le`]).
@@ -93,7 +92,7 @@ impl RenderScene {
         textured: &'s mut Option<Bsdf>,
     ) -> Interaction<'s> {
         let Some(hit) = self.geometry.intersect(ray) else {
-            return self.escape(ray);
+            return Interaction::Escaped;
         };
         let sp = self.geometry.surface(ray, &hit);
         let object = &self.objects[sp.object as usize];

@@ -127,7 +127,7 @@ impl Light {
     /// True for lights whose samples carry no MIS weight because BSDF sampling never reaches
     /// them: point and spot lights (deltas in position) and distant lights of angular radius 0
     /// (a delta direction). A distant light with a disc (the sun) is not: escaping rays see it
-    /// ([`RenderScene::suns_seen`](crate::render_scene::RenderScene::suns_seen)).
+    /// ([`Light::le_escaped`]).
     #[inline]
     #[must_use]
     pub fn is_delta(&self) -> bool {
@@ -150,6 +150,65 @@ impl Light {
             | Light::Rect(_)
             | Light::Mesh(_)
             | Light::Spot(_) => false,
+        }
+    }
+
+    /// What the light sends back along a ray escaping the scene in direction `dir` (any
+    /// non-zero length; each kind normalises it as its own lookups do): for an environment or
+    /// sky, the map's radiance in that direction; for a distant light with a disc (the sun), its
+    /// radiance inside the disc. `None` where it sends nothing: outside a sun's disc, for a delta
+    /// distant light, a black map direction, and for every light with a position (point,
+    /// sphere, rectangle, mesh, spot), which rays meet as surfaces or never.
+    #[inline]
+    #[must_use]
+    pub fn le_escaped(&self, dir: Vec3) -> Option<escape::Escape> {
+        let (le, wi) = match self {
+            Light::Distant(d) => {
+                let wi = dir.try_normalize()?;
+                (d.le(wi), wi)
+            }
+            Light::Environment(e) => {
+                let wi = dir / dir.length();
+                (e.le(wi), wi)
+            }
+            Light::Point { .. }
+            | Light::Sphere { .. }
+            | Light::Rect(_)
+            | Light::Mesh(_)
+            | Light::Spot(_) => return None,
+        };
+        (le != Vec3::ZERO).then_some(escape::Escape { le, wi })
+    }
+
+    /// True for the lights at infinity that fill the sphere of directions (environment): ray
+    /// trees name escaping rays after the first of them, which compilation gives an object.
+    #[inline]
+    #[must_use]
+    pub fn fills_sky(&self) -> bool {
+        match self {
+            Light::Environment(_) => true,
+            Light::Point { .. }
+            | Light::Sphere { .. }
+            | Light::Rect(_)
+            | Light::Mesh(_)
+            | Light::Spot(_)
+            | Light::Distant(_) => false,
+        }
+    }
+
+    /// The scene's bounding sphere a light at infinity places its shadow-ray ends and photons
+    /// on; `None` for lights with a position.
+    #[inline]
+    #[must_use]
+    pub fn scene_sphere(&self) -> Option<SceneSphere> {
+        match self {
+            Light::Distant(d) => Some(d.scene),
+            Light::Environment(e) => Some(e.scene),
+            Light::Point { .. }
+            | Light::Sphere { .. }
+            | Light::Rect(_)
+            | Light::Mesh(_)
+            | Light::Spot(_) => None,
         }
     }
 
@@ -261,7 +320,7 @@ impl Light {
             Light::Rect(ref r) => r.sample_li(p, u),
             Light::Mesh(ref m) => m.sample_li(p, u).map(|s| s.light),
             Light::Spot(ref s) => s.sample_li(p, u),
-            // The sun's cone: escaping rays see it too (`RenderScene::suns_seen`), so its samples
+            // The sun's cone: escaping rays see it too (`Light::le_escaped`), so its samples
             // are MIS-weighted against BSDF sampling as an environment's are.
             Light::Distant(ref d) => d.sample_li(p, u),
             Light::Environment(ref e) => e.sample_li(p, u),
@@ -332,7 +391,7 @@ impl Light {
     /// radiance on an emitting side (`n` is the triangle's winding normal). Environment: the
     /// radiance arriving along a ray escaping in direction `−w` (`n` unused). Spot and distant
     /// lights: zero (rays never hit them as surfaces; an escaping ray sees a sun's disc through
-    /// [`RenderScene::suns_seen`](crate::render_scene::RenderScene::suns_seen)).
+    /// [`Light::le_escaped`]).
     #[inline]
     #[must_use]
     pub fn le(&self, n: Vec3, w: Vec3) -> Vec3 {

@@ -126,9 +126,12 @@ pub struct RenderScene {
     pub material_names: Vec<String>,
     /// Lights.
     pub lights: Vec<Light>,
-    /// The environment light, if the scene has one (at most one: validation), which rays
-    /// escaping the scene hit ([`RenderScene::escape`]).
-    pub environment: Option<light::escape::EnvironmentRef>,
+    /// The lights at infinity (indices into `lights`, in list order) that rays escaping the
+    /// scene loop over ([`RenderScene::lights_escaped`]).
+    pub infinite_lights: Vec<u32>,
+    /// The first light that fills the sky (environment) and its object: what ray trees record
+    /// escaping rays against ([`RenderScene::escape_record`]).
+    pub infinity: Option<light::escape::InfinityRef>,
     /// Objects, indexed by the `object` of each primitive.
     pub objects: Vec<ObjectInfo>,
     /// Primitives and their BVH.

@@ -181,13 +181,18 @@ impl<'a> PhotonMapper<'a> {
             let it = scene.interact(&ray, |t| b.cone.width_at(&ray, t), &mut textured);
             // Beer–Lambert absorption along the segment just travelled (1 outside media).
             let beta = beta * b.medium.transmittance(&ray, &it);
-            // Leaving the scene along a specular chain (or directly): the suns whose disc the
-            // ray points into are seen, besides the background or the environment.
-            let suns = |ray: &Ray| scene.suns_seen(ray).map(|(_, le)| le).sum::<Vec3>();
             let v = match it {
                 Interaction::Escaped => {
-                    gathered = beta * (params.background + suns(&ray));
+                    // Leaving the scene along a specular chain (or directly): the background and
+                    // the lights at infinity the ray sees.
+                    gathered = beta * params.background;
+                    for (_, e) in scene.lights_escaped(&ray) {
+                        gathered += beta * e.le;
+                    }
                     l.add(LightPath::Specular, gathered);
+                    if let Some(e) = scene.escape_record(&ray) {
+                        cx.observer.hit(node, scene, &e.hit, &e.sp, "light");
+                    }
                     cx.observer.set_radiance(node, gathered);
                     continue;
                 }
@@ -195,12 +200,6 @@ impl<'a> PhotonMapper<'a> {
                     // Reached along a specular chain (or directly): the emitter is seen.
                     if e.light.is_some() {
                         gathered = beta * e.le(scene);
-                        if scene
-                            .environment
-                            .is_some_and(|env| e.light == Some(env.light))
-                        {
-                            gathered += beta * suns(&ray);
-                        }
                         l.add(LightPath::Specular, gathered);
                     }
                     cx.observer.hit(node, scene, &e.hit, &e.sp, "light");

@@ -145,6 +145,42 @@ impl LightSpec {
         }
     }
 
+    /// The light's own caustic photon budget, to set or clear (`--caustic-photons` drops them
+    /// all).
+    #[must_use]
+    pub fn caustic_photons_mut(&mut self) -> &mut Option<u32> {
+        match self {
+            LightSpec::Point {
+                caustic_photons, ..
+            }
+            | LightSpec::Sphere {
+                caustic_photons, ..
+            }
+            | LightSpec::Spot {
+                caustic_photons, ..
+            }
+            | LightSpec::Distant {
+                caustic_photons, ..
+            }
+            | LightSpec::Environment {
+                caustic_photons, ..
+            } => caustic_photons,
+        }
+    }
+
+    /// True for the lights that every escaping ray sees, which fill the sky: environment (at
+    /// most one per scene, and no background beside it).
+    #[must_use]
+    pub fn fills_sky(&self) -> bool {
+        match self {
+            LightSpec::Environment { .. } => true,
+            LightSpec::Point { .. }
+            | LightSpec::Sphere { .. }
+            | LightSpec::Spot { .. }
+            | LightSpec::Distant { .. } => false,
+        }
+    }
+
     /// The light's kind as written in the file.
     #[must_use]
     pub fn kind(&self) -> &'static str {

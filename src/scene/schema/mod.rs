@@ -16,7 +16,7 @@ mod material;
 mod node;
 mod values;
 
-pub use light::{EmissionSpec, LightSpec};
+pub use light::*;
 pub use material::{
     AbsorptionSpec, CONDUCTOR_PRESETS, CoatSpec, ColorAtDepth, ColorSpec, ConductorSpec,
     ConductorTint, Mapping, MaterialSpec, RoughnessSpec, TextureSpec,

@@ -160,7 +160,7 @@ impl<'a> Validator<'a> {
     /// At most one environment light, and no background beside it.
     pub(super) fn environments(&mut self, scene: &SceneFile) {
         let envs: Vec<usize> = (scene.lights.iter().enumerate())
-            .filter(|(_, l)| matches!(l, LightSpec::Environment { .. }))
+            .filter(|(_, l)| l.fills_sky())
             .map(|(i, _)| i)
             .collect();
         if let [_, second, ..] = envs[..] {
