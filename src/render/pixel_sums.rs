@@ -265,7 +265,11 @@ impl PixelSums {
         let n = self.counts.len();
         let mut out =
             Vec::with_capacity(72 + metadata.len() + n * 100 + self.wide.len() * WIDE_ENTRY);
-        out.extend_from_slice(if self.wide.is_empty() { MAGIC } else { MAGIC_WIDE });
+        out.extend_from_slice(if self.wide.is_empty() {
+            MAGIC
+        } else {
+            MAGIC_WIDE
+        });
         out.extend_from_slice(&self.width.to_le_bytes());
         out.extend_from_slice(&self.height.to_le_bytes());
         out.extend_from_slice(&(metadata.len() as u64).to_le_bytes());
@@ -527,7 +531,10 @@ mod tests {
         let n = big.len() as f64;
         let exact_mean = big.iter().map(|&v| f64::from(v)).sum::<f64>() / n;
         let m = all.mean(1);
-        assert!((f64::from(m.x) / exact_mean - 1.0).abs() < 1e-6, "{m} vs {exact_mean:e}");
+        assert!(
+            (f64::from(m.x) / exact_mean - 1.0).abs() < 1e-6,
+            "{m} vs {exact_mean:e}"
+        );
         assert!((f64::from(m.z) / -exact_mean - 1.0).abs() < 1e-6, "{m}");
         assert_eq!(m.y, 0.5);
         let exact_var = big

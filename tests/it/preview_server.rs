@@ -93,7 +93,10 @@ impl Server {
         let t = Instant::now();
         let (code, body) = self.get("/status");
         assert_eq!(code, 200, "{body}");
-        (serde_json::from_str(&body).expect("status JSON"), t.elapsed())
+        (
+            serde_json::from_str(&body).expect("status JSON"),
+            t.elapsed(),
+        )
     }
 
     fn alive(&mut self) -> bool {
@@ -123,7 +126,10 @@ impl Server {
             if let Some(s) = self.child.try_wait().expect("wait") {
                 return (s.code(), t.elapsed());
             }
-            assert!(t.elapsed() < Duration::from_secs(10), "no exit after SIGINT");
+            assert!(
+                t.elapsed() < Duration::from_secs(10),
+                "no exit after SIGINT"
+            );
             std::thread::sleep(Duration::from_millis(10));
         }
     }
@@ -154,8 +160,10 @@ fn a_huge_or_withheld_body_neither_aborts_nor_stalls_the_preview() {
     // answer to anyone until this client left), and this one is answered 413 or dropped.
     let mut held = server.connect();
     held.write_all(
-        format!("POST /save HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 1000000000\r\n\r\nab")
-            .as_bytes(),
+        format!(
+            "POST /save HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 1000000000\r\n\r\nab"
+        )
+        .as_bytes(),
     )
     .expect("sends");
     let mut slow = server.connect();
@@ -173,7 +181,10 @@ fn a_huge_or_withheld_body_neither_aborts_nor_stalls_the_preview() {
     // Ctrl-C while a client holds a request open: the preview ends within moments.
     let mut held2 = server.connect();
     held2
-        .write_all(format!("POST /pause HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 10\r\n\r\n").as_bytes())
+        .write_all(
+            format!("POST /pause HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 10\r\n\r\n")
+                .as_bytes(),
+        )
         .expect("sends");
     let (code, took) = server.interrupt();
     assert_eq!(code, Some(130));
@@ -204,12 +215,14 @@ fn only_the_pages_own_origin_changes_the_preview_and_status_hides_the_scenes_fol
         assert_eq!(post("/save", origin).0, 403, "{origin}");
         assert_eq!(post("/pause?on=1", origin).0, 403, "{origin}");
     }
-    assert!(!dir.path().join("out.png").exists(), "a cross-origin save wrote the image");
+    assert!(
+        !dir.path().join("out.png").exists(),
+        "a cross-origin save wrote the image"
+    );
     assert_eq!(server.status().0["paused"], false);
     // DNS rebinding: a page whose own name now resolves to 127.0.0.1 can read nothing.
-    let rebound = server.exchange(
-        format!("GET /status HTTP/1.1\r\nHost: evil.example:{port}\r\n\r\n").as_bytes(),
-    );
+    let rebound = server
+        .exchange(format!("GET /status HTTP/1.1\r\nHost: evil.example:{port}\r\n\r\n").as_bytes());
     assert_eq!(rebound.0, 403);
     // The page itself (as Chromium sends its fetches) pauses, resumes and saves.
     let page = format!("Origin: http://127.0.0.1:{port}\r\n");
@@ -298,7 +311,10 @@ fn fuzz_request(f: &mut Fuzz, port: u16) -> (Vec<u8>, u64) {
         head.push_str(f.pick(&headers));
     }
     if f.below(20) == 0 {
-        head.push_str(&format!("X-Long: {}\r\n", "a".repeat(f.below(20_000) as usize)));
+        head.push_str(&format!(
+            "X-Long: {}\r\n",
+            "a".repeat(f.below(20_000) as usize)
+        ));
     }
     head.push_str("\r\n");
     let mut bytes = head.into_bytes();
@@ -329,14 +345,19 @@ fn fuzzed_requests_never_abort_stall_or_stop_the_preview() {
         let clients: Vec<_> = (0..8u64)
             .map(|c| {
                 scope.spawn(move || {
-                    let mut f = Fuzz(0x9e37_79b9_7f4a_7c15 ^ (c + 1).wrapping_mul(0x1234_5678_9abc));
+                    let mut f =
+                        Fuzz(0x9e37_79b9_7f4a_7c15 ^ (c + 1).wrapping_mul(0x1234_5678_9abc));
                     for _ in 0..40 {
                         let (bytes, cut) = fuzz_request(&mut f, port);
                         let Ok(mut s) = TcpStream::connect(("127.0.0.1", port)) else {
                             continue;
                         };
                         s.set_read_timeout(Some(Duration::from_secs(5))).ok();
-                        let sent = if cut > 0 { &bytes[..cut as usize] } else { &bytes[..] };
+                        let sent = if cut > 0 {
+                            &bytes[..cut as usize]
+                        } else {
+                            &bytes[..]
+                        };
                         let _ = s.write_all(sent);
                         match f.below(4) {
                             // Close at once, without reading.
@@ -378,7 +399,10 @@ fn fuzzed_requests_never_abort_stall_or_stop_the_preview() {
     assert_eq!(s["paused"], false);
     let after = server.spp_when_rendering();
     assert!(after > before, "spp {before} -> {after}");
-    assert!(!dir.path().join("out.png").exists(), "a fuzzed request saved");
+    assert!(
+        !dir.path().join("out.png").exists(),
+        "a fuzzed request saved"
+    );
     let (code, took) = server.interrupt();
     assert_eq!(code, Some(130));
     assert!(took < Duration::from_secs(2), "exit took {took:?}");

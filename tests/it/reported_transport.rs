@@ -98,7 +98,10 @@ fn the_default_photon_bounce_cap_does_not_darken_an_integrating_sphere() {
     let maps = build_maps(&scene_from_text(&integrating_sphere("")));
     let t = PhotonSummary::total(&maps.summary.global);
     let stored = f64::from(t.stored_flux.x);
-    eprintln!("default cap: stored {stored:.4} W of 4 Φ = {:.4} W", 4.0 * phi);
+    eprintln!(
+        "default cap: stored {stored:.4} W of 4 Φ = {:.4} W",
+        4.0 * phi
+    );
     // σ of the stored flux with 2·10⁵ photons ≈ 0.25 %.
     assert!((stored / (4.0 * phi) - 1.0).abs() < 0.0075, "{stored}");
     assert_eq!(t.lost_at_depth, 0, "no path reaches the default cap");
@@ -116,7 +119,9 @@ fn a_photon_bounce_cap_reports_the_flux_it_takes_from_the_map() {
     let (stored, lost) = (f64::from(t.stored_flux.x), f64::from(t.lost_flux.x));
     let kept = 4.0 * phi * (1.0 - rho.powi(16));
     let cut = 4.0 * phi * (rho.powi(16) - rho.powi(32));
-    eprintln!("cap 16: stored {stored:.4} W (exact {kept:.4}), reported cut {lost:.4} W (exact {cut:.4})");
+    eprintln!(
+        "cap 16: stored {stored:.4} W (exact {kept:.4}), reported cut {lost:.4} W (exact {cut:.4})"
+    );
     assert!((stored / kept - 1.0).abs() < 0.0075, "{stored} vs {kept}");
     assert!((lost / cut - 1.0).abs() < 0.05, "{lost} vs {cut}");
     // The photons still alive after the cap's 16 bounces from their first landing: 2·10⁵ ρ¹⁷

@@ -67,9 +67,10 @@ pub fn save(
     };
     eprintln!("{}", saved(&output.display()));
     // The page (and `/status`) shows the file's name, not the folder it is in.
-    let name = output
-        .file_name()
-        .map_or_else(|| output.display().to_string(), |n| n.to_string_lossy().into_owned());
+    let name = output.file_name().map_or_else(
+        || output.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
     let mut message = saved(&name);
     if let Some(reference) = &s.reference {
         let checked = super::super::max_rmse::check(
