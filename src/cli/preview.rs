@@ -233,9 +233,10 @@ pub fn run(args: &PreviewArgs) -> Result<(), Error> {
 
 /// The scene's file name as the page shows it (never its folder).
 fn scene_name(scene: &std::path::Path) -> String {
-    scene
-        .file_name()
-        .map_or_else(|| scene.display().to_string(), |n| n.to_string_lossy().into_owned())
+    scene.file_name().map_or_else(
+        || scene.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
 }
 
 /// Ctrl-C (and SIGTERM/SIGHUP): ends the server loop and the render thread cleanly.

@@ -274,7 +274,11 @@ impl PixelSums {
         let n = self.counts.len();
         let mut out =
             Vec::with_capacity(72 + metadata.len() + n * 100 + self.wide.len() * WIDE_ENTRY);
-        out.extend_from_slice(if self.wide.is_empty() { MAGIC } else { MAGIC_WIDE });
+        out.extend_from_slice(if self.wide.is_empty() {
+            MAGIC
+        } else {
+            MAGIC_WIDE
+        });
         out.extend_from_slice(&self.width.to_le_bytes());
         out.extend_from_slice(&self.height.to_le_bytes());
         out.extend_from_slice(&(metadata.len() as u64).to_le_bytes());
@@ -518,5 +522,62 @@ mod tests {
         assert!(PixelSums::from_bytes(&flipped, "t").is_err());
         let mut other = PixelSums::new(2, 2);
         assert!(matches!(other.merge(&f), Err(FilmError::Size(2, 2, 3, 2))));
+        // No wide sums: the v1 format, as every film before them.
+        assert!(bytes.starts_with(MAGIC));
+    }
+
+    #[test]
+    fn huge_samples_keep_their_mean_and_variance_in_any_order() {
+        // 1e30 (far beyond the 128-bit sums' 9.2e18), f32::MAX and a value just over the limit,
+        // mixed with ordinary ones in one pixel; per channel the exact mean and variance.
+        let big = [1e30f32, f32::MAX / 4.0, MAIN_LIMIT as f32 * 1.5, 0.25, 3.0];
+        let samples: Vec<(usize, Vec3)> = big
+            .iter()
+            .map(|&v| (1, Vec3::new(v, 0.5, -v)))
+            .chain([(0, Vec3::splat(2e20)), (0, Vec3::splat(2e20))])
+            .collect();
+        let all = filled(&samples);
+        let n = big.len() as f64;
+        let exact_mean = big.iter().map(|&v| f64::from(v)).sum::<f64>() / n;
+        let m = all.mean(1);
+        assert!(
+            (f64::from(m.x) / exact_mean - 1.0).abs() < 1e-6,
+            "{m} vs {exact_mean:e}"
+        );
+        assert!((f64::from(m.z) / -exact_mean - 1.0).abs() < 1e-6, "{m}");
+        assert_eq!(m.y, 0.5);
+        let exact_var = big
+            .iter()
+            .map(|&v| (f64::from(v) - exact_mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        // In f32 the variance of f32::MAX/4 overflows: infinite, never a small wrong number.
+        assert_eq!(all.variance(1).x, exact_var as f32);
+        assert_eq!(all.variance(1).y, 0.0);
+        assert_eq!(all.mean(0), Vec3::splat(2e20));
+        assert_eq!(all.variance(0), Vec3::ZERO);
+        // Any split and merge order: the same sums, so the same bytes.
+        for split in 0..samples.len() {
+            let mut a = filled(&samples[..split]);
+            let b = filled(&samples[split..]);
+            let mut b2 = b.clone();
+            a.merge(&b).unwrap();
+            b2.merge(&filled(&samples[..split])).unwrap();
+            assert_eq!(a, all, "split {split}");
+            assert_eq!(b2, all, "split {split}");
+        }
+        // The wide sums travel in the v2 format, and a damaged one is refused.
+        let bytes = all.to_bytes("m");
+        assert!(bytes.starts_with(MAGIC_WIDE));
+        let (back, _) = PixelSums::from_bytes(&bytes, "t").unwrap();
+        assert_eq!(back, all);
+        assert!(back.has_wide_sums(1) && !back.has_wide_sums(5));
+        for cut in [bytes.len() - 9, bytes.len() - 300] {
+            assert!(PixelSums::from_bytes(&bytes[..cut], "t").is_err());
+        }
+        let mut future = bytes.clone();
+        future[14] = b'9';
+        let e = PixelSums::from_bytes(&future, "t").unwrap_err().to_string();
+        assert!(e.contains("version"), "{e}");
     }
 }

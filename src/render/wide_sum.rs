@@ -156,7 +156,9 @@ mod tests {
             assert_eq!(WideSum::from_le_bytes(w.to_le_bytes()), w);
         }
         assert_eq!(
-            WideSum::from_i128(i128::MAX).add(WideSum::from_i128(1)).to_i128(),
+            WideSum::from_i128(i128::MAX)
+                .add(WideSum::from_i128(1))
+                .to_i128(),
             None
         );
     }

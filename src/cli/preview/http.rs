@@ -208,7 +208,11 @@ fn body_length(request: &Request) -> Result<usize, Refusal> {
         return Err(refuse(411, "a body needs a Content-Length"));
     }
     let mut length = None;
-    for (_, v) in request.headers.iter().filter(|(n, _)| n == "content-length") {
+    for (_, v) in request
+        .headers
+        .iter()
+        .filter(|(n, _)| n == "content-length")
+    {
         if v.is_empty() || !v.bytes().all(|b| b.is_ascii_digit()) {
             return Err(refuse(400, "bad Content-Length"));
         }

@@ -58,13 +58,20 @@ pub fn save(
         write_image(&job.snapshot(), output, display)
     };
     written.map_err(|e| format!("not saved: {e}"))?;
-    let mut message = format!(
-        "saved `{}`: samples {first}..{end} ({} of {} per pixel)",
-        output.display(),
-        end - first,
-        p.samples_per_pixel
+    let saved = |name: &dyn std::fmt::Display| {
+        format!(
+            "saved `{name}`: samples {first}..{end} ({} of {} per pixel)",
+            end - first,
+            p.samples_per_pixel
+        )
+    };
+    eprintln!("{}", saved(&output.display()));
+    // The page (and `/status`) shows the file's name, not the folder it is in.
+    let name = output.file_name().map_or_else(
+        || output.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
     );
-    eprintln!("{message}");
+    let mut message = saved(&name);
     if let Some(reference) = &s.reference {
         let checked = super::super::max_rmse::check(
             reference,

@@ -75,7 +75,13 @@ impl Server {
         }
     }
 
-    fn spawn(&self, stream: TcpStream, peer: SocketAddr, shared: &Arc<Shared>, to_render: &Sender<Msg>) {
+    fn spawn(
+        &self,
+        stream: TcpStream,
+        peer: SocketAddr,
+        shared: &Arc<Shared>,
+        to_render: &Sender<Msg>,
+    ) {
         // Over the bound: the connection is closed at once (dropped), unanswered.
         if self.open.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS || !peer.ip().is_loopback() {
             self.open.fetch_sub(1, Ordering::SeqCst);
@@ -144,7 +150,9 @@ fn is_us(host: &str, port: u16) -> bool {
 /// another site, a sandboxed frame or a file, whose `Origin` differs or is `null`, is refused).
 fn forbidden(request: &Request, port: u16) -> Option<&'static str> {
     if !request.header("host").is_some_and(|h| is_us(h, port)) {
-        return Some("forbidden: the Host must be this preview (127.0.0.1 or localhost and its port)");
+        return Some(
+            "forbidden: the Host must be this preview (127.0.0.1 or localhost and its port)",
+        );
     }
     if request.method == Method::Post {
         let ours = request
@@ -274,8 +282,14 @@ mod tests {
         assert!(ok(Method::Get, &[("host", "127.0.0.1")]));
         assert!(!ok(Method::Get, &[("host", "evil.example")]));
         assert!(!ok(Method::Get, &[]));
-        assert!(ok(Method::Post, &[host, ("origin", "http://127.0.0.1:4711")]));
-        assert!(ok(Method::Post, &[host, ("origin", "http://localhost:4711")]));
+        assert!(ok(
+            Method::Post,
+            &[host, ("origin", "http://127.0.0.1:4711")]
+        ));
+        assert!(ok(
+            Method::Post,
+            &[host, ("origin", "http://localhost:4711")]
+        ));
         for origin in [
             "https://evil.example",
             "null",

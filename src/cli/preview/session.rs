@@ -64,6 +64,15 @@ pub fn run(settings: &Settings, shared: &Shared, rx: &Receiver<Msg>, watch: &mut
     }
 }
 
+/// `text` with the scene's folder left out of the paths it names (`/home/me/x/scene.ron:3:5` →
+/// `scene.ron:3:5`): the page shows where in the scene, `/status` never where the scene is.
+fn without_folder(text: &str, scene: &std::path::Path) -> String {
+    match scene.parent().map(|p| p.display().to_string()) {
+        Some(folder) if !folder.is_empty() => text.replace(&format!("{folder}/"), ""),
+        _ => text.to_string(),
+    }
+}
+
 impl Session<'_> {
     fn load_and_render(&mut self) -> Next {
         let cancel = self.shared.new_cancel();
@@ -122,7 +131,7 @@ impl Session<'_> {
         {
             let mut s = self.shared.status();
             s.phase = Phase::Failed;
-            s.error = Some(text);
+            s.error = Some(without_folder(&text, &self.settings.scene));
             // The figures stay those of the image shown (the last good one).
             let elapsed = s.started.elapsed();
             s.stopped.get_or_insert(elapsed);

@@ -152,7 +152,8 @@ pub struct PhotonSettings {
     /// Final-gather rays per camera hit on a diffuse surface (indirect light sampled from the
     /// BSDF and read from the maps where those rays land); 0 reads the global map directly.
     pub final_gather: u32,
-    /// Most bounces a photon path makes before it is dropped.
+    /// Most bounces a photon path makes before it is dropped: a safety net (Russian roulette
+    /// ends paths without bias); the summary says what a cut path would have stored.
     pub max_bounces: u32,
 }
 
