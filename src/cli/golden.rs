@@ -57,8 +57,9 @@ struct UpdateArgs {
     #[arg(long, default_value = "8", value_name = "PIXELS")]
     block: u32,
     /// The smallest change to catch, e.g. `2%`: render at the samples per pixel that catch a
-    /// change of that size over a square of 5 % of the image in 95 % of checks (recorded as
-    /// `--spp`).
+    /// change of that size over a block of about 5 % of the image in 95 % of checks (for the
+    /// median block; predicted from the noise measured, rendered and measured again; recorded
+    /// as `--spp`).
     #[arg(long, value_name = "PERCENT", value_parser = parse_percent)]
     detect: Option<f64>,
     /// Most samples per pixel `--detect` may choose.
@@ -101,6 +102,12 @@ struct CheckArgs {
     #[arg(short, long)]
     quiet: bool,
 }
+
+/// Renders `--detect` may take to find the samples per pixel.
+const DETECT_ROUNDS: usize = 4;
+/// The prediction aims this far below the requested floor, so that the measured floor (itself
+/// an estimate) usually reaches it at the first try.
+const DETECT_AIM: f64 = 0.9;
 
 fn parse_percent(text: &str) -> Result<f64, String> {
     let t = text.trim();
@@ -270,7 +277,6 @@ struct Rendered {
     meta: GoldenMeta,
     /// The settings hash as if rendered with `hash_seed` instead of its own seed.
     hash_at_seed: u64,
-    progressive_alpha: Option<f64>,
 }
 
 /// Prepares and renders `path` batch by batch; refuses fewer than 2 samples per pixel (no
@@ -310,7 +316,7 @@ fn render_scene(
         threads,
         ..RenderOptions::default()
     };
-    let out = render_batches(&prepared.render_scene, &options, block)?;
+    let out = render_batches(&mut prepared.render_scene, &options, block)?;
     if out.output.stats.nan_samples > 0 && !quiet {
         eprintln!(
             "warning: `{}`: {} samples were NaN or infinite and were dropped",
@@ -336,7 +342,6 @@ fn render_scene(
         batches: out.batches,
         meta,
         hash_at_seed,
-        progressive_alpha: out.progressive_alpha,
     })
 }
 
@@ -352,40 +357,62 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
         let mut r = render_scene(path, &overrides, a.block, a.threads, a.quiet, None)?;
         let mut floor = DetectionFloor::of(&r.batches, a.alpha);
         if let Some(target) = a.detect {
+            // Predict the samples per pixel from the measured floor, render, measure again:
+            // the prediction (noise ∝ 1/√spp) is only approximate for the progressive
+            // integrators, whose per-pass noise grows as their radius shrinks.
+            for _ in 0..DETECT_ROUNDS {
+                let (w, h) = (r.estimates.width, r.estimates.height);
+                let scale = floor.detect_scale(w, h);
+                let side = floor.scales[scale].side;
+                let reached = floor.scales[scale].median <= target;
+                let advice = floor::recommend_spp(
+                    &floor,
+                    scale,
+                    r.meta.spp,
+                    DETECT_AIM * target,
+                    a.alpha,
+                    None,
+                    a.detect_limit,
+                );
+                let spp = match advice {
+                    None if r.meta.spp >= a.detect_limit => break,
+                    None => a.detect_limit,
+                    Some(spp) if reached && spp >= r.meta.spp => break,
+                    Some(spp) if spp == r.meta.spp => break,
+                    Some(spp) => spp,
+                };
+                println!(
+                    "{}: {} spp catch a change of {} % over {side}×{side} px (≈ {} % of the image) in 95 % of checks; measuring at {spp} spp",
+                    path.display(),
+                    r.meta.spp,
+                    report::number((1000.0 * floor.scales[scale].median).round() / 10.0),
+                    report::number(100.0 * floor::DETECT_AREA)
+                );
+                let mut more = overrides.clone();
+                more.samples_per_pixel = Some(spp);
+                let next = render_scene(path, &more, a.block, a.threads, a.quiet, None)?;
+                let next_floor = DetectionFloor::of(&next.batches, a.alpha);
+                let now_reached = next_floor.scales[scale].median <= target;
+                // Fewer samples are only taken when they still reach the floor.
+                if now_reached || spp > r.meta.spp {
+                    r = next;
+                    floor = next_floor;
+                }
+                if (now_reached && !reached) || (!now_reached && spp < r.meta.spp) {
+                    break;
+                }
+            }
             let (w, h) = (r.estimates.width, r.estimates.height);
             let scale = floor.detect_scale(w, h);
-            let side = floor.scales[scale].side;
-            let advice = floor::recommend_spp(
-                &floor,
-                scale,
-                r.meta.spp,
-                target,
-                a.alpha,
-                r.progressive_alpha,
-                a.detect_limit,
-            );
-            match advice {
-                None => println!(
-                    "{}: a change of {} over {side}×{side} px needs more than {} samples per pixel (--detect-limit); keeping {}",
+            if floor.scales[scale].median > target {
+                println!(
+                    "{}: warning: {} spp do not reach a floor of {} % over {side}×{side} px (--detect-limit {})",
                     path.display(),
-                    report::number(100.0 * target) + " %",
+                    r.meta.spp,
+                    report::number(100.0 * target),
                     a.detect_limit,
-                    r.meta.spp
-                ),
-                Some(spp) if spp != r.meta.spp => {
-                    println!(
-                        "{}: {} samples per pixel catch a change of {} % over {side}×{side} px (≈ {} % of the image) in 95 % of checks; rendering at {spp}",
-                        path.display(),
-                        spp,
-                        report::number(100.0 * target),
-                        report::number((100.0 * floor::DETECT_AREA).round())
-                    );
-                    let mut more = overrides.clone();
-                    more.samples_per_pixel = Some(spp);
-                    r = render_scene(path, &more, a.block, a.threads, a.quiet, None)?;
-                    floor = DetectionFloor::of(&r.batches, a.alpha);
-                }
-                Some(_) => {}
+                    side = floor.scales[scale].side
+                );
             }
         }
         let target = a.output.join(golden_name(path));

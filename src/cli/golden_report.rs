@@ -104,11 +104,11 @@ pub fn report(
     ));
     write_error_image(g, now.estimates, &v, &image)?;
     println!(
-        "{name}: CHANGED: {} beyond their noise ({seeds}); error image `{}`",
+        "{name}: CHANGED: {} ({seeds}); error image `{}`",
         if changed.len() == 1 {
-            "1 block is".to_string()
+            "1 block is beyond its noise".to_string()
         } else {
-            format!("{} blocks are", changed.len())
+            format!("{} blocks are beyond their noise", changed.len())
         },
         image.display()
     );

@@ -1,10 +1,10 @@
-//! Every scene in `scenes/` rendered small (64×64, 4 spp) and checked against its golden image
+//! Every scene in `scenes/` rendered small (64×64, 8 spp) and checked against its golden image
 //! (`tests/golden/<scene file>.golden`) by `caustic golden check` — the very command README
 //! shows for a user's CI — **within noise**, not byte for byte: these are stochastic renders,
 //! and a harmless change of random streams changes every pixel's noise but not what the image
 //! shows. The check renders with a seed other than the golden's and judges the difference of
-//! 8×8-block means against both images' own variances (docs/golden.md), so there is no
-//! tolerance to tune. Exact bytes are still asserted elsewhere: across thread counts, regions
+//! block means at every scale against the spread of both renders' batch means (each pass an
+//! independent estimate; docs/golden.md), so there is no tolerance to tune. Exact bytes are still asserted elsewhere: across thread counts, regions
 //! and passes (determinism.rs).
 //!
 //! On failure the error images are written beside the goldens (`<scene>.error.png`);
@@ -29,7 +29,7 @@ fn every_scene_matches_its_golden_image_within_noise() {
             "--height",
             "64",
             "--spp",
-            "4",
+            "8",
             "--quiet",
         ]);
         assert!(

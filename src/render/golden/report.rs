@@ -43,7 +43,8 @@ fn flatten(v: &Value, path: String, out: &mut Vec<(String, String)>) {
 
 /// A value as the scene file would write it: a number that is an `f32` widened to `f64`
 /// (`0.949999988079071`) is printed as the shortest decimal that reads back as that `f32`
-/// (`0.95`), other numbers by their shortest round-trip form, arrays as `[a, b, c]`.
+/// (`0.95`), whole numbers without a fraction (`45`), other numbers by their shortest
+/// round-trip form, arrays as `[a, b, c]`.
 #[must_use]
 pub fn text(v: &Value) -> String {
     match v {
@@ -61,11 +62,15 @@ pub fn text(v: &Value) -> String {
     }
 }
 
-/// The shortest decimal of `f` that reads back as `f`, or as the `f32` it came from.
+/// The shortest decimal of `f` that reads back as `f`, or as the `f32` it came from; whole
+/// numbers below 10¹⁵ without a fraction.
 #[must_use]
 pub fn number(f: f64) -> String {
     let narrow = f as f32;
-    if f64::from(narrow) == f {
+    if f.fract() == 0.0 && f.abs() < 1e15 {
+        // Whole numbers as a scene writes them: `45`, not `45.0`.
+        format!("{f}")
+    } else if f64::from(narrow) == f {
         format!("{narrow:?}")
     } else {
         format!("{f:?}")
@@ -273,6 +278,9 @@ mod tests {
             ]
         );
         assert_eq!(number(0.1), "0.1");
+        assert_eq!(number(45.0), "45");
+        assert_eq!(number(-2.0), "-2");
+        assert_eq!(number(2.5e20), "2.5e20");
         assert_eq!(number(f64::from(0.1f32)), "0.1");
         assert_eq!(number(1.0 / 3.0), "0.3333333333333333");
         let mut now = out.clone();
