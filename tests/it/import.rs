@@ -877,3 +877,59 @@ fn a_blender_exported_room_renders_as_its_hand_written_twin() {
         "Blender's export uses only extensions caustic maps: {text:?}"
     );
 }
+
+#[test]
+fn obj_mtl_materials_compile_as_their_hand_written_twins_and_the_scene_wins_by_name() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    std::fs::write(
+        tmp.path().join("a.mtl"),
+        "newmtl red\nKd 0.8 0.1 0.1\nKs 0.1 0.1 0.1\nNs 50\n\
+         newmtl glass\nKd 1 1 1\nNi 1.33\nd 0.25\n\
+         newmtl wood\nKd 0.2 0.2 0.2\n",
+    )
+    .expect("write");
+    std::fs::write(
+        tmp.path().join("a.obj"),
+        "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+         usemtl red\nf 1 2 3\nusemtl glass\nf 1 3 4\nusemtl wood\nf 2 3 4\n",
+    )
+    .expect("write");
+    let scene = |materials: &str, nodes: &str| {
+        format!(
+            "Scene(camera: Pinhole(eye: (0.5, 0.5, 3), look_at: (0.5, 0.5, 0), fov_y: 40),
+               lights: [Point(position: (0, 1, 3), power: (40, 40, 40))],
+               materials: {{ {materials} }}, nodes: [{nodes}])"
+        )
+    };
+    std::fs::write(
+        tmp.path().join("import.ron"),
+        scene(
+            "\"oak\": (color: (0.5, 0.3, 0.1))",
+            "Mesh(file: \"a.obj\", mtl: true, materials: {\"wood\": \"oak\"})",
+        ),
+    )
+    .expect("write");
+    std::fs::write(
+        tmp.path().join("twin.ron"),
+        scene(
+            "\"oak\": (color: (0.5, 0.3, 0.1)),
+             \"red\": (color: (0.8, 0.1, 0.1), specular: (0.1, 0.1, 0.1), shininess: 50),
+             \"glass\": (color: (1, 1, 1), diffuse: 0.25, transmit: 0.75, ior: 1.33)",
+            "Mesh(file: \"a.obj\", materials: {\"red\": \"red\", \"glass\": \"glass\", \"wood\": \"oak\"})",
+        ),
+    )
+    .expect("write");
+    let overrides = caustic::pipeline::SceneOverrides::default();
+    let import = caustic::pipeline::prepare(&tmp.path().join("import.ron"), &overrides)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let twin = caustic::pipeline::prepare(&tmp.path().join("twin.ron"), &overrides)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(import.render_scene.materials.len(), 3);
+    for m in &twin.render_scene.materials {
+        assert!(import.render_scene.materials.contains(m), "a twin material is missing");
+    }
+    // `d` as a dielectric is said once, for `glass`; `wood`'s Kd never compiles (the scene's oak).
+    let notes: Vec<&str> = import.warnings.iter().map(|d| d.message.as_str()).collect();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].starts_with("material `glass` of"), "{notes:?}");
+}
