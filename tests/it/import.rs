@@ -926,7 +926,10 @@ fn obj_mtl_materials_compile_as_their_hand_written_twins_and_the_scene_wins_by_n
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(import.render_scene.materials.len(), 3);
     for m in &twin.render_scene.materials {
-        assert!(import.render_scene.materials.contains(m), "a twin material is missing");
+        assert!(
+            import.render_scene.materials.contains(m),
+            "a twin material is missing"
+        );
     }
     // `d` as a dielectric is said once, for `glass`; `wood`'s Kd never compiles (the scene's oak).
     let notes: Vec<&str> = import.warnings.iter().map(|d| d.message.as_str()).collect();
