@@ -19,7 +19,14 @@ const N: usize = 708;
 /// Triangles kept: exactly one million.
 const TRIANGLES: usize = 1_000_000;
 
-fn grid() -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[u32; 3]>) {
+/// The benchmark mesh: positions, normals, triangles.
+struct Grid {
+    p: Vec<[f32; 3]>,
+    n: Vec<[f32; 3]>,
+    t: Vec<[u32; 3]>,
+}
+
+fn grid() -> Grid {
     let mut p = Vec::with_capacity(N * N);
     let mut n = Vec::with_capacity(N * N);
     for j in 0..N {
@@ -45,11 +52,11 @@ fn grid() -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[u32; 3]>) {
             }
         }
     }
-    (p, n, t)
+    Grid { p, n, t }
 }
 
 fn write_files(dir: &Path) {
-    let (p, n, t) = grid();
+    let Grid { p, n, t } = grid();
     let mut obj = String::with_capacity(80 * p.len());
     for v in &p {
         obj.push_str(&format!("v {} {} {}\n", v[0], v[1], v[2]));
@@ -98,7 +105,7 @@ fn write_files(dir: &Path) {
         3 * t.len()
     )
     .into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let mut glb = b"glTF".to_vec();

@@ -141,7 +141,7 @@ pub fn import_gltf(
     let key = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
     let doc = &gltf.document;
     // Meshes: one ObjMesh per triangle primitive, in file order.
-    let mut prim_keys: Vec<Vec<Option<(PathBuf, Option<usize>)>>> = Vec::new();
+    let mut prim_keys: Vec<Vec<Option<PrimKey>>> = Vec::new();
     let mut default_material_of_file = None;
     for mesh in doc.meshes() {
         let mut keys = Vec::new();
@@ -256,6 +256,10 @@ pub fn import_gltf(
     Ok(out)
 }
 
+/// A triangle primitive of a glTF mesh: its key in the mesh cache and its material index
+/// (`None`: glTF's default material).
+type PrimKey = (PathBuf, Option<usize>);
+
 /// What the primitives of one glTF material get.
 #[derive(Debug, Clone)]
 enum Look {
@@ -266,7 +270,7 @@ enum Look {
 }
 
 struct NodeContext<'a> {
-    prim_keys: &'a [Vec<Option<(PathBuf, Option<usize>)>>],
+    prim_keys: &'a [Vec<Option<PrimKey>>],
     looks: &'a BTreeMap<Option<usize>, Look>,
 }
 
@@ -841,7 +845,7 @@ fn read_primitive(
         Some(i) => i.into_u32().collect(),
         None => (0..n as u32).collect(),
     };
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err((
             format!("{at}/indices"),
             format!("{} indices do not make whole triangles", indices.len()),

@@ -524,10 +524,10 @@ fn room_glb(extra: &str) -> Vec<u8> {
     let (mut bin, views) = room_buffer();
     let mut json =
         room_json(&format!("{{\"byteLength\": {}}}", bin.len()), &views, extra).into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();
