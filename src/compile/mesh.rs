@@ -156,6 +156,8 @@ pub struct ObjMesh {
     pub names: Vec<String>,
     /// Per triangle (parallel to `triangles`): the names of the face it came from.
     pub triangle_names: Vec<FaceNames>,
+    /// The material libraries the file names (`mtllib`), as written, in order.
+    pub mtllibs: Vec<String>,
 }
 
 /// The names an OBJ face is under, as indices into [`ObjMesh::names`].
@@ -191,6 +193,12 @@ pub(super) struct MeshCache {
 impl MeshCache {
     pub fn len(&self) -> usize {
         self.meshes.len()
+    }
+
+    /// Adds a mesh read elsewhere (a glTF primitive) under `key`, which `Mesh` nodes made by the
+    /// import name as their file.
+    pub fn insert(&mut self, key: PathBuf, mesh: ObjMesh) {
+        self.meshes.insert(key, Rc::new(mesh));
     }
 
     /// Loads `path` (or returns the cached copy); the error is a user-facing sentence. The flag
@@ -230,7 +238,7 @@ fn wrong_kind_help(format: MeshFormat) -> &'static str {
     match format {
         MeshFormat::Obj | MeshFormat::Ply => "a `Mesh` node reads OBJ and PLY files",
         MeshFormat::Gltf | MeshFormat::Glb => {
-            "a `Mesh` node reads OBJ and PLY files; caustic does not read glTF yet: export an OBJ"
+            "a `Mesh` node reads OBJ and PLY files; a glTF file is a scene: import it with a `Gltf(file: …)` node"
         }
         MeshFormat::Stl => {
             "a `Mesh` node reads OBJ and PLY files: convert it (e.g. Blender's import STL, export PLY)"
@@ -255,7 +263,7 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ObjMesh, ObjError> {
     })?;
     let text = normalise_line_endings(text);
     let mut mesh = ObjMesh::default();
-    let faces = check_obj_text(&text, &mut mesh.names, path)?;
+    let faces = check_obj_text(&text, &mut mesh.names, &mut mesh.mtllibs, path)?;
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
@@ -405,6 +413,7 @@ fn normalise_line_endings(text: &str) -> std::borrow::Cow<'_, str> {
 fn check_obj_text(
     text: &str,
     names: &mut Vec<String>,
+    mtllibs: &mut Vec<String>,
     path: &Path,
 ) -> Result<Vec<FaceRecord>, ObjError> {
     let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
@@ -437,6 +446,7 @@ fn check_obj_text(
         match words.next() {
             Some("g" | "o") => current.group = intern(rest()),
             Some("usemtl") => current.usemtl = intern(rest()),
+            Some("mtllib") => mtllibs.extend(rest().split_whitespace().map(str::to_string)),
             Some(kind @ ("v" | "vt" | "vn")) => {
                 let need = if kind == "vt" { 1 } else { 3 };
                 let nums: Vec<&str> = words.collect();

@@ -2,10 +2,13 @@
 //! flat [`RenderScene`] (world-space primitives, resolved indices, BVH), keeping only what the
 //! scene uses.
 
+pub mod gltf;
+mod gltf_node;
 pub mod lights;
 mod materials;
 pub mod mesh;
 pub mod mesh_file;
+pub mod mtl;
 mod nodes;
 pub mod ply;
 pub mod polygon;
@@ -94,6 +97,8 @@ pub fn compile(
         warnings: &mut stats.warnings,
         degenerate: 0,
         emitters: Vec::new(),
+        camera: None,
+        imported_lights: Vec::new(),
     };
     for (i, node) in scene.nodes.iter().enumerate() {
         flattener.node(&format!("nodes[{i}]"), node, glam::DAffine3::IDENTITY);
@@ -101,16 +106,24 @@ pub fn compile(
     stats.degenerate_triangles = flattener.degenerate;
     stats.meshes_loaded = flattener.meshes.len();
     let emitters = std::mem::take(&mut flattener.emitters);
+    // A glTF import's camera (chosen by name) and punctual lights join the scene's.
+    let camera_spec = flattener
+        .camera
+        .take()
+        .unwrap_or_else(|| scene.camera.clone());
+    let all_lights: Vec<LightSpec> = (scene.lights.iter().cloned())
+        .chain(std::mem::take(&mut flattener.imported_lights))
+        .collect();
     if !errors.is_empty() {
         return Err(errors);
     }
-    let eye = scene.camera.view().0.into();
+    let eye = camera_spec.view().0.into();
     let lights::Compiled {
         lights,
         infinite_lights,
         infinity,
     } = lights::compile_lights(
-        &scene.lights,
+        &all_lights,
         &emitters,
         lights::Targets {
             builder: &mut builder,
@@ -152,7 +165,7 @@ pub fn compile(
             (kind, Some(why))
         }
     };
-    let mut photons = photon_params(&scene.photons, &scene.lights);
+    let mut photons = photon_params(&scene.photons, &all_lights);
     if let Some(p) = default_estimator.and_then(|d| d.photons) {
         // The default estimator's own per-pass budget (the scene's counts are per render).
         photons.caustic = p.caustic;
@@ -181,7 +194,7 @@ pub fn compile(
     let mut params = params;
     // Emissive shapes have no budget of their own: they share `photons.caustic` by power.
     params.photons.caustic_per_light.resize(lights.len(), None);
-    let (eye, look_at, up, fov_y) = scene.camera.view();
+    let (eye, look_at, up, fov_y) = camera_spec.view();
     let camera = Camera::pinhole(
         eye.into(),
         look_at.into(),
@@ -189,7 +202,7 @@ pub fn compile(
         fov_y,
         r.width as f32 / r.height as f32,
     );
-    let camera = match scene.camera.lens() {
+    let camera = match camera_spec.lens() {
         Some((radius, focus_distance)) => camera.with_thin_lens(radius, focus_distance),
         None => camera,
     };

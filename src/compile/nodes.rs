@@ -28,6 +28,10 @@ pub(super) struct Flattener<'a> {
     pub degenerate: usize,
     /// The emissive shapes found, in tree order, for `compile::lights` to make lights of.
     pub emitters: Vec<super::lights::NodeEmitter>,
+    /// The camera a `Gltf` node chose (`camera: "name"`), replacing the scene's.
+    pub camera: Option<crate::scene::schema::CameraSpec>,
+    /// Punctual lights of `Gltf` nodes, in world space, after the scene's `lights`.
+    pub imported_lights: Vec<crate::scene::schema::LightSpec>,
 }
 
 /// The affine map of a transform list: the first step is applied first.
@@ -54,9 +58,11 @@ impl Flattener<'_> {
                 .resolve(self.scene, self.base_dir, m, self.errors)
         });
         let object = self.objects.len() as u32;
-        // A mesh with per-group materials makes its objects once its file is read.
-        let per_group = node.group_materials().is_some_and(|m| !m.is_empty());
-        if !matches!(node, NodeSpec::Group { .. }) && !per_group {
+        // A mesh with per-group materials (or its .mtl's) makes its objects once its file is
+        // read; a glTF import makes its own nodes.
+        let mtl = matches!(node, NodeSpec::Mesh { mtl: true, .. });
+        let per_group = node.group_materials().is_some_and(|m| !m.is_empty()) || mtl;
+        if !matches!(node, NodeSpec::Group { .. } | NodeSpec::Gltf { .. }) && !per_group {
             let name = node.name().map_or_else(|| path.to_string(), str::to_string);
             self.objects.push(ObjectInfo {
                 name,
@@ -92,6 +98,22 @@ impl Flattener<'_> {
                     * DAffine3::from_scale(DVec3::new(f64::from(size[0]), f64::from(size[1]), 1.0));
                 self.quad(&m, QUAD_FACE, object);
             }
+            NodeSpec::Gltf {
+                file,
+                materials,
+                camera,
+                lights,
+                ..
+            } => self.gltf_node(
+                path,
+                &super::gltf_node::GltfNode {
+                    file,
+                    materials,
+                    camera: camera.as_deref(),
+                    lights: *lights,
+                },
+                xf,
+            ),
             NodeSpec::Mesh {
                 file,
                 smooth,
@@ -110,14 +132,21 @@ impl Flattener<'_> {
                                 )
                             }));
                         }
-                        if per_group {
+                        let from_mtl = if mtl {
+                            self.mtl_materials(path, &full, &mesh, materials)
+                        } else {
+                            None
+                        };
+                        if mtl && from_mtl.is_none() {
+                            // The error is pushed; no objects without materials.
+                        } else if per_group {
                             let node_name =
                                 node.name().map_or_else(|| path.to_string(), str::to_string);
                             let group_objects = GroupObjects {
                                 path,
                                 node_name: &node_name,
                                 file: &full,
-                                materials,
+                                materials: from_mtl.as_ref().unwrap_or(materials),
                                 default: mesh_material,
                             };
                             if let Some(objects) = self.group_objects(&group_objects, &mesh) {
@@ -388,7 +417,7 @@ impl Flattener<'_> {
 }
 
 /// What [`Flattener::group_objects`] needs from a `Mesh` node with `materials`.
-struct GroupObjects<'a> {
+pub(super) struct GroupObjects<'a> {
     /// The node's field path.
     path: &'a str,
     /// The node's name (or path), for the objects' names.

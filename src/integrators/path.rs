@@ -340,8 +340,8 @@ impl<'a> PathTracer<'a> {
                 {
                     let u = cx.sampler.get_2d(u_point);
                     let scatter = may_scatter && !read_global;
-                    // Where the diffuse depth ends, direct light is Whitted's: through glass too.
-                    let through = (!may_scatter).then_some((v, medium));
+                    // At diffuse depth 0 direct light is Whitted's: through glass too.
+                    let through = (params.diffuse_depth == 0).then_some((v, medium));
                     let c = self.direct(sp, &at, index, pmf, u, scatter, through, cx, node);
                     l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
                 }
@@ -502,11 +502,12 @@ impl PathTracer<'_> {
     /// Next-event estimation at `sp` towards light `index` (chosen with probability `pmf`):
     /// the radiance it sends through the non-delta part of the BSDF, MIS-weighted against BSDF
     /// sampling when the path may still scatter diffusely (else the light sample alone stands
-    /// for direct light). `through`: the vertex and the medium its ray travelled in, where the
-    /// diffuse depth ends (no BSDF sample follows, so no light would come through glass):
-    /// there a blocked shadow ray crosses transmitting surfaces in a straight line as
-    /// Whitted's do ([`shadow_transmittance`]), which makes `diffuse_depth: 0` Whitted's
-    /// transport. Logged as a shadow record.
+    /// for direct light). `through`: the vertex and the medium its ray travelled in when
+    /// `diffuse_depth` is 0 (Whitted's transport, as documented): there a blocked shadow ray
+    /// crosses transmitting surfaces in a straight line as Whitted's do
+    /// ([`shadow_transmittance`]). At a deeper diffuse depth's last vertex it stays blocked: a
+    /// straight line through a refracting surface is not a light path (it would add light that
+    /// refraction sends elsewhere). Logged as a shadow record.
     #[allow(clippy::too_many_arguments)]
     fn direct<O: PathObserver>(
         &self,

@@ -31,7 +31,7 @@ pub fn asset_files(scene: &SceneFile, base_dir: &Path) -> BTreeSet<PathBuf> {
     while let Some(node) = stack.pop() {
         match node {
             NodeSpec::Group { children, .. } => stack.extend(children),
-            NodeSpec::Mesh { file, .. } => {
+            NodeSpec::Mesh { file, .. } | NodeSpec::Gltf { file, .. } => {
                 files.insert(base_dir.join(file));
             }
             NodeSpec::Sphere { .. } | NodeSpec::Cube { .. } | NodeSpec::Quad { .. } => {}

@@ -115,6 +115,40 @@ pub enum NodeSpec {
         /// Light every face emits, making the mesh an area light without a material.
         #[serde(default)]
         emission: Option<EmissionSpec>,
+        /// Take the materials of the OBJ file's `usemtl` names from its `.mtl` library
+        /// (`mtllib`): `Kd`, `Ks`/`Ns`, `d`, `Ni` and `map_Kd` (docs/import.md). A name that
+        /// `materials` maps keeps the scene's material.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        mtl: bool,
+    },
+    /// A glTF 2.0 scene (`.gltf` with its buffers and images, or `.glb`) imported as a
+    /// subtree: every triangle primitive of its default scene under the file's node
+    /// transforms, its materials mapped onto caustic's (emissive ones as area lights), and its
+    /// `KHR_lights_punctual` lights; docs/import.md says what maps to what.
+    Gltf {
+        /// Optional name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Transform steps, applied after the file's own node transforms.
+        #[serde(default)]
+        transform: Vec<TransformStep>,
+        /// The `.gltf` or `.glb` file, relative to the scene file.
+        file: String,
+        /// Scene materials replacing the file's, by the file's material name
+        /// (`{"Glass": "my_glass"}`). A key the file does not use is an error.
+        #[serde(
+            default,
+            skip_serializing_if = "BTreeMap::is_empty",
+            deserialize_with = "unique_keys"
+        )]
+        materials: BTreeMap<String, String>,
+        /// Render from the file's perspective camera of this name (the camera's or its node's)
+        /// instead of the scene's `camera`.
+        #[serde(default)]
+        camera: Option<String>,
+        /// Import the file's `KHR_lights_punctual` lights (point, spot, directional).
+        #[serde(default = "yes")]
+        lights: bool,
     },
 }
 
@@ -143,6 +177,7 @@ impl NodeSpec {
             NodeSpec::Cube { .. } => "Cube",
             NodeSpec::Quad { .. } => "Quad",
             NodeSpec::Mesh { .. } => "Mesh",
+            NodeSpec::Gltf { .. } => "Gltf",
         }
     }
 
@@ -154,7 +189,8 @@ impl NodeSpec {
             | NodeSpec::Sphere { transform, .. }
             | NodeSpec::Cube { transform, .. }
             | NodeSpec::Quad { transform, .. }
-            | NodeSpec::Mesh { transform, .. } => transform,
+            | NodeSpec::Mesh { transform, .. }
+            | NodeSpec::Gltf { transform, .. } => transform,
         }
     }
 
@@ -166,16 +202,17 @@ impl NodeSpec {
             | NodeSpec::Sphere { name, .. }
             | NodeSpec::Cube { name, .. }
             | NodeSpec::Quad { name, .. }
-            | NodeSpec::Mesh { name, .. } => name.as_deref(),
+            | NodeSpec::Mesh { name, .. }
+            | NodeSpec::Gltf { name, .. } => name.as_deref(),
         }
     }
 
-    /// The material a leaf node references (None for groups, emissive shapes, and a mesh that
-    /// gives only `materials`).
+    /// The material a leaf node references (None for groups, emissive shapes, a mesh that
+    /// gives only `materials`, and glTF imports).
     #[must_use]
     pub fn material(&self) -> Option<&str> {
         match self {
-            NodeSpec::Group { .. } => None,
+            NodeSpec::Group { .. } | NodeSpec::Gltf { .. } => None,
             NodeSpec::Sphere { material, .. }
             | NodeSpec::Cube { material, .. }
             | NodeSpec::Quad { material, .. }
@@ -183,11 +220,12 @@ impl NodeSpec {
         }
     }
 
-    /// The light a leaf node emits (None for groups and non-emissive shapes).
+    /// The light a leaf node emits (None for groups, non-emissive shapes and glTF imports,
+    /// whose emissive materials make their own).
     #[must_use]
     pub fn emission(&self) -> Option<&EmissionSpec> {
         match self {
-            NodeSpec::Group { .. } => None,
+            NodeSpec::Group { .. } | NodeSpec::Gltf { .. } => None,
             NodeSpec::Sphere { emission, .. }
             | NodeSpec::Cube { emission, .. }
             | NodeSpec::Quad { emission, .. }

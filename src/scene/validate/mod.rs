@@ -196,5 +196,7 @@ fn has_emission(n: &NodeSpec) -> bool {
         | NodeSpec::Cube { .. }
         | NodeSpec::Quad { .. }
         | NodeSpec::Mesh { .. } => n.emission().is_some(),
+        // Its emissive materials and punctual lights are known only once the file is read.
+        NodeSpec::Gltf { .. } => true,
     }
 }

@@ -41,12 +41,51 @@ impl<'a> Validator<'a> {
                     self.positive(&format!("{path}.size[{i}]"), *s, "size");
                 }
             }
+            NodeSpec::Gltf {
+                file,
+                materials,
+                camera,
+                ..
+            } => {
+                for (key, m) in materials {
+                    let at = format!("{path}.materials.{key}");
+                    if key.trim().is_empty() {
+                        self.err(
+                            &at,
+                            "must name a material of the glTF file, found an empty string".into(),
+                        );
+                    }
+                    self.material_ref(&at, m);
+                }
+                if file.trim().is_empty() {
+                    self.err(
+                        &format!("{path}.file"),
+                        "must name a .gltf or .glb file, found an empty string".into(),
+                    );
+                }
+                if camera.as_deref().is_some_and(|c| c.trim().is_empty()) {
+                    self.err(
+                        &format!("{path}.camera"),
+                        "must name a camera of the glTF file, found an empty string".into(),
+                    );
+                }
+            }
             NodeSpec::Mesh {
                 file,
                 material,
                 materials,
+                mtl,
                 ..
             } => {
+                if *mtl && n.emission().is_some() {
+                    self.out.push(
+                        Diagnostic::error(
+                            format!("{path}.mtl"),
+                            "an emissive mesh has no materials: `emission` and `mtl` exclude each other",
+                        )
+                        .with_help("remove `mtl`, or split the emitting faces into their own Mesh node"),
+                    );
+                }
                 for (group, m) in materials {
                     let at = format!("{path}.materials.{group}");
                     if group.trim().is_empty() {
@@ -66,10 +105,10 @@ impl<'a> Validator<'a> {
                         .with_help("split the emitting faces into their own Mesh node"),
                     );
                 }
-                if material.is_none() && materials.is_empty() && n.emission().is_none() {
+                if material.is_none() && materials.is_empty() && !*mtl && n.emission().is_none() {
                     self.out.push(
-                        Diagnostic::error(path, "a mesh needs a `material` (or `materials` for its OBJ groups), found neither")
-                            .with_help("add `material: \"name\"`, or `materials: {\"group\": \"name\", ...}` mapping each OBJ group or `usemtl` name"),
+                        Diagnostic::error(path, "a mesh needs a `material` (or `materials` for its OBJ groups, or `mtl: true` for its .mtl file), found none")
+                            .with_help("add `material: \"name\"`, `materials: {\"group\": \"name\", ...}` mapping each OBJ group or `usemtl` name, or `mtl: true`"),
                     );
                 }
                 if file.trim().is_empty() {
