@@ -43,6 +43,7 @@ mod reported;
 mod reported_photon;
 mod rough_integrators;
 mod rough_textures;
+mod scene_key;
 mod sun_caustic;
 mod textures;
 mod transmission_nee;
