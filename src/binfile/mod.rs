@@ -5,8 +5,10 @@
 
 pub mod atomic;
 pub mod fnv;
+pub mod key;
 pub mod reader;
 
 pub use atomic::{AtomicWrite, parent_dir};
 pub use fnv::{Fnv, fnv1a};
+pub use key::KeyHash;
 pub use reader::{Reader, Truncated};

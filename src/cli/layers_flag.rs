@@ -9,7 +9,7 @@ use caustic::Error;
 use caustic::render::output::{OutputFormat, check_writable};
 use caustic::render::{Layer, layer_path, picture_layers};
 
-use super::render::same_file;
+use super::same_file::same_file;
 
 /// The layers of every `--layers` flag, in order, each once.
 pub(super) fn listed(flags: &[Vec<Layer>]) -> Vec<Layer> {

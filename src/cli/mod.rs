@@ -18,6 +18,7 @@ mod plot_backend;
 mod plot_csv;
 mod preview;
 mod render;
+mod same_file;
 
 use std::path::PathBuf;
 

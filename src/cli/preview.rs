@@ -27,7 +27,8 @@ use caustic::pipeline::{Prepared, SceneOverrides};
 use caustic::render::output::OutputFormat;
 use caustic::render::{Layer, Region};
 
-use super::render::{BUDGET_SPP_CAP, RenderArgs, default_output, is_part, parse_region, same_file};
+use super::render::{BUDGET_SPP_CAP, RenderArgs, default_output, is_part, parse_region};
+use super::same_file::same_file;
 use state::{Msg, Phase, Shared};
 
 /// Arguments of `caustic preview`: those of `render`, and the port.

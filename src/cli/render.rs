@@ -20,6 +20,7 @@ use caustic::render::tonemap::Display;
 use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, write_with_layers};
 use caustic::render::{LayerExtras, write_with_extras};
 
+use super::same_file::same_file;
 use super::{SceneArgs, count, layers_flag, print_warnings};
 
 /// Samples per pixel a `--time` render may reach when `--spp` is not given.
@@ -242,15 +243,6 @@ impl Interrupt {
     fn raised(&self) -> bool {
         self.cancel.load(Ordering::SeqCst)
     }
-}
-
-/// Whether two paths name the same file (lexically after making them absolute, or the same
-/// existing file).
-pub(super) fn same_file(a: &Path, b: &Path) -> bool {
-    if let (Ok(x), Ok(y)) = (a.canonicalize(), b.canonicalize()) {
-        return x == y;
-    }
-    matches!((std::path::absolute(a), std::path::absolute(b)), (Ok(x), Ok(y)) if x == y)
 }
 
 /// Renders the scene and writes the image (or the mergeable film).

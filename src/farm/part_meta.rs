@@ -6,10 +6,9 @@
 
 use std::ops::Range;
 
-use crate::binfile::fnv1a;
 use crate::render::Region;
 use crate::render_scene::RenderScene;
-use crate::render_scene::hash::photon_key;
+use crate::render_scene::hash::pixel_key;
 
 /// First line of the metadata: the format and its version.
 const HEADER: &str = "caustic-part 1";
@@ -52,26 +51,15 @@ pub struct PartMeta {
     pub seconds: f64,
 }
 
-/// A 64-bit hash of everything in `scene` that decides pixel values: the photon key
-/// (geometry, materials, textures with their texels, lights, photon settings, seed, sampler;
-/// see [`crate::render_scene::hash`]), every render parameter (size, samples per
-/// pixel, depths, integrator, exposure, background, ...), the camera, and the crate version.
-/// FNV-1a over those (accidental mismatches, not adversaries). Two renders with the same hash
-/// and disjoint sample ranges merge into the render of their union.
+/// A 64-bit hash of everything in `scene` that decides pixel values: the scene's pixel key
+/// ([`crate::render_scene::hash::pixel_key`]: geometry, materials, textures with their texels,
+/// lights, every render and photon parameter, the camera and the crate version, derived field by
+/// field from the data). FNV-1a (accidental mismatches, not adversaries). Two renders with the
+/// same hash and disjoint sample ranges merge into the render of their union; the output path
+/// and the thread count are not in it.
 #[must_use]
 pub fn settings_hash(scene: &RenderScene) -> u64 {
-    // Why the default estimator chose the integrator is not a setting: a scene that names the
-    // chosen integrator and photon counts renders the same bytes and hashes the same.
-    let mut params = scene.params.clone();
-    params.default_estimator = None;
-    let text = format!(
-        "{HEADER}\n{}\n{:016x}\n{:?}\n{:?}",
-        env!("CARGO_PKG_VERSION"),
-        photon_key(scene),
-        params,
-        scene.camera
-    );
-    fnv1a(text.as_bytes())
+    pixel_key(scene)
 }
 
 /// `0..4,8..12` (empty: `none`).

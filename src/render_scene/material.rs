@@ -19,9 +19,9 @@ const MIN_FOOTPRINT_COS: f32 = 1e-3;
 
 /// A material as compiled from the scene: the BSDF with constant parameters, the textures
 /// that replace its colour and perturb its shading normal, and the absorption of the medium it
-/// encloses. Its `Debug` text (read by the scene hash) names the absorption only when there is
-/// one, so clear materials hash as they always did.
-#[derive(Clone, Copy, PartialEq)]
+/// encloses. Its scene key is its `KeyHash` impl (`render_scene::hash`), which names every
+/// field.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfaceMaterial {
     /// The BSDF; its `color` is used when `color_texture` is `None`.
     pub bsdf: Bsdf,
@@ -44,27 +44,6 @@ pub struct SurfaceMaterial {
     /// Beer–Lambert absorption inside the object (the side its geometric normal points away
     /// from), applied along path segments inside it ([`super::Medium`]).
     pub absorption: Absorption,
-}
-
-impl std::fmt::Debug for SurfaceMaterial {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let mut d = f.debug_struct("SurfaceMaterial");
-        d.field("bsdf", &self.bsdf)
-            .field("color_texture", &self.color_texture)
-            .field("bump", &self.bump)
-            .field("filtered", &self.filtered);
-        if let Some(t) = self.normal_map {
-            d.field("normal_map", &t);
-        }
-        if let Some(t) = self.roughness_texture {
-            d.field("roughness_texture", &t)
-                .field("conductor", &self.conductor);
-        }
-        if !self.absorption.is_clear() {
-            d.field("absorption", &self.absorption.sigma());
-        }
-        d.finish()
-    }
 }
 
 /// The BSDF and frame at one hit, as seen from the outgoing direction `wo`, with its own copy

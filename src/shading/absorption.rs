@@ -142,6 +142,8 @@ fn attenuate(sigma: f32, d: f32) -> f32 {
     }
 }
 
+crate::key_hash_struct!(Absorption { sigma });
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -18,8 +18,8 @@
 
 use glam::Vec3;
 
-use super::bsdf_at::{BsdfAt, eval_value, lambert_value, non_delta_value};
-use super::coated::{CoatLayer, Coated};
+use super::bxdf::LobeContext;
+use super::coated::{CoatLayer, Coated, CoatedLobe};
 use super::conductor::ConductorFresnel;
 use super::dielectric::Dielectric;
 use super::lambert::Lambert;
@@ -29,7 +29,6 @@ use super::part::{Part, PartUse};
 use super::phong::Phong;
 use super::rough_conductor::RoughConductor;
 use super::rough_dielectric::RoughDielectric;
-use super::scattering::mean;
 pub use super::scattering::{
     BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction,
 };
@@ -48,9 +47,12 @@ pub const NEAR_SPECULAR_ALPHA: f32 = 0.16;
 /// Parts of the mixture (each a weight and its lobes).
 pub(super) const PARTS: usize = 3;
 /// A compiled material's scattering function: a tint (the colour; texture lookups replace it)
-/// and a weighted mixture of lobes. Its `Debug` text is the material's parameters (the scene
-/// hash of `.part` files and photon caches reads it, so it stays as it always was).
-#[derive(Clone, Copy, PartialEq)]
+/// and a weighted mixture of lobes. Evaluating and sampling it is in `bsdf_at.rs`
+/// ([`Bsdf::eval`], [`Bsdf::sample`], [`Bsdf::at`]); its scene key is its [`KeyHash`] impl
+/// (`Debug` is for messages only).
+///
+/// [`KeyHash`]: crate::binfile::KeyHash
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Bsdf {
     /// Diffuse albedo; also tints the mirror and transmitted light.
     tint: Vec3,
@@ -60,7 +62,7 @@ pub struct Bsdf {
     /// ([`Bsdf::with_parts`]), so that per-vertex queries test flags instead of walking lobes.
     uses: [PartUse; PARTS],
     /// Only the diffuse part has weight and its only lobe with a value is Lambert (Phong, if
-    /// present, is black): the common matte material, which [`BsdfAt`] evaluates, samples and
+    /// present, is black): the common matte material, which [`super::BsdfAt`] evaluates, samples and
     /// asks densities of without walking the mixture. Derived with `uses`.
     lambert: bool,
     /// The union of the flags of the parts of non-zero weight ([`Bsdf::flags`]), derived with
@@ -76,47 +78,6 @@ pub struct Bsdf {
     /// or a microfacet lobe and at least one is a microfacet lobe (`None` otherwise), derived
     /// likewise ([`Bsdf::is_near_specular`]).
     glossy_alpha: Option<f32>,
-}
-
-impl std::fmt::Debug for Bsdf {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let lobes = || self.parts.iter().flat_map(Part::lobes);
-        let (specular, shininess) = lobes()
-            .find_map(|l| match l {
-                Lobe::Phong(p) => Some((p.specular, p.exponent)),
-                _ => None,
-            })
-            .unwrap_or((Vec3::ZERO, 1.0));
-        let ior = lobes().find_map(Lobe::ior).unwrap_or(1.0);
-        let [diffuse, reflect, transmit] = self.weights();
-        let mut d = f.debug_struct("Bsdf");
-        d.field("color", &self.tint)
-            .field("specular", &specular)
-            .field("shininess", &shininess)
-            .field("diffuse", &diffuse)
-            .field("reflect", &reflect)
-            .field("transmit", &transmit)
-            .field("ior", &ior);
-        // Only materials that use the microfacet lobes or a conductor say so, so the text (and
-        // the scene hash) of every other material is what it always was.
-        if let Some(g) = self.distribution() {
-            d.field("roughness_alpha", &(g.alpha_x, g.alpha_y));
-        }
-        if let Some(c) = lobes().find_map(|l| match l {
-            Lobe::SpecularConductor(s) => Some(s.fresnel),
-            Lobe::RoughConductor {
-                lobe,
-                tinted: false,
-            } => Some(lobe.fresnel),
-            _ => None,
-        }) {
-            d.field("conductor", &c);
-        }
-        if let Some(c) = self.coat() {
-            d.field("coat_ior", &c.ior);
-        }
-        d.finish()
-    }
 }
 
 /// The specular (delta) directions leaving a surface point and their weights, given as radiance
@@ -216,13 +177,11 @@ impl Bsdf {
         let mirror = match (distribution, conductor) {
             (None, None) => None,
             (None, Some(fresnel)) => Some(Lobe::SpecularConductor(SpecularConductor { fresnel })),
-            (Some(g), c) => Some(Lobe::RoughConductor {
-                lobe: RoughConductor {
-                    distribution: g,
-                    fresnel: c.unwrap_or(ConductorFresnel::schlick(Vec3::ONE)),
-                },
+            (Some(g), c) => Some(Lobe::RoughConductor(RoughConductor {
+                distribution: g,
+                fresnel: c.unwrap_or(ConductorFresnel::schlick(Vec3::ONE)),
                 tinted: c.is_none(),
-            }),
+            })),
         };
         // A part of weight 0 is never chosen: leave it as it is, so that a BSDF without a
         // mirror part equals itself with or without microfacets.
@@ -259,18 +218,18 @@ impl Bsdf {
         let mut parts = self.parts;
         parts[0] = Part::new(
             1.0,
-            Lobe::Coated {
+            Lobe::Coated(CoatedLobe {
                 coat,
                 layer: CoatLayer::Base,
-            },
+            }),
             None,
         );
         parts[1] = Part::new(
             1.0,
-            Lobe::Coated {
+            Lobe::Coated(CoatedLobe {
                 coat,
                 layer: CoatLayer::Coat,
-            },
+            }),
             None,
         );
         parts[2].weight = 0.0;
@@ -283,10 +242,8 @@ impl Bsdf {
         self.parts
             .iter()
             .flat_map(Part::lobes)
-            .find_map(|l| match l {
-                Lobe::Coated { coat, .. } => Some(*coat),
-                _ => None,
-            })
+            .find_map(Lobe::coat)
+            .map(|c| c.coat)
     }
 
     /// The microfacet distribution of the rough parts, if any.
@@ -295,11 +252,7 @@ impl Bsdf {
         self.parts
             .iter()
             .flat_map(Part::lobes)
-            .find_map(|l| match l {
-                Lobe::RoughConductor { lobe, .. } => Some(lobe.distribution),
-                Lobe::RoughDielectric(d) => Some(d.distribution),
-                _ => None,
-            })
+            .find_map(Lobe::distribution)
     }
 
     /// The tint: the diffuse albedo, which also tints the mirror and the transmitted light.
@@ -409,51 +362,10 @@ impl Bsdf {
             .find_map(Lobe::ior)
     }
 
-    /// The non-delta part `f(wo, wi)` (per steradian) with `n` the shading normal on the side of
-    /// `wo`: each non-delta part's weight times the sum of its lobes (here
-    /// `diffuse · (ρ/π + k_s (m+2)/(2π) max(0, r·wi)^m)`, `r` the mirror of `wo`). Zero when
-    /// `wi` is below `n`. Symmetric in `wo` and `wi` (reciprocal).
-    ///
-    /// The frame is taken as `ns = ng = n` seen from outside, in radiance mode; [`Bsdf::eval`]
-    /// is the full form.
-    #[inline]
-    #[must_use]
-    pub fn f(&self, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
-        let fr = ShadingFrame {
-            ns: n,
-            ng: n,
-            entering: true,
-        };
-        non_delta_value(
-            &self.parts,
-            &self.uses,
-            self.tint,
-            wo,
-            wi,
-            &fr,
-            TransportMode::Radiance,
-        )
-    }
-
     /// True if a part of non-zero weight transmits through a non-delta lobe.
     #[inline]
-    fn transmits_glossy(&self) -> bool {
+    pub(super) fn transmits_glossy(&self) -> bool {
         self.uses.iter().any(|u| u.transmits_glossy)
-    }
-
-    /// The non-delta BSDF value in frame `fr`, for `wi` above both the shading and the geometric
-    /// surface (else 0: no light through a surface whose shading normal leans towards it). In
-    /// importance mode it includes [`shading_normal_correction`], so `eval · |ns·wi|` is the
-    /// flux throughput of a light path in either mode.
-    #[inline]
-    #[must_use]
-    pub fn eval(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, mode: TransportMode) -> Vec3 {
-        if self.lambert && mean(self.tint).is_finite() {
-            // The matte-Lambert arithmetic [`BsdfAt`] takes (the same numbers).
-            return lambert_value(self, wo, wi, fr, mode);
-        }
-        let any = self.transmits_glossy();
-        eval_value(&self.parts, &self.uses, any, self.tint, wo, wi, fr, mode)
     }
 
     /// Whether [`Bsdf::sample`]'s lobe number `u_lobe` can change its result: false for a
@@ -478,54 +390,19 @@ impl Bsdf {
         }
     }
 
-    /// Solid-angle density with which [`Bsdf::sample`] returns the non-delta direction `wi`
-    /// (0 below the shading or geometric surface, where `sample` returns nothing). Delta lobes
-    /// have no density; their discrete probabilities are in the samples themselves.
-    #[must_use]
-    pub fn pdf(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
-        self.at(wo, fr).pdf(wi)
-    }
-
-    /// Samples a direction for a path arriving from `wo`: a part chosen with `u_lobe` (the
-    /// diffuse part, the mirror or the dielectric, in proportion to their weights times their
-    /// mean albedo; inside the dielectric, reflection or refraction in proportion to F and
-    /// (1 − F)·ρ), then a direction from `u` (cosine-weighted for Lambert, Phong's
-    /// `cos^m` lobe around the mirror direction). `None` when the BSDF is black or the sampled
-    /// direction is below the surface (that probability mass is lost, not renormalised).
-    #[must_use]
-    pub fn sample(
-        &self,
-        wo: Vec3,
-        u_lobe: f32,
-        u: (f32, f32),
-        fr: &ShadingFrame,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
-        self.at(wo, fr).sample(u_lobe, u, mode)
-    }
-
-    /// The BSDF prepared for outgoing direction `wo` in frame `fr` ([`BsdfAt`]): what a path
-    /// vertex asks for its light sample's value and density and for its next direction, with
-    /// the mixture worked out once.
-    #[inline]
-    #[must_use]
-    pub fn at(&self, wo: Vec3, fr: &ShadingFrame) -> BsdfAt<'_> {
-        BsdfAt::new(self, wo, fr)
-    }
-
-    /// The mixture's parts, for [`BsdfAt`].
+    /// The mixture's parts, for [`super::BsdfAt`].
     #[inline]
     pub(super) fn parts(&self) -> &[Part; PARTS] {
         &self.parts
     }
 
-    /// What each part takes part in, for [`BsdfAt`].
+    /// What each part takes part in, for [`super::BsdfAt`].
     #[inline]
     pub(super) fn uses(&self) -> &[PartUse; PARTS] {
         &self.uses
     }
 
-    /// Whether the BSDF is a matte Lambert material alone (see the field), for [`BsdfAt`].
+    /// Whether the BSDF is a matte Lambert material alone (see the field), for [`super::BsdfAt`].
     #[inline]
     pub(super) fn is_lambert(&self) -> bool {
         self.lambert
@@ -566,6 +443,11 @@ impl Bsdf {
             ng,
             entering,
         };
+        let ctx = LobeContext {
+            wo,
+            fr: &fr,
+            tint: self.tint,
+        };
         let mut lobes = DeltaLobes {
             reflect_dir: mirror_above(wo, n, ng),
             reflect_weight: Vec3::ZERO,
@@ -577,7 +459,7 @@ impl Bsdf {
                 continue;
             }
             for lobe in part.lobes() {
-                let d = lobe.delta_weights(wo, &fr, part.weight, self.tint);
+                let d = lobe.delta_weights(&ctx, part.weight);
                 lobes.reflect_weight += d.reflect;
                 if let Some((dir, w, eta_scale)) = d.refract {
                     lobes.refract = Some((dir, w));
@@ -629,18 +511,35 @@ fn glossy_alpha(parts: &[Part; PARTS]) -> Option<f32> {
         .filter(|p| p.weight > 0.0)
         .flat_map(Part::lobes)
     {
-        let g = match lobe {
-            Lobe::RoughConductor { lobe, .. } => lobe.distribution,
-            Lobe::RoughDielectric(d) => d.distribution,
-            Lobe::SpecularReflection(_) | Lobe::SpecularConductor(_) | Lobe::Dielectric(_) => {
+        let Some(g) = lobe.distribution() else {
+            if lobe.flags().is_delta() {
                 continue;
             }
-            Lobe::Lambert(_) | Lobe::Phong(_) | Lobe::Coated { .. } => return None,
+            return None;
         };
         let a = g.alpha_x.max(g.alpha_y);
         widest = Some(widest.map_or(a, |w| w.max(a)));
     }
     widest
+}
+
+impl crate::binfile::KeyHash for Bsdf {
+    /// The tint and the parts; the other fields are derived from those two.
+    fn key_hash(&self, h: &mut crate::binfile::Fnv) {
+        let Self {
+            tint,
+            parts,
+            uses: _,
+            lambert: _,
+            flags: _,
+            choice_matters: _,
+            diffuse_only: _,
+            glossy_alpha: _,
+        } = self;
+        h.str("Bsdf");
+        tint.key_hash(h);
+        parts.key_hash(h);
+    }
 }
 
 #[cfg(test)]

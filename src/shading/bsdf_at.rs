@@ -9,8 +9,8 @@
 use glam::Vec3;
 
 use super::bsdf::{Bsdf, PARTS};
+use super::bxdf::{LobeContext, LobeDraw, LobeSample, Prepared};
 use super::lambert::Lambert;
-use super::lobe::Prepared;
 use super::part::{LOBES_PER_PART, Part, PartUse};
 use super::scattering::{BsdfSample, ShadingFrame, TransportMode, mean, shading_normal_correction};
 
@@ -70,6 +70,7 @@ pub(super) fn non_delta_value(
     mode: TransportMode,
 ) -> Vec3 {
     let below = fr.ng.dot(wi) <= 0.0;
+    let ctx = LobeContext { wo, fr, tint };
     let mut f = Vec3::ZERO;
     for (part, use_) in parts.iter().zip(uses) {
         if !use_.local || (below && !use_.transmits_glossy) {
@@ -77,7 +78,7 @@ pub(super) fn non_delta_value(
         }
         let mut fp = Vec3::ZERO;
         for lobe in part.lobes() {
-            fp += lobe.f(wo, wi, fr, mode, tint);
+            fp += lobe.f(&ctx, wi, mode);
         }
         f += fp * part.weight;
     }
@@ -99,7 +100,7 @@ pub(super) fn lambert_value(
     }
     // The mixture's sum, `0 + (0 + f_Lambert [+ 0 from black Phong]) · weight`, kept
     // literally so that signed zeros come out as they do there.
-    let lambert = Lambert.f(bsdf.color(), wi, fr.ns);
+    let lambert = Lambert::value(bsdf.color(), wi, fr.ns);
     let f = Vec3::ZERO + (Vec3::ZERO + lambert) * bsdf.parts()[0].weight;
     match mode {
         TransportMode::Radiance => f,
@@ -127,6 +128,95 @@ pub(super) fn eval_value(
     match mode {
         TransportMode::Radiance => f,
         TransportMode::Importance => f * shading_normal_correction(wo, wi, fr),
+    }
+}
+
+/// The mixture's evaluation and sampling, asked of the BSDF directly (each prepares it for the
+/// one query) or prepared once per outgoing direction ([`Bsdf::at`]).
+impl Bsdf {
+    /// The non-delta part `f(wo, wi)` (per steradian) with `n` the shading normal on the side of
+    /// `wo`: each non-delta part's weight times the sum of its lobes (here
+    /// `diffuse · (ρ/π + k_s (m+2)/(2π) max(0, r·wi)^m)`, `r` the mirror of `wo`). Zero when
+    /// `wi` is below `n`. Symmetric in `wo` and `wi` (reciprocal).
+    ///
+    /// The frame is taken as `ns = ng = n` seen from outside, in radiance mode; [`Bsdf::eval`]
+    /// is the full form.
+    #[inline]
+    #[must_use]
+    pub fn f(&self, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
+        let fr = ShadingFrame {
+            ns: n,
+            ng: n,
+            entering: true,
+        };
+        non_delta_value(
+            self.parts(),
+            self.uses(),
+            self.color(),
+            wo,
+            wi,
+            &fr,
+            TransportMode::Radiance,
+        )
+    }
+
+    /// The non-delta BSDF value in frame `fr`, for `wi` above both the shading and the geometric
+    /// surface (else 0: no light through a surface whose shading normal leans towards it). In
+    /// importance mode it includes [`shading_normal_correction`], so `eval · |ns·wi|` is the
+    /// flux throughput of a light path in either mode.
+    #[inline]
+    #[must_use]
+    pub fn eval(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, mode: TransportMode) -> Vec3 {
+        if self.is_lambert() && mean(self.color()).is_finite() {
+            // The matte-Lambert arithmetic [`BsdfAt`] takes (the same numbers).
+            return lambert_value(self, wo, wi, fr, mode);
+        }
+        let any = self.transmits_glossy();
+        eval_value(
+            self.parts(),
+            self.uses(),
+            any,
+            self.color(),
+            wo,
+            wi,
+            fr,
+            mode,
+        )
+    }
+
+    /// Solid-angle density with which [`Bsdf::sample`] returns the non-delta direction `wi`
+    /// (0 below the shading or geometric surface, where `sample` returns nothing). Delta lobes
+    /// have no density; their discrete probabilities are in the samples themselves.
+    #[must_use]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
+        self.at(wo, fr).pdf(wi)
+    }
+
+    /// Samples a direction for a path arriving from `wo`: a part chosen with `u_lobe` (the
+    /// diffuse part, the mirror or the dielectric, in proportion to their weights times their
+    /// mean albedo; inside the dielectric, reflection or refraction in proportion to F and
+    /// (1 − F)·ρ), then a direction from `u` (cosine-weighted for Lambert, Phong's
+    /// `cos^m` lobe around the mirror direction). `None` when the BSDF is black or the sampled
+    /// direction is below the surface (that probability mass is lost, not renormalised).
+    #[must_use]
+    pub fn sample(
+        &self,
+        wo: Vec3,
+        u_lobe: f32,
+        u: (f32, f32),
+        fr: &ShadingFrame,
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
+        self.at(wo, fr).sample(u_lobe, u, mode)
+    }
+
+    /// The BSDF prepared for outgoing direction `wo` in frame `fr` ([`BsdfAt`]): what a path
+    /// vertex asks for its light sample's value and density and for its next direction, with
+    /// the mixture worked out once.
+    #[inline]
+    #[must_use]
+    pub fn at(&self, wo: Vec3, fr: &ShadingFrame) -> BsdfAt<'_> {
+        BsdfAt::new(self, wo, fr)
     }
 }
 
@@ -256,7 +346,7 @@ impl<'b> BsdfAt<'b> {
             return 0.0;
         }
         // The mixture's `0 + p · (0 + share · cos/π)` with Lambert's share 1.
-        0.0 + prob * (0.0 + Lambert.scaled_pdf(1.0, wi, fr))
+        0.0 + prob * (0.0 + Lambert::scaled_density(1.0, wi, fr))
     }
 
     /// The lobe number for [`BsdfAt::sample`] ([`Bsdf::lobe_number`]).
@@ -279,7 +369,7 @@ impl<'b> BsdfAt<'b> {
                 if *p == 0.0 {
                     return None;
                 }
-                let wi = Lambert.sample(u, &self.fr);
+                let wi = Lambert::direction(u, &self.fr);
                 let pdf = self.lambert_pdf(*p, wi);
                 let f = self.lambert_eval(wi, mode);
                 self.weigh(wi, f, pdf, None)
@@ -341,13 +431,18 @@ impl General {
     fn new(bsdf: &Bsdf, wo: Vec3, fr: &ShadingFrame, rho: f32) -> Self {
         let parts = bsdf.parts();
         let uses = *bsdf.uses();
+        let ctx = LobeContext {
+            wo,
+            fr,
+            tint: bsdf.color(),
+        };
         let mut prepared = [Prepared::Nothing; PARTS];
         let mut q = [0.0f32; PARTS];
         let mut sum = 0.0f32;
         for i in 0..PARTS {
             let part = &parts[i];
             if part.weight > 0.0 {
-                prepared[i] = part.prepare(wo, fr);
+                prepared[i] = part.prepare(&ctx);
                 q[i] = part.probability_weight(&prepared[i], rho);
             }
             sum += q[i];
@@ -381,7 +476,11 @@ impl General {
             return 0.0;
         }
         let below = fr.ns.dot(wi) <= 0.0 || fr.ng.dot(wi) <= 0.0;
-        let tint = bsdf.color();
+        let ctx = LobeContext {
+            wo,
+            fr,
+            tint: bsdf.color(),
+        };
         let mut pdf = 0.0f32;
         for (i, part) in bsdf.parts().iter().enumerate() {
             let prob = self.p[i];
@@ -391,7 +490,7 @@ impl General {
             let mut d = 0.0f32;
             for (lobe, &share) in part.lobes().zip(&self.shares[i]) {
                 if share > 0.0 {
-                    d += lobe.scaled_pdf(share, wo, wi, fr, tint);
+                    d += lobe.pdf(&ctx, wi, share);
                 }
             }
             pdf += prob * d;
@@ -414,7 +513,11 @@ impl General {
         mode: TransportMode,
     ) -> Option<(Sampled, Option<f32>)> {
         let parts = bsdf.parts();
-        let (rho, tint) = (self.rho, bsdf.color());
+        let ctx = LobeContext {
+            wo,
+            fr,
+            tint: bsdf.color(),
+        };
         // Walk the parts: the first whose interval holds u_lobe, else (rounding) the last of
         // non-zero weight; `rest` is u_lobe less the probabilities before the part.
         let mut chosen = None;
@@ -436,18 +539,20 @@ impl General {
         // A chosen part has weight, so it is delta exactly when it is not local.
         if !self.uses[i].local {
             let lobe = part.lobes().next()?;
-            let s = lobe.sample_delta(
-                &self.prepared[i],
-                wo,
+            let draw = LobeDraw {
+                prepared: &self.prepared[i],
+                rho: self.rho,
                 v,
-                fr,
+                u,
                 mode,
-                part.weight,
-                self.p[i],
-                tint,
-                rho,
-            )?;
-            return Some((Sampled::Delta(s), None));
+                weight: part.weight,
+                prob: self.p[i],
+            };
+            return match lobe.sample(&ctx, &draw)? {
+                LobeSample::Delta(s) => Some((Sampled::Delta(s), None)),
+                // A delta part's lobe is a delta lobe (parts never mix).
+                LobeSample::Direction(_) => None,
+            };
         }
         // A non-delta part: reuse the lobe number to pick one of its lobes.
         let mut lobe = None;
@@ -467,7 +572,20 @@ impl General {
         } else {
             0.0
         };
-        let wi = lobe.sample_direction(wo, rest, u, fr, tint)?;
+        let draw = LobeDraw {
+            prepared: &self.prepared[i],
+            rho: self.rho,
+            v: rest,
+            u,
+            mode,
+            weight: part.weight,
+            prob: self.p[i],
+        };
+        let wi = match lobe.sample(&ctx, &draw)? {
+            LobeSample::Direction(wi) => wi,
+            // A non-delta part's lobes are non-delta (parts never mix).
+            LobeSample::Delta(_) => return None,
+        };
         let ior = lobe.ior().filter(|_| mode == TransportMode::Radiance);
         Some((Sampled::Direction(wi), ior))
     }

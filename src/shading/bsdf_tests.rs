@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::sampling::Rng;
+use crate::shading::BsdfAt;
 use crate::shading::microfacet::Ggx;
 
 fn diffuse(c: f32) -> Bsdf {

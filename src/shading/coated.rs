@@ -28,6 +28,8 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
+use super::bxdf::{Bxdf, DeltaWeights, LobeContext, LobeDraw, LobeInfo, LobeSample, Prepared};
+use super::lambert::Lambert;
 use super::optics::fresnel_dielectric;
 use super::scattering::{BsdfSample, LobeFlags, ShadingFrame, TransportMode};
 use super::specular_reflection::SpecularReflection;
@@ -39,6 +41,16 @@ pub enum CoatLayer {
     Coat,
     /// The diffuse base seen through the coat (a non-delta lobe).
     Base,
+}
+
+/// One layer of a coated material as a lobe of the mixture: the coat's Fresnel mirror (delta)
+/// or the base seen through it (diffuse); a coated material has one part of each.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoatedLobe {
+    /// The coat and its diffuse reflectances.
+    pub coat: Coated,
+    /// Which layer this lobe is.
+    pub layer: CoatLayer,
 }
 
 /// A smooth clear coat of index `ior` over a Lambertian base whose albedo is the mixture's
@@ -107,7 +119,7 @@ impl Coated {
         fresnel_dielectric(cos, 1.0 / self.ior)
     }
 
-    /// The coat's reflectance at `wo` (what [`super::Lobe::prepare`] keeps for both layers).
+    /// The coat's reflectance at `wo` (what [`Bxdf::prepare`] keeps for both layers).
     #[inline]
     #[must_use]
     pub fn fresnel_at(&self, wo: Vec3, fr: &ShadingFrame) -> f32 {
@@ -151,7 +163,7 @@ impl Coated {
         weight: f32,
         prob: f32,
     ) -> Option<BsdfSample> {
-        SpecularReflection.sample(wo, fr, mode, weight, prob, Vec3::splat(fresnel))
+        SpecularReflection::mirror_sample(wo, fr, mode, weight, prob, Vec3::splat(fresnel))
     }
 
     /// The directional albedo `F(θₒ) + ∫ f_base cos θᵢ dωᵢ` in closed form for incidence
@@ -200,6 +212,125 @@ fn fresnel_f64(cos_i: f64, eta: f64) -> f64 {
     let r_parl = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     let r_perp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     0.5 * (r_parl * r_parl + r_perp * r_perp)
+}
+
+// Every field, the ones `Coated::new` derives from `ior` too.
+crate::key_hash_struct!(Coated {
+    ior,
+    scale,
+    inv_eta2,
+    internal,
+    external
+});
+
+crate::key_hash_struct!(CoatedLobe { coat, layer });
+
+impl Bxdf for CoatedLobe {
+    fn info(&self) -> LobeInfo {
+        // The coat: delta reflection, focusing its mean reflectance `F_dr,ext`; the base: diffuse.
+        let (flags, focusing_fraction) = match self.layer {
+            CoatLayer::Coat => (Coated::COAT_FLAGS, self.coat.external_reflectance()),
+            CoatLayer::Base => (Coated::BASE_FLAGS, 0.0),
+        };
+        LobeInfo {
+            flags,
+            uses_lobe_number: false,
+            focusing_fraction,
+            ior: None,
+            distribution: None,
+        }
+    }
+
+    /// The base's value ([`Coated::base_f`]); 0 for the coat (a delta lobe).
+    #[inline]
+    fn f(&self, ctx: &LobeContext<'_>, wi: Vec3, _mode: TransportMode) -> Vec3 {
+        match self.layer {
+            CoatLayer::Base => self.coat.base_f(ctx.tint, ctx.wo, wi, ctx.fr.ns),
+            CoatLayer::Coat => Vec3::ZERO,
+        }
+    }
+
+    /// The base samples like Lambert; the coat has no density.
+    #[inline]
+    fn pdf(&self, ctx: &LobeContext<'_>, wi: Vec3, share: f32) -> f32 {
+        match self.layer {
+            CoatLayer::Base => Lambert::scaled_density(share, wi, ctx.fr),
+            CoatLayer::Coat => 0.0,
+        }
+    }
+
+    /// The base: a cosine-distributed direction; the coat: its mirror direction of weight
+    /// `F(θₒ) · weight / prob` ([`Coated::sample_coat`]).
+    #[inline]
+    fn sample(&self, ctx: &LobeContext<'_>, draw: &LobeDraw<'_>) -> Option<LobeSample> {
+        let coat = &self.coat;
+        let (wo, fr, mode, weight, prob) = (ctx.wo, ctx.fr, draw.mode, draw.weight, draw.prob);
+        match (self.layer, draw.prepared) {
+            (CoatLayer::Base, _) => Some(LobeSample::Direction(Lambert::direction(draw.u, fr))),
+            (CoatLayer::Coat, Prepared::Reflectance(f)) => coat
+                .sample_coat(*f, wo, fr, mode, weight, prob)
+                .map(LobeSample::Delta),
+            (CoatLayer::Coat, Prepared::Nothing | Prepared::Fresnel(_)) => coat
+                .sample_coat(coat.fresnel_at(wo, fr), wo, fr, mode, weight, prob)
+                .map(LobeSample::Delta),
+        }
+    }
+
+    /// The coat's reflectance at `wo` (both layers).
+    fn prepare(&self, ctx: &LobeContext<'_>) -> Prepared {
+        Prepared::Reflectance(self.coat.fresnel_at(ctx.wo, ctx.fr))
+    }
+
+    /// [`Coated::albedo`] of the layer (0 if unprepared).
+    fn albedo(&self, prepared: &Prepared, rho: f32) -> f32 {
+        match prepared {
+            Prepared::Reflectance(f) => self.coat.albedo(self.layer, *f, rho),
+            Prepared::Nothing | Prepared::Fresnel(_) => 0.0,
+        }
+    }
+
+    /// The coat: `F(θₒ)` times the part's weight along the mirror direction.
+    fn delta_weights(&self, ctx: &LobeContext<'_>, weight: f32) -> DeltaWeights {
+        match self.layer {
+            CoatLayer::Coat => DeltaWeights {
+                reflect: Vec3::splat(self.coat.fresnel_at(ctx.wo, ctx.fr) * weight),
+                refract: None,
+            },
+            CoatLayer::Base => DeltaWeights::NONE,
+        }
+    }
+
+    fn straight_transmittance(
+        &self,
+        _weight: f32,
+        _tint: Vec3,
+        _cos: f32,
+        _entering: bool,
+    ) -> Vec3 {
+        Vec3::ZERO
+    }
+
+    fn is_black(&self, tint: Vec3) -> bool {
+        self.layer == CoatLayer::Base && tint == Vec3::ZERO
+    }
+
+    /// The coat has no non-delta value; the base's follows the coat's transmittance
+    /// `1 − F(θᵢ)`.
+    fn is_flat(&self, tint: Vec3) -> bool {
+        match self.layer {
+            CoatLayer::Coat => true,
+            CoatLayer::Base => self.is_black(tint),
+        }
+    }
+}
+
+impl crate::binfile::KeyHash for CoatLayer {
+    fn key_hash(&self, h: &mut crate::binfile::Fnv) {
+        h.str(match self {
+            CoatLayer::Coat => "Coat",
+            CoatLayer::Base => "Base",
+        });
+    }
 }
 
 #[cfg(test)]

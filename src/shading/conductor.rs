@@ -208,6 +208,23 @@ impl ConductorPreset {
     }
 }
 
+impl crate::binfile::KeyHash for ConductorFresnel {
+    fn key_hash(&self, h: &mut crate::binfile::Fnv) {
+        match self {
+            ConductorFresnel::Complex { eta, k } => {
+                h.str("Complex");
+                eta.key_hash(h);
+                k.key_hash(h);
+            }
+            ConductorFresnel::F82Tint { f0, tint } => {
+                h.str("F82Tint");
+                f0.key_hash(h);
+                tint.key_hash(h);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

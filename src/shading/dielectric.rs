@@ -5,7 +5,8 @@
 
 use glam::Vec3;
 
-use super::optics::{fresnel_dielectric, refract};
+use super::bxdf::{Bxdf, DeltaWeights, LobeContext, LobeDraw, LobeInfo, LobeSample, Prepared};
+use super::optics::{FresnelSplit, fresnel_dielectric, refract};
 use super::scattering::{BsdfSample, LobeFlags, ShadingFrame, TransportMode, mode_correction};
 use super::specular_reflection::mirror_above;
 
@@ -16,47 +17,11 @@ pub struct Dielectric {
     pub ior: f32,
 }
 
-/// The dielectric's split at one incidence: Fresnel reflectance (1 when nothing refracts),
-/// refracted direction (if any) and the relative index `eta = ηₒ/ηᵢ` of the crossing.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FresnelSplit {
-    /// Fresnel reflectance at `wo`.
-    pub fresnel: f32,
-    /// The refracted direction, below the geometric surface.
-    pub refracted: Option<Vec3>,
-    /// `ηₒ/ηᵢ` of the crossing.
-    pub eta: f32,
-}
-
-/// What a delta lobe sends along the mirror direction and through the surface (radiance mode;
-/// see [`super::DeltaLobes`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DeltaWeights {
-    /// Weight of the mirror direction.
-    pub reflect: Vec3,
-    /// Refracted direction, its weight, and the (ηₒ/ηᵢ)² included in it.
-    pub refract: Option<(Vec3, Vec3, f32)>,
-}
-
 impl Dielectric {
     /// Delta reflection and transmission.
     pub const FLAGS: LobeFlags = LobeFlags::DELTA
         .union(LobeFlags::REFLECTION)
         .union(LobeFlags::TRANSMISSION);
-
-    /// A delta lobe has no value for any pair of directions: 0.
-    #[inline]
-    #[must_use]
-    pub fn f(&self) -> Vec3 {
-        Vec3::ZERO
-    }
-
-    /// A delta lobe has no solid-angle density: 0.
-    #[inline]
-    #[must_use]
-    pub fn pdf(&self) -> f32 {
-        0.0
-    }
 
     /// The Fresnel split for `wo` in frame `fr`.
     #[inline]
@@ -84,7 +49,7 @@ impl Dielectric {
     /// mean).
     #[inline]
     #[must_use]
-    pub fn albedo(&self, split: &FresnelSplit, rho: f32) -> f32 {
+    pub fn split_albedo(&self, split: &FresnelSplit, rho: f32) -> f32 {
         split.fresnel + (1.0 - split.fresnel) * rho
     }
 
@@ -96,7 +61,7 @@ impl Dielectric {
     #[allow(clippy::too_many_arguments)]
     #[inline]
     #[must_use]
-    pub fn sample(
+    pub fn split_sample(
         &self,
         d: &FresnelSplit,
         wo: Vec3,
@@ -151,7 +116,7 @@ impl Dielectric {
     /// mirror gets `weight · F`, the refraction `tint · weight (1 − F) η²`.
     #[inline]
     #[must_use]
-    pub fn delta_weights(&self, d: &FresnelSplit, weight: f32, tint: Vec3) -> DeltaWeights {
+    pub fn split_weights(&self, d: &FresnelSplit, weight: f32, tint: Vec3) -> DeltaWeights {
         DeltaWeights {
             reflect: Vec3::splat(weight * d.fresnel),
             refract: d.refracted.map(|dir| {
@@ -166,13 +131,7 @@ impl Dielectric {
     /// (1 − F(θ)) · η²`, F taken from the outside at the angle `acos(cos)`.
     #[inline]
     #[must_use]
-    pub fn straight_transmittance(
-        &self,
-        weight: f32,
-        tint: Vec3,
-        cos: f32,
-        entering: bool,
-    ) -> Vec3 {
+    pub fn straight_through(&self, weight: f32, tint: Vec3, cos: f32, entering: bool) -> Vec3 {
         let eta2 = if entering {
             1.0 / (self.ior * self.ior)
         } else {
@@ -191,6 +150,97 @@ fn refract_below(wo: Vec3, n: Vec3, ng: Vec3, eta: f32) -> Option<Vec3> {
         _ => refract(wo, ng, eta).filter(|t| t.dot(ng) < 0.0),
     }
 }
+
+impl Bxdf for Dielectric {
+    fn info(&self) -> LobeInfo {
+        // The lobe number chooses between reflection and refraction.
+        LobeInfo {
+            flags: Self::FLAGS,
+            uses_lobe_number: true,
+            focusing_fraction: 1.0,
+            ior: Some(self.ior),
+            distribution: None,
+        }
+    }
+
+    /// A delta lobe has no value for any pair of directions: 0.
+    #[inline]
+    fn f(&self, _ctx: &LobeContext<'_>, _wi: Vec3, _mode: TransportMode) -> Vec3 {
+        Vec3::ZERO
+    }
+
+    /// A delta lobe has no solid-angle density: 0.
+    #[inline]
+    fn pdf(&self, _ctx: &LobeContext<'_>, _wi: Vec3, share: f32) -> f32 {
+        share * 0.0
+    }
+
+    /// Reflection or refraction by `draw.v` ([`Dielectric::split_sample`]), from the prepared
+    /// split (worked out here if the part was not prepared).
+    #[inline]
+    fn sample(&self, ctx: &LobeContext<'_>, draw: &LobeDraw<'_>) -> Option<LobeSample> {
+        let (wo, fr) = (ctx.wo, ctx.fr);
+        let (v, mode, weight, prob, tint, rho) = (
+            draw.v,
+            draw.mode,
+            draw.weight,
+            draw.prob,
+            ctx.tint,
+            draw.rho,
+        );
+        match draw.prepared {
+            Prepared::Fresnel(split) => {
+                self.split_sample(split, wo, v, fr, mode, weight, prob, tint, rho)
+            }
+            Prepared::Nothing | Prepared::Reflectance(_) => self.split_sample(
+                &self.split(wo, fr),
+                wo,
+                v,
+                fr,
+                mode,
+                weight,
+                prob,
+                tint,
+                rho,
+            ),
+        }
+        .map(LobeSample::Delta)
+    }
+
+    /// The Fresnel split at `wo`.
+    fn prepare(&self, ctx: &LobeContext<'_>) -> Prepared {
+        Prepared::Fresnel(self.split(ctx.wo, ctx.fr))
+    }
+
+    /// `F + (1 − F)·ρ̄` of the prepared split (0 if unprepared).
+    fn albedo(&self, prepared: &Prepared, rho: f32) -> f32 {
+        match prepared {
+            Prepared::Fresnel(s) => self.split_albedo(s, rho),
+            Prepared::Nothing | Prepared::Reflectance(_) => 0.0,
+        }
+    }
+
+    /// Both delta directions ([`Dielectric::split_weights`]).
+    fn delta_weights(&self, ctx: &LobeContext<'_>, weight: f32) -> DeltaWeights {
+        self.split_weights(&self.split(ctx.wo, ctx.fr), weight, ctx.tint)
+    }
+
+    /// [`Dielectric::straight_through`].
+    fn straight_transmittance(&self, weight: f32, tint: Vec3, cos: f32, entering: bool) -> Vec3 {
+        self.straight_through(weight, tint, cos, entering)
+    }
+
+    /// Glass reflects whatever its tint.
+    fn is_black(&self, _tint: Vec3) -> bool {
+        false
+    }
+
+    fn is_flat(&self, _tint: Vec3) -> bool {
+        true
+    }
+}
+
+crate::key_hash_struct!(Dielectric { ior });
 
 #[cfg(test)]
 mod tests {
@@ -224,7 +274,7 @@ mod tests {
                 for _ in 0..n {
                     let v = rng.next_f32();
                     let s = glass
-                        .sample(&d, wo, v, &fr, TransportMode::Radiance, 1.0, 1.0, tint, rho)
+                        .split_sample(&d, wo, v, &fr, TransportMode::Radiance, 1.0, 1.0, tint, rho)
                         .expect("a sample");
                     refracted += u32::from(s.transmitted);
                 }
@@ -261,7 +311,7 @@ mod tests {
             let sum: f32 = (0..n)
                 .filter_map(|i| {
                     let v = (i as f32 + 0.5) / n as f32;
-                    glass.sample(
+                    glass.split_sample(
                         &d,
                         wo,
                         v,
@@ -277,7 +327,13 @@ mod tests {
                 .sum();
             assert!((sum / n as f32 - 1.0).abs() < 1e-3, "{}", sum / n as f32);
         }
-        assert_eq!(glass.f(), Vec3::ZERO);
-        assert_eq!(glass.pdf(), 0.0);
+        let fr = frame(true);
+        let ctx = LobeContext {
+            wo,
+            fr: &fr,
+            tint: Vec3::ONE,
+        };
+        assert_eq!(glass.f(&ctx, -wo, TransportMode::Radiance), Vec3::ZERO);
+        assert_eq!(glass.pdf(&ctx, -wo, 1.0), 0.0);
     }
 }

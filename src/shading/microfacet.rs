@@ -147,6 +147,8 @@ impl Ggx {
     }
 }
 
+crate::key_hash_struct!(Ggx { alpha_x, alpha_y });
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,6 +4,7 @@
 pub mod absorption;
 pub mod bsdf;
 pub mod bsdf_at;
+pub mod bxdf;
 pub mod coated;
 pub mod conductor;
 pub mod dielectric;
@@ -22,6 +23,7 @@ pub mod specular_reflection;
 
 pub use bsdf::{Bsdf, DeltaLobes, NEAR_SPECULAR_ALPHA};
 pub use bsdf_at::BsdfAt;
+pub use bxdf::{Bxdf, LobeContext, LobeDraw, LobeInfo, LobeSample, Prepared};
 pub use lobe::Lobe;
 pub use normals::usable_shading_normal;
 pub use scattering::{

@@ -49,6 +49,18 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     (0.5 * (r_parl * r_parl + r_perp * r_perp)).clamp(0.0, 1.0)
 }
 
+/// The dielectric's split at one incidence: Fresnel reflectance (1 when nothing refracts),
+/// refracted direction (if any) and the relative index `eta = ηₒ/ηᵢ` of the crossing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FresnelSplit {
+    /// Fresnel reflectance at `wo`.
+    pub fresnel: f32,
+    /// The refracted direction, below the geometric surface.
+    pub refracted: Option<Vec3>,
+    /// `ηₒ/ηᵢ` of the crossing.
+    pub eta: f32,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

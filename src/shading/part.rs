@@ -2,10 +2,9 @@
 //! scene's weights (all non-delta, or one delta lobe), and the per-direction numbers the mixture
 //! asks of it (its sampling weight, its lobes' shares).
 
-use glam::Vec3;
-
-use super::lobe::{Lobe, Prepared};
-use super::scattering::{LobeFlags, ShadingFrame};
+use super::bxdf::{LobeContext, Prepared};
+use super::lobe::Lobe;
+use super::scattering::LobeFlags;
 
 /// Most lobes in one part.
 pub(super) const LOBES_PER_PART: usize = 2;
@@ -69,10 +68,10 @@ impl Part {
 
     /// The per-direction state of the part's (first) lobe.
     #[inline]
-    pub(super) fn prepare(&self, wo: Vec3, fr: &ShadingFrame) -> Prepared {
+    pub(super) fn prepare(&self, ctx: &LobeContext<'_>) -> Prepared {
         self.lobes()
             .next()
-            .map_or(Prepared::Nothing, |l| l.prepare(wo, fr))
+            .map_or(Prepared::Nothing, |l| l.prepare(ctx))
     }
 
     /// Each lobe's share of the part: `aⱼ / Σa` (`a` the lobes' sampling weights) for all but
@@ -117,3 +116,5 @@ impl Part {
         self.weight * a
     }
 }
+
+crate::key_hash_struct!(Part { weight, lobes });

@@ -12,15 +12,16 @@
 //! are in docs/material.md). Roughness 0 is not this lobe: a material of roughness 0 is the
 //! perfect mirror ([`super::bsdf`]'s mirror part), bit for bit, which the scene compiler
 //! substitutes. `f` is the same in both transport modes (a reflection has no η² factor); the
-//! adjoint shading-normal correction is applied by [`RoughConductor::sample`] as for every
+//! adjoint shading-normal correction is applied by [`RoughConductor::sample_alone`] as for every
 //! `BsdfSample`, and by the mixture's `eval` for `f`.
 
 use glam::Vec3;
 
+use super::bxdf::{Bxdf, DeltaWeights, LobeContext, LobeDraw, LobeInfo, LobeSample, Prepared};
 use super::conductor::ConductorFresnel;
 use super::microfacet::Ggx;
 use super::optics::reflect;
-use super::{BsdfSample, ShadingFrame, TransportMode, shading_normal_correction};
+use super::{BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction};
 use crate::geometry::Frame;
 
 /// A rough metal: its microfacet distribution and its Fresnel reflectance.
@@ -30,6 +31,9 @@ pub struct RoughConductor {
     pub distribution: Ggx,
     /// Reflectance of one microfacet.
     pub fresnel: ConductorFresnel,
+    /// Multiply by the mixture's tint (a rough mirror without a conductor: its Fresnel is 1 and
+    /// the material's colour is its reflectance, as for the perfect mirror).
+    pub tinted: bool,
 }
 
 impl RoughConductor {
@@ -85,7 +89,7 @@ impl RoughConductor {
     /// mixture picks a lobe.
     #[inline]
     #[must_use]
-    pub fn albedo(&self, wo: Vec3, fr: &ShadingFrame) -> f32 {
+    pub fn mean_reflectance(&self, wo: Vec3, fr: &ShadingFrame) -> f32 {
         let f = self.fresnel.eval(wo.dot(fr.ns).abs());
         (f.x + f.y + f.z) * (1.0 / 3.0)
     }
@@ -97,7 +101,7 @@ impl RoughConductor {
     // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
     #[inline(never)]
     #[must_use]
-    pub fn f(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> Vec3 {
+    pub fn value(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> Vec3 {
         if fr.ng.dot(wi) <= 0.0 {
             return Vec3::ZERO;
         }
@@ -105,12 +109,12 @@ impl RoughConductor {
         self.f_local(frame.to_local(wo), frame.to_local(wi))
     }
 
-    /// The density of [`RoughConductor::sample`] at the world direction `wi` (0 where `f` is 0).
+    /// The density of [`RoughConductor::sample_alone`] at the world direction `wi` (0 where `f` is 0).
     // Out of line: inlined into the BSDF mixture, its frame and half-vector arithmetic was
     // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
     #[inline(never)]
     #[must_use]
-    pub fn pdf(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
+    pub fn density(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame) -> f32 {
         if fr.ng.dot(wi) <= 0.0 {
             return 0.0;
         }
@@ -125,7 +129,7 @@ impl RoughConductor {
     // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
     #[inline(never)]
     #[must_use]
-    pub fn sample_direction(&self, wo: Vec3, u: (f32, f32), fr: &ShadingFrame) -> Option<Vec3> {
+    pub fn direction(&self, wo: Vec3, u: (f32, f32), fr: &ShadingFrame) -> Option<Vec3> {
         let frame = Frame::from_normal(fr.ns);
         let li = self.sample_local(frame.to_local(wo), u)?;
         Some(frame.to_world(li))
@@ -136,7 +140,7 @@ impl RoughConductor {
     /// geometric surface.
     #[inline]
     #[must_use]
-    pub fn sample(
+    pub fn sample_alone(
         &self,
         wo: Vec3,
         u: (f32, f32),
@@ -168,6 +172,84 @@ impl RoughConductor {
         })
     }
 }
+
+impl Bxdf for RoughConductor {
+    fn info(&self) -> LobeInfo {
+        LobeInfo {
+            flags: LobeFlags::GLOSSY.union(LobeFlags::REFLECTION),
+            uses_lobe_number: false,
+            focusing_fraction: 0.0,
+            ior: None,
+            distribution: Some(self.distribution),
+        }
+    }
+
+    /// [`RoughConductor::value`], times the tint if tinted.
+    #[inline]
+    fn f(&self, ctx: &LobeContext<'_>, wi: Vec3, _mode: TransportMode) -> Vec3 {
+        let f = self.value(ctx.wo, wi, ctx.fr);
+        if self.tinted { f * ctx.tint } else { f }
+    }
+
+    #[inline]
+    fn pdf(&self, ctx: &LobeContext<'_>, wi: Vec3, share: f32) -> f32 {
+        share * self.density(ctx.wo, wi, ctx.fr)
+    }
+
+    /// A direction from the visible normals ([`RoughConductor::direction`]).
+    #[inline]
+    fn sample(&self, ctx: &LobeContext<'_>, draw: &LobeDraw<'_>) -> Option<LobeSample> {
+        self.direction(ctx.wo, draw.u, ctx.fr)
+            .map(LobeSample::Direction)
+    }
+
+    /// The mean reflectance at `wo`.
+    fn prepare(&self, ctx: &LobeContext<'_>) -> Prepared {
+        Prepared::Reflectance(self.mean_reflectance(ctx.wo, ctx.fr))
+    }
+
+    /// The prepared mean reflectance, times `rho` if tinted (0 if unprepared).
+    fn albedo(&self, prepared: &Prepared, rho: f32) -> f32 {
+        match prepared {
+            Prepared::Reflectance(r) => {
+                if self.tinted {
+                    r * rho
+                } else {
+                    *r
+                }
+            }
+            Prepared::Nothing | Prepared::Fresnel(_) => 0.0,
+        }
+    }
+
+    fn delta_weights(&self, _ctx: &LobeContext<'_>, _weight: f32) -> DeltaWeights {
+        DeltaWeights::NONE
+    }
+
+    fn straight_transmittance(
+        &self,
+        _weight: f32,
+        _tint: Vec3,
+        _cos: f32,
+        _entering: bool,
+    ) -> Vec3 {
+        Vec3::ZERO
+    }
+
+    fn is_black(&self, tint: Vec3) -> bool {
+        self.tinted && tint == Vec3::ZERO
+    }
+
+    fn is_flat(&self, tint: Vec3) -> bool {
+        self.is_black(tint)
+    }
+}
+
+crate::key_hash_struct!(RoughConductor {
+    distribution,
+    fresnel,
+    tinted
+});
 
 #[cfg(test)]
 #[path = "rough_conductor_tests.rs"]

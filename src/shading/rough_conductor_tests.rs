@@ -24,6 +24,7 @@ fn white(ax: f32, ay: f32) -> RoughConductor {
     RoughConductor {
         distribution: Ggx::new(ax, ay),
         fresnel: ConductorFresnel::schlick(Vec3::ONE),
+        tinted: false,
     }
 }
 
@@ -54,6 +55,7 @@ fn chi2_cases(cases: &[((f32, f32), f32)], seed: u64) {
         let lobe = RoughConductor {
             distribution: Ggx::new(ax, ay),
             fresnel: gold,
+            tinted: false,
         };
         let wo = dir(theta, 30.0);
         let fr = frame_z();
@@ -63,10 +65,10 @@ fn chi2_cases(cases: &[((f32, f32), f32)], seed: u64) {
             seed + k as u64,
             &bins_around(mirror, ax.max(ay)),
             |rng| {
-                lobe.sample(wo, rng.next_2d(), &fr, TransportMode::Radiance)
+                lobe.sample_alone(wo, rng.next_2d(), &fr, TransportMode::Radiance)
                     .map(|s| s.wi)
             },
-            |wi| lobe.pdf(wo, wi, &fr),
+            |wi| lobe.density(wo, wi, &fr),
         );
         eprintln!(
             "rough conductor α ({ax}, {ay}) θo {theta}°: χ² {:.1} / {} dof, p {:.3}, lost {}",
@@ -116,7 +118,7 @@ fn chi2_rejects_the_full_distribution_pdf_and_a_wrong_roughness() {
         lobe.distribution.d(h) * h.z / (4.0 * wo.dot(h))
     };
     let sample = |rng: &mut Rng| {
-        lobe.sample(wo, rng.next_2d(), &fr, TransportMode::Radiance)
+        lobe.sample_alone(wo, rng.next_2d(), &fr, TransportMode::Radiance)
             .map(|s| s.wi)
     };
     let bins = SphereBins::sphere(Vec3::Z, 16, 32);
@@ -134,10 +136,10 @@ fn chi2_rejects_the_full_distribution_pdf_and_a_wrong_roughness() {
         8,
         &bins,
         |rng| {
-            lobe.sample(wo, rng.next_2d(), &fr, TransportMode::Radiance)
+            lobe.sample_alone(wo, rng.next_2d(), &fr, TransportMode::Radiance)
                 .map(|s| s.wi)
         },
-        |wi| other.pdf(wo, wi, &fr),
+        |wi| other.density(wo, wi, &fr),
     );
     eprintln!(
         "wrong pdf (α 0.33 for 0.3): χ² {:.0} / {} dof, p {:e}",
@@ -172,7 +174,7 @@ fn albedo_mc(lobe: &RoughConductor, wo: Vec3, n: u32, seed: u64) -> (f64, f64) {
     let fr = frame_z();
     let (mut s, mut s2) = (0.0f64, 0.0f64);
     for _ in 0..n {
-        if let Some(x) = lobe.sample(wo, rng.next_2d(), &fr, TransportMode::Importance) {
+        if let Some(x) = lobe.sample_alone(wo, rng.next_2d(), &fr, TransportMode::Importance) {
             let w = f64::from(x.weight.x);
             s += w;
             s2 += w * w;
@@ -232,6 +234,7 @@ fn f_is_reciprocal_and_sample_weights_are_consistent() {
     let lobe = RoughConductor {
         distribution: Ggx::new(0.4, 0.15),
         fresnel: ConductorFresnel::preset(ConductorPreset::Copper),
+        tinted: false,
     };
     let fr = frame_z();
     let mut rng = Rng::new(11, 2);
@@ -239,22 +242,22 @@ fn f_is_reciprocal_and_sample_weights_are_consistent() {
         let (a, b) = (rng.next_2d(), rng.next_2d());
         let wo = crate::sampling::warp::cosine_hemisphere(a, Vec3::Z);
         let wi = crate::sampling::warp::cosine_hemisphere(b, Vec3::Z);
-        let (x, y) = (lobe.f(wo, wi, &fr), lobe.f(wi, wo, &fr));
+        let (x, y) = (lobe.value(wo, wi, &fr), lobe.value(wi, wo, &fr));
         assert!(
             (x - y).abs().max_element() <= 1e-5 * x.max_element().max(1.0),
             "{wo} {wi}: {x} vs {y}"
         );
-        if let Some(s) = lobe.sample(wo, rng.next_2d(), &fr, TransportMode::Radiance) {
-            let pdf = lobe.pdf(wo, s.wi, &fr);
+        if let Some(s) = lobe.sample_alone(wo, rng.next_2d(), &fr, TransportMode::Radiance) {
+            let pdf = lobe.density(wo, s.wi, &fr);
             assert!((s.pdf - pdf).abs() <= 1e-4 * pdf, "{} vs {pdf}", s.pdf);
-            let w = lobe.f(wo, s.wi, &fr) * (s.wi.z / pdf);
+            let w = lobe.value(wo, s.wi, &fr) * (s.wi.z / pdf);
             assert!((s.weight - w).abs().max_element() <= 1e-4 * w.max_element().max(1.0));
             assert!(!s.delta && !s.transmitted && s.eta_scale == 1.0);
         }
     }
     // Below the surface nothing.
-    assert_eq!(lobe.f(Vec3::Z, -Vec3::Z, &fr), Vec3::ZERO);
-    assert_eq!(lobe.pdf(Vec3::Z, dir(100.0, 0.0), &fr), 0.0);
+    assert_eq!(lobe.value(Vec3::Z, -Vec3::Z, &fr), Vec3::ZERO);
+    assert_eq!(lobe.density(Vec3::Z, dir(100.0, 0.0), &fr), 0.0);
 }
 
 #[test]
@@ -271,15 +274,15 @@ fn tilted_shading_normals_never_reflect_below_the_geometric_surface() {
         let wo = dir(70.0, 180.0);
         for mode in [TransportMode::Radiance, TransportMode::Importance] {
             for _ in 0..50 {
-                if let Some(s) = lobe.sample(wo, rng.next_2d(), &fr, mode) {
+                if let Some(s) = lobe.sample_alone(wo, rng.next_2d(), &fr, mode) {
                     assert!(s.wi.dot(fr.ng) > 0.0 && s.weight.is_finite());
                 }
             }
         }
         let below = Vec3::new(0.9, 0.0, -0.1).normalize();
-        assert_eq!(lobe.f(wo, below, &fr), Vec3::ZERO);
-        assert_eq!(lobe.pdf(wo, below, &fr), 0.0);
+        assert_eq!(lobe.value(wo, below, &fr), Vec3::ZERO);
+        assert_eq!(lobe.density(wo, below, &fr), 0.0);
     }
     // Mean reflectance at normal incidence of white Schlick: 1.
-    assert_eq!(lobe.albedo(Vec3::Z, &frame_z()), 1.0);
+    assert_eq!(lobe.mean_reflectance(Vec3::Z, &frame_z()), 1.0);
 }

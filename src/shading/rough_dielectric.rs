@@ -23,14 +23,16 @@
 //! Two cases are not this lobe: roughness 0 is the smooth dielectric (the scene compiler
 //! substitutes it, bit for bit); and `ior = 1` (an index-matched surface, whose microfacets bend
 //! nothing) is a pass-through at any roughness: [`RoughDielectric::is_pass_through`], `f` and
-//! `pdf` are 0 and [`RoughDielectric::sample`] returns the delta sample `wi = −wo`, weight
+//! `pdf` are 0 and [`RoughDielectric::sample_alone`] returns the delta sample `wi = −wo`, weight
 //! `tint`.
 
 use glam::Vec3;
 
+use super::bxdf::{Bxdf, DeltaWeights, LobeContext, LobeDraw, LobeInfo, LobeSample, Prepared};
+use super::dielectric::Dielectric;
 use super::microfacet::Ggx;
 use super::optics::{fresnel_dielectric, reflect, refract};
-use super::{BsdfSample, ShadingFrame, TransportMode, shading_normal_correction};
+use super::{BsdfSample, LobeFlags, ShadingFrame, TransportMode, shading_normal_correction};
 use crate::geometry::Frame;
 
 /// A rough dielectric boundary: its microfacet distribution and index of refraction.
@@ -201,7 +203,7 @@ impl RoughDielectric {
     /// (as the smooth dielectric), `rho` the tint's mean; `rho` for a pass-through.
     #[inline]
     #[must_use]
-    pub fn albedo(&self, wo: Vec3, fr: &ShadingFrame, rho: f32) -> f32 {
+    pub fn mean_albedo(&self, wo: Vec3, fr: &ShadingFrame, rho: f32) -> f32 {
         if self.is_pass_through() {
             return rho;
         }
@@ -225,7 +227,7 @@ impl RoughDielectric {
     // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
     #[inline(never)]
     #[must_use]
-    pub fn f(
+    pub fn value(
         &self,
         wo: Vec3,
         wi: Vec3,
@@ -239,13 +241,13 @@ impl RoughDielectric {
         })
     }
 
-    /// The density of [`RoughDielectric::sample`]'s non-delta samples at the world direction
+    /// The density of [`RoughDielectric::sample_alone`]'s non-delta samples at the world direction
     /// `wi` (0 where `f` is 0, and for a pass-through).
     // Out of line: inlined into the BSDF mixture, its frame and half-vector arithmetic was
     // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
     #[inline(never)]
     #[must_use]
-    pub fn pdf(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, tint: Vec3) -> f32 {
+    pub fn density(&self, wo: Vec3, wi: Vec3, fr: &ShadingFrame, tint: Vec3) -> f32 {
         let frame = Frame::from_normal(fr.ns);
         Self::classify(fr, &frame, wi).map_or(0.0, |li| {
             self.pdf_local(frame.to_local(wo), li, fr.entering, tint)
@@ -259,7 +261,7 @@ impl RoughDielectric {
     // hoisted above the lobe test and paid by every material (measured: scripts/hot_share.sh).
     #[inline(never)]
     #[must_use]
-    pub fn sample_direction(
+    pub fn direction(
         &self,
         wo: Vec3,
         v: f32,
@@ -285,7 +287,7 @@ impl RoughDielectric {
     /// `−wo` of weight `tint` and probability 1.
     #[inline]
     #[must_use]
-    pub fn sample(
+    pub fn sample_alone(
         &self,
         wo: Vec3,
         u_lobe: f32,
@@ -329,6 +331,74 @@ impl RoughDielectric {
         })
     }
 }
+
+impl Bxdf for RoughDielectric {
+    fn info(&self) -> LobeInfo {
+        // The lobe number chooses between reflection and refraction.
+        LobeInfo {
+            flags: LobeFlags::GLOSSY
+                .union(LobeFlags::REFLECTION)
+                .union(LobeFlags::TRANSMISSION),
+            uses_lobe_number: true,
+            focusing_fraction: 0.0,
+            ior: Some(self.ior),
+            distribution: Some(self.distribution),
+        }
+    }
+
+    #[inline]
+    fn f(&self, ctx: &LobeContext<'_>, wi: Vec3, mode: TransportMode) -> Vec3 {
+        self.value(ctx.wo, wi, ctx.fr, mode, ctx.tint)
+    }
+
+    #[inline]
+    fn pdf(&self, ctx: &LobeContext<'_>, wi: Vec3, share: f32) -> f32 {
+        share * self.density(ctx.wo, wi, ctx.fr, ctx.tint)
+    }
+
+    /// A direction, reflection or refraction chosen by `draw.v` ([`RoughDielectric::direction`]).
+    #[inline]
+    fn sample(&self, ctx: &LobeContext<'_>, draw: &LobeDraw<'_>) -> Option<LobeSample> {
+        self.direction(ctx.wo, draw.v, draw.u, ctx.fr, ctx.tint)
+            .map(LobeSample::Direction)
+    }
+
+    /// The Fresnel reflectance at the macro-surface.
+    fn prepare(&self, ctx: &LobeContext<'_>) -> Prepared {
+        Prepared::Reflectance(fresnel_dielectric(
+            ctx.wo.dot(ctx.fr.ns),
+            1.0 / self.eta(ctx.fr.entering),
+        ))
+    }
+
+    /// `F + (1 − F)·ρ̄` of the prepared reflectance (0 if unprepared).
+    fn albedo(&self, prepared: &Prepared, rho: f32) -> f32 {
+        match prepared {
+            Prepared::Reflectance(f) => f + (1.0 - f) * rho,
+            Prepared::Nothing | Prepared::Fresnel(_) => 0.0,
+        }
+    }
+
+    fn delta_weights(&self, _ctx: &LobeContext<'_>, _weight: f32) -> DeltaWeights {
+        DeltaWeights::NONE
+    }
+
+    /// As its smooth counterpart (its Fresnel at the macro-surface), for integrators that do
+    /// not follow refraction.
+    fn straight_transmittance(&self, weight: f32, tint: Vec3, cos: f32, entering: bool) -> Vec3 {
+        Dielectric { ior: self.ior }.straight_through(weight, tint, cos, entering)
+    }
+
+    fn is_black(&self, _tint: Vec3) -> bool {
+        false
+    }
+
+    fn is_flat(&self, tint: Vec3) -> bool {
+        self.is_black(tint)
+    }
+}
+
+crate::key_hash_struct!(RoughDielectric { distribution, ior });
 
 #[cfg(test)]
 #[path = "rough_dielectric_tests.rs"]

@@ -78,7 +78,7 @@ fn chi2_cases(roughness: &[(f32, f32)], seed: u64) {
             bins,
             |rng| {
                 let u_lobe = rng.next_f32();
-                lobe.sample(
+                lobe.sample_alone(
                     wo.to_owned(),
                     u_lobe,
                     rng.next_2d(),
@@ -88,7 +88,7 @@ fn chi2_cases(roughness: &[(f32, f32)], seed: u64) {
                 )
                 .map(|s| s.wi)
             },
-            |wi| lobe.pdf(*wo, wi, &fr, Vec3::ONE),
+            |wi| lobe.density(*wo, wi, &fr, Vec3::ONE),
         );
         let g = lobe.distribution;
         eprintln!(
@@ -122,7 +122,7 @@ fn chi2_rejects_a_transmission_pdf_without_the_eta_squared_of_its_jacobian() {
     let wo = dir(30.0, 0.0);
     let eta = lobe.eta(true);
     let wrong = |wi: Vec3| {
-        let p = lobe.pdf(wo, wi, &fr, Vec3::ONE);
+        let p = lobe.density(wo, wi, &fr, Vec3::ONE);
         if wi.z < 0.0 { p / (eta * eta) } else { p }
     };
     let r = chi2_test(
@@ -131,7 +131,7 @@ fn chi2_rejects_a_transmission_pdf_without_the_eta_squared_of_its_jacobian() {
         &SphereBins::sphere(Vec3::Z, 16, 32),
         |rng| {
             let u_lobe = rng.next_f32();
-            lobe.sample(
+            lobe.sample_alone(
                 wo,
                 u_lobe,
                 rng.next_2d(),
@@ -170,7 +170,7 @@ fn albedo_mc(lobe: &RoughDielectric, wo: Vec3, entering: bool, n: u32) -> (f64, 
     let (mut r, mut t, mut s2) = (0.0f64, 0.0f64, 0.0f64);
     for _ in 0..n {
         let u_lobe = rng.next_f32();
-        if let Some(s) = lobe.sample(
+        if let Some(s) = lobe.sample_alone(
             wo,
             u_lobe,
             rng.next_2d(),
@@ -241,16 +241,16 @@ fn index_matched_glass_is_a_pass_through_at_any_roughness() {
                 for mode in [TransportMode::Radiance, TransportMode::Importance] {
                     for u in [0.0, 0.5, 0.999] {
                         let s = lobe
-                            .sample(wo, u, (u, 1.0 - u), &fr, mode, Vec3::ONE)
+                            .sample_alone(wo, u, (u, 1.0 - u), &fr, mode, Vec3::ONE)
                             .unwrap();
                         assert_eq!(s.wi, -wo);
                         assert_eq!(s.weight, Vec3::ONE);
                         assert!(s.delta && s.transmitted && s.eta_scale == 1.0 && s.pdf == 1.0);
                     }
-                    assert_eq!(lobe.f(wo, -wo, &fr, mode, Vec3::ONE), Vec3::ZERO);
+                    assert_eq!(lobe.value(wo, -wo, &fr, mode, Vec3::ONE), Vec3::ZERO);
                 }
-                assert_eq!(lobe.pdf(wo, -wo, &fr, Vec3::ONE), 0.0);
-                assert_eq!(lobe.albedo(wo, &fr, 1.0), 1.0);
+                assert_eq!(lobe.density(wo, -wo, &fr, Vec3::ONE), 0.0);
+                assert_eq!(lobe.mean_albedo(wo, &fr, 1.0), 1.0);
             }
         }
     }
@@ -333,16 +333,17 @@ fn samples_agree_with_f_and_pdf_and_respect_the_geometric_normal() {
             for mode in [TransportMode::Radiance, TransportMode::Importance] {
                 for _ in 0..40 {
                     let u_lobe = rng.next_f32();
-                    let Some(s) = lobe.sample(wo, u_lobe, rng.next_2d(), &fr, mode, Vec3::ONE)
+                    let Some(s) =
+                        lobe.sample_alone(wo, u_lobe, rng.next_2d(), &fr, mode, Vec3::ONE)
                     else {
                         continue;
                     };
                     assert_eq!(s.wi.dot(fr.ng) < 0.0, s.transmitted, "side of ng");
                     assert_eq!(s.wi.dot(fr.ns) < 0.0, s.transmitted, "side of ns");
-                    let pdf = lobe.pdf(wo, s.wi, &fr, Vec3::ONE);
+                    let pdf = lobe.density(wo, s.wi, &fr, Vec3::ONE);
                     assert!((s.pdf - pdf).abs() <= 1e-3 * pdf, "{} vs {pdf}", s.pdf);
                     let mut w =
-                        lobe.f(wo, s.wi, &fr, mode, Vec3::ONE) * (s.wi.dot(fr.ns).abs() / pdf);
+                        lobe.value(wo, s.wi, &fr, mode, Vec3::ONE) * (s.wi.dot(fr.ns).abs() / pdf);
                     if mode == TransportMode::Importance {
                         w *= shading_normal_correction(wo, s.wi, &fr);
                     }

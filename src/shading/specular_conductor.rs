@@ -5,6 +5,7 @@
 
 use glam::Vec3;
 
+use super::bxdf::{Bxdf, DeltaWeights, LobeContext, LobeDraw, LobeInfo, LobeSample, Prepared};
 use super::conductor::ConductorFresnel;
 use super::scattering::{BsdfSample, LobeFlags, ShadingFrame, TransportMode, mean};
 use super::specular_reflection::SpecularReflection;
@@ -30,7 +31,7 @@ impl SpecularConductor {
     /// The lobe's sampling weight: the mean reflectance at `wo`.
     #[inline]
     #[must_use]
-    pub fn albedo(&self, wo: Vec3, fr: &ShadingFrame) -> f32 {
+    pub fn mean_reflectance(&self, wo: Vec3, fr: &ShadingFrame) -> f32 {
         mean(self.reflectance(wo, fr))
     }
 
@@ -39,7 +40,7 @@ impl SpecularConductor {
     /// mode), `pdf = prob`. `None` when `prob` is 0.
     #[inline]
     #[must_use]
-    pub fn sample(
+    pub fn mirror_sample(
         &self,
         wo: Vec3,
         fr: &ShadingFrame,
@@ -48,9 +49,82 @@ impl SpecularConductor {
         prob: f32,
     ) -> Option<BsdfSample> {
         // The mirror lobe's sample with the Fresnel reflectance as its tint.
-        SpecularReflection.sample(wo, fr, mode, weight, prob, self.reflectance(wo, fr))
+        SpecularReflection::mirror_sample(wo, fr, mode, weight, prob, self.reflectance(wo, fr))
     }
 }
+
+impl Bxdf for SpecularConductor {
+    fn info(&self) -> LobeInfo {
+        LobeInfo {
+            flags: Self::FLAGS,
+            uses_lobe_number: false,
+            focusing_fraction: 1.0,
+            ior: None,
+            distribution: None,
+        }
+    }
+
+    /// A delta lobe has no value: 0.
+    #[inline]
+    fn f(&self, _ctx: &LobeContext<'_>, _wi: Vec3, _mode: TransportMode) -> Vec3 {
+        Vec3::ZERO
+    }
+
+    /// A delta lobe has no density: 0.
+    #[inline]
+    fn pdf(&self, _ctx: &LobeContext<'_>, _wi: Vec3, _share: f32) -> f32 {
+        0.0
+    }
+
+    /// The mirror direction of weight `F · weight / prob` ([`SpecularConductor::mirror_sample`]).
+    #[inline]
+    fn sample(&self, ctx: &LobeContext<'_>, draw: &LobeDraw<'_>) -> Option<LobeSample> {
+        self.mirror_sample(ctx.wo, ctx.fr, draw.mode, draw.weight, draw.prob)
+            .map(LobeSample::Delta)
+    }
+
+    /// The mean reflectance at `wo`.
+    fn prepare(&self, ctx: &LobeContext<'_>) -> Prepared {
+        Prepared::Reflectance(self.mean_reflectance(ctx.wo, ctx.fr))
+    }
+
+    /// The prepared mean reflectance (0 if unprepared).
+    fn albedo(&self, prepared: &Prepared, _rho: f32) -> f32 {
+        match prepared {
+            Prepared::Reflectance(r) => *r,
+            Prepared::Nothing | Prepared::Fresnel(_) => 0.0,
+        }
+    }
+
+    /// `F(|wo·ns|)` times the part's weight along the mirror direction.
+    fn delta_weights(&self, ctx: &LobeContext<'_>, weight: f32) -> DeltaWeights {
+        DeltaWeights {
+            reflect: self.reflectance(ctx.wo, ctx.fr) * weight,
+            refract: None,
+        }
+    }
+
+    fn straight_transmittance(
+        &self,
+        _weight: f32,
+        _tint: Vec3,
+        _cos: f32,
+        _entering: bool,
+    ) -> Vec3 {
+        Vec3::ZERO
+    }
+
+    /// A metal's colour is its Fresnel, never black by the tint.
+    fn is_black(&self, _tint: Vec3) -> bool {
+        false
+    }
+
+    fn is_flat(&self, _tint: Vec3) -> bool {
+        true
+    }
+}
+
+crate::key_hash_struct!(SpecularConductor { fresnel });
 
 #[cfg(test)]
 mod tests {
@@ -69,7 +143,7 @@ mod tests {
         };
         let wo = Vec3::new(0.6, 0.0, 0.8);
         let s = gold
-            .sample(wo, &fr, TransportMode::Radiance, 0.5, 0.25)
+            .mirror_sample(wo, &fr, TransportMode::Radiance, 0.5, 0.25)
             .expect("sample");
         assert!(s.wi.distance(Vec3::new(-0.6, 0.0, 0.8)) < 1e-6);
         // By hand: the red channel's F at cos 0.8 from gold's (η, k), times 0.5 / 0.25.
@@ -78,7 +152,7 @@ mod tests {
         assert!((s.weight.x - want).abs() < 1e-6, "{} vs {want}", s.weight.x);
         assert!(s.delta && s.pdf == 0.25 && !s.transmitted);
         assert!(
-            gold.sample(wo, &fr, TransportMode::Radiance, 0.5, 0.0)
+            gold.mirror_sample(wo, &fr, TransportMode::Radiance, 0.5, 0.0)
                 .is_none()
         );
     }

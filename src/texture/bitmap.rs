@@ -102,6 +102,8 @@ impl BitmapTexture {
     }
 }
 
+crate::key_hash_struct!(BitmapTexture { mip, tile });
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -113,6 +113,8 @@ pub fn perturb_normal_by_gradient(n: Vec3, grad: Vec3) -> Vec3 {
     if out.is_finite() { out } else { n }
 }
 
+crate::key_hash_struct!(HeightMap { mip, depth, tile });
+
 #[cfg(test)]
 mod tests {
     use super::*;

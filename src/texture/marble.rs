@@ -210,6 +210,18 @@ impl Marble {
     }
 }
 
+// Every field, the derived ones too (cheap, and a derived field is never wrongly left out).
+crate::key_hash_struct!(Marble {
+    scale,
+    octaves,
+    turbulence,
+    base,
+    vein,
+    noise,
+    harmonics,
+    min_resolved
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

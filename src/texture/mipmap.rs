@@ -409,6 +409,24 @@ fn downsample<T: Texel>(src: &Level<T>) -> Level<T> {
     }
 }
 
+impl<T: crate::binfile::KeyHash> crate::binfile::KeyHash for MipMap<T> {
+    /// The finest level's size and texels; the coarser levels are filtered from it.
+    fn key_hash(&self, h: &mut crate::binfile::Fnv) {
+        let Self { levels } = self;
+        h.u64(levels.len() as u64);
+        if let Some(Level {
+            width,
+            height,
+            texels,
+        }) = levels.first()
+        {
+            h.u32(*width);
+            h.u32(*height);
+            crate::binfile::KeyHash::key_hash(texels, h);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

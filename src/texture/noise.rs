@@ -277,6 +277,8 @@ pub fn octaves_for(width: f32, max: u32) -> f32 {
     ((0.5 / width).log2()).clamp(0.0, max as f32)
 }
 
+crate::key_hash_struct!(Noise { perm, seed });
+
 #[cfg(test)]
 mod tests {
     use super::*;

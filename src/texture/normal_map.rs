@@ -149,6 +149,13 @@ pub fn apply_tangent_normal(n: Vec3, dpdu: Vec3, dpdv: Vec3, t: Vec3, strength: 
     }
 }
 
+crate::key_hash_struct!(NormalMap {
+    mip,
+    tile,
+    strength,
+    flip_y
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

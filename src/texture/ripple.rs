@@ -91,6 +91,13 @@ impl Ripples {
     }
 }
 
+crate::key_hash_struct!(Ripples {
+    centers,
+    frequency,
+    amplitude,
+    decay
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

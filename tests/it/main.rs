@@ -46,6 +46,7 @@ mod reported_photon;
 mod reported_transport;
 mod rough_integrators;
 mod rough_textures;
+mod scene_key;
 mod sun_caustic;
 mod textures;
 mod transmission_nee;

@@ -264,6 +264,26 @@ impl PhotonMap {
         self.tree.is_empty()
     }
 
+    /// This map as the pilot of a progressive render's initial radius `R(x)`
+    /// ([`RadiusField::from_radii`]): each photon's k-nearest radius in this map, raised to
+    /// [`MIN_RADIUS_FRACTION`] of the largest radius. `None` for an empty map.
+    #[must_use]
+    pub fn radius_field(&self) -> Option<RadiusField> {
+        use rayon::prelude::*;
+        if self.is_empty() {
+            return None;
+        }
+        let max_radius = self.max_radius();
+        let floor = max_radius * MIN_RADIUS_FRACTION;
+        RadiusField::cell_side(max_radius)?;
+        let radii: Vec<(Vec3, f32)> = self
+            .photons()
+            .par_iter()
+            .map(|ph| (ph.position(), self.knn_radius(ph.position()).max(floor)))
+            .collect();
+        RadiusField::from_radii(max_radius, floor, &radii)
+    }
+
     /// The largest estimate radius (scene units).
     #[must_use]
     pub fn max_radius(&self) -> f32 {

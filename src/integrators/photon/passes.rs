@@ -129,7 +129,9 @@ impl<'a> ProgressivePhotons<'a> {
                     return;
                 }
                 let field = |m: &Option<super::PhotonMap>| {
-                    m.as_ref().and_then(RadiusField::from_pilot).map(Arc::new)
+                    m.as_ref()
+                        .and_then(super::PhotonMap::radius_field)
+                        .map(Arc::new)
                 };
                 let f = PassFields {
                     caustic: field(&pilot.caustic),

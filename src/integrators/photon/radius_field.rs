@@ -22,7 +22,6 @@
 
 use glam::Vec3;
 
-use super::estimate::PhotonMap;
 use crate::spatial::VoxelTable;
 
 /// Coarse cells per largest radius (the field's cell side is `max_radius / CELLS_PER_RADIUS`).
@@ -44,40 +43,32 @@ pub struct RadiusField {
 }
 
 impl RadiusField {
-    /// The field of `pilot` (a map built from photon streams no pass uses): each pilot photon's
-    /// k-nearest radius in the pilot map (the map's own `k` and largest radius), the median per
-    /// cell of side `max_radius / CELLS_PER_RADIUS`. `None` for an empty map.
+    /// The cell side of a field over a pilot map of largest radius `max_radius`
+    /// (`max_radius / CELLS_PER_RADIUS`), `None` unless finite and positive (then there is no
+    /// field).
     #[must_use]
-    pub fn from_pilot(pilot: &PhotonMap) -> Option<Self> {
-        use rayon::prelude::*;
-        if pilot.is_empty() {
-            return None;
-        }
-        let max_radius = pilot.max_radius();
-        let floor = max_radius * super::estimate::MIN_RADIUS_FRACTION;
+    pub fn cell_side(max_radius: f32) -> Option<f32> {
         let side = max_radius / CELLS_PER_RADIUS;
-        if !(side.is_finite() && side > 0.0) {
+        (side.is_finite() && side > 0.0).then_some(side)
+    }
+
+    /// The field of a pilot map (a map built from photon streams no pass uses; its constructor
+    /// is `PhotonMap::radius_field`) of largest radius `max_radius`: `radii` holds each pilot
+    /// photon's position and its k-nearest radius in the pilot map (the map's own `k` and
+    /// largest radius), already raised to `floor`; the field keeps their median per cell of side
+    /// [`RadiusField::cell_side`]. `None` without photons or cells.
+    #[must_use]
+    pub fn from_radii(max_radius: f32, floor: f32, radii: &[(Vec3, f32)]) -> Option<Self> {
+        let side = Self::cell_side(max_radius)?;
+        if radii.is_empty() {
             return None;
         }
-        let radii: Vec<f32> = pilot
-            .photons()
-            .par_iter()
-            .map(|ph| pilot.knn_radius(ph.position()).max(floor))
-            .collect();
-        let (cells, medians) = VoxelTable::build(
-            side,
-            pilot
-                .photons()
-                .iter()
-                .map(|ph| ph.position())
-                .zip(radii.iter().copied()),
-            |group| {
-                group.sort_by(f32::total_cmp);
-                Some(group[group.len() / 2])
-            },
-        )
+        let (cells, medians) = VoxelTable::build(side, radii.iter().copied(), |group| {
+            group.sort_by(f32::total_cmp);
+            Some(group[group.len() / 2])
+        })
         .ok()?;
-        let mut sorted = radii;
+        let mut sorted: Vec<f32> = radii.iter().map(|&(_, r)| r).collect();
         sorted.sort_by(f32::total_cmp);
         let typical = sorted[sorted.len() / 2];
         Some(Self {
@@ -120,7 +111,7 @@ impl RadiusField {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrators::photon::Kernel;
+    use crate::integrators::photon::{Kernel, PhotonMap};
     use crate::sampling::Rng;
     use crate::spatial::{KdTree, Photon};
 
@@ -150,7 +141,7 @@ mod tests {
             (0..20_000)
                 .map(|_| Vec3::new(0.8 + 0.1 * rng.next_f32(), 0.8 + 0.1 * rng.next_f32(), 0.0)),
         );
-        let field = RadiusField::from_pilot(&map(&pts, 20, 0.1)).expect("field");
+        let field = map(&pts, 20, 0.1).radius_field().expect("field");
         let patch = (20.0 / (std::f32::consts::PI * 2e4)).sqrt();
         let spot = (20.0 / (std::f32::consts::PI * 2.02e6)).sqrt();
         for p in [
@@ -171,7 +162,7 @@ mod tests {
     #[test]
     fn coincident_photons_give_the_floor_not_zero() {
         let pts = vec![Vec3::new(0.2, 0.2, 0.2); 100];
-        let field = RadiusField::from_pilot(&map(&pts, 10, 0.5)).expect("field");
+        let field = map(&pts, 10, 0.5).radius_field().expect("field");
         let r = field.radius(Vec3::new(0.2, 0.2, 0.2));
         assert!(
             r > 0.0 && r == 0.5 * super::super::estimate::MIN_RADIUS_FRACTION,
