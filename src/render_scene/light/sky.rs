@@ -158,11 +158,7 @@ impl SkyModel {
             sun,
             turbidity,
             zenith: (1000.0 * zenith_luminance(turbidity, theta_s), xz, yz),
-            coefficients: [
-                perez_y(turbidity),
-                perez_x(turbidity),
-                perez_yc(turbidity),
-            ],
+            coefficients: [perez_y(turbidity), perez_x(turbidity), perez_yc(turbidity)],
         })
     }
 
@@ -306,7 +302,11 @@ impl SkyLight {
             for i in 0..w {
                 let phi = 2.0 * PI * (i as f64 + 0.5) / w as f64;
                 // The environment map's convention: (sin θ sin φ, cos θ, −sin θ cos φ).
-                let d = DVec3::new(theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos());
+                let d = DVec3::new(
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                    -theta.sin() * phi.cos(),
+                );
                 let l = model.rgb(d) * k;
                 e_sky += l * theta.cos() * omega;
                 texels[j * w + i] = l.as_vec3();

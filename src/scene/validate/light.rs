@@ -97,7 +97,10 @@ impl<'a> Validator<'a> {
                         self.out.push(
                             Diagnostic::error(
                                 &at,
-                                format!("the sun must be above the horizon (y > 0), found {}", fmt3(*d)),
+                                format!(
+                                    "the sun must be above the horizon (y > 0), found {}",
+                                    fmt3(*d)
+                                ),
                             )
                             .with_help("the sky model holds for a sun above the horizon; +y is up"),
                         );
@@ -116,7 +119,10 @@ impl<'a> Validator<'a> {
                 {
                     self.err(
                         &at,
-                        format!("must be within [0, 1] per channel, found {}", fmt3(*ground_albedo)),
+                        format!(
+                            "must be within [0, 1] per channel, found {}",
+                            fmt3(*ground_albedo)
+                        ),
                     );
                 }
                 self.positive(&format!("{path}.scale"), *scale, "scale");
@@ -194,7 +200,9 @@ impl<'a> Validator<'a> {
                         other.kind()
                     ),
                 )
-                .with_help("give the index of the sun's `Distant` light, or `Direction((x, y, z))`"),
+                .with_help(
+                    "give the index of the sun's `Distant` light, or `Direction((x, y, z))`",
+                ),
             ),
             None => self.out.push(
                 Diagnostic::error(
@@ -204,7 +212,9 @@ impl<'a> Validator<'a> {
                         lights.len()
                     ),
                 )
-                .with_help("give the index of the sun's `Distant` light, or `Direction((x, y, z))`"),
+                .with_help(
+                    "give the index of the sun's `Distant` light, or `Direction((x, y, z))`",
+                ),
             ),
         }
     }

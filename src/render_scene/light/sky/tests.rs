@@ -24,7 +24,10 @@ fn zenith_luminance_matches_a_hand_computation() {
     assert!((yz - 15.5007).abs() < 1e-3, "{yz}");
     // Zenith chromaticity, T = 3, θs = 40°: x_z = 0.24772, y_z = 0.25348 (the two cubics by hand).
     let (x, y) = zenith_chromaticity(3.0, 40f64.to_radians());
-    assert!((x - 0.24772).abs() < 1e-4 && (y - 0.25348).abs() < 1e-4, "{x} {y}");
+    assert!(
+        (x - 0.24772).abs() < 1e-4 && (y - 0.25348).abs() < 1e-4,
+        "{x} {y}"
+    );
 }
 
 #[test]
@@ -40,7 +43,8 @@ fn the_distribution_is_normalised_at_the_zenith() {
     let ts = (0.766 / sun.length()).acos(); // θs of the unit sun
     let c = perez_y(3.0);
     let f = |cos_t: f64, g: f64| {
-        (1.0 + c[0] * (c[1] / cos_t).exp()) * (1.0 + c[2] * (c[3] * g).exp() + c[4] * g.cos().powi(2))
+        (1.0 + c[0] * (c[1] / cos_t).exp())
+            * (1.0 + c[2] * (c[3] * g).exp() + c[4] * g.cos().powi(2))
     };
     let w = DVec3::new(0.3, 0.4, -0.5).normalize();
     let gamma = w.dot(sun.normalize()).acos();
@@ -75,7 +79,12 @@ fn the_unit_rule_keeps_the_sun_to_sky_ratio() {
     // E_dn = 127500 · exp(−0.21 · 2) = 83 777 lux; k = 30 / E_dn.
     let e_dn = 127_500.0 * (-0.42f64).exp();
     // (The f32 direction makes cos θs = 0.5 to a few 1e-8: m = 2 to that precision.)
-    assert!((sky.k - 30.0 / e_dn).abs() < 1e-6 * sky.k, "{} vs {}", sky.k, 30.0 / e_dn);
+    assert!(
+        (sky.k - 30.0 / e_dn).abs() < 1e-6 * sky.k,
+        "{} vs {}",
+        sky.k,
+        30.0 / e_dn
+    );
     // Twice the sun: twice the sky (the ratio is kept).
     let twice = SkyLight::new(
         SkySun::Light {
@@ -89,14 +98,28 @@ fn the_unit_rule_keeps_the_sun_to_sky_ratio() {
     )
     .unwrap();
     let w = Vec3::new(0.2, 0.7, 0.1).normalize();
-    assert!((twice.map.le(w) / sky.map.le(w) - Vec3::splat(2.0)).abs().max_element() < 1e-5);
+    assert!(
+        (twice.map.le(w) / sky.map.le(w) - Vec3::splat(2.0))
+            .abs()
+            .max_element()
+            < 1e-5
+    );
     // A sun given only by direction: 1 scene unit per kcd/m² (zenith texel ≈ Y_z / 1000).
     let bare = SkyLight::new(SkySun::Direction(dir), 3.0, Vec3::ZERO, 1.0, scene()).unwrap();
     let y = luminance(bare.map.le(Vec3::Y));
-    assert!((y / (bare.model.zenith.0 / 1000.0) - 1.0).abs() < 0.01, "{y}");
+    assert!(
+        (y / (bare.model.zenith.0 / 1000.0) - 1.0).abs() < 0.01,
+        "{y}"
+    );
     // Out of range.
     assert!(matches!(
-        SkyLight::new(SkySun::Direction(Vec3::new(1.0, -0.1, 0.0)), 3.0, Vec3::ZERO, 1.0, scene()),
+        SkyLight::new(
+            SkySun::Direction(Vec3::new(1.0, -0.1, 0.0)),
+            3.0,
+            Vec3::ZERO,
+            1.0,
+            scene()
+        ),
         Err(SkyError::SunBelowHorizon(_))
     ));
     assert!(matches!(
@@ -180,7 +203,13 @@ fn sampling_density_integrates_to_one_and_follows_the_radiance() {
         let w = uniform_sphere(rng.next_2d());
         uniform += luminance(l.le(w)) * 4.0 * PI;
     }
-    assert!(mismatched < n / 1000, "{mismatched} of {n} samples' pdf_li differ");
+    assert!(
+        mismatched < n / 1000,
+        "{mismatched} of {n} samples' pdf_li differ"
+    );
     let (by_light, uniform) = (by_light / f64::from(n), uniform / f64::from(n));
-    assert!((by_light / uniform - 1.0).abs() < 0.01, "{by_light} vs {uniform}");
+    assert!(
+        (by_light / uniform - 1.0).abs() < 0.01,
+        "{by_light} vs {uniform}"
+    );
 }
