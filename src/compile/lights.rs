@@ -25,11 +25,11 @@ use glam::Vec3;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::render_scene::light::escape::InfinityRef;
 use crate::render_scene::light::{
-    DistantLight, EnvironmentLight, MeshLight, RectLight, SceneSphere, SpotLight,
+    DistantLight, EnvironmentLight, MeshLight, RectLight, SceneSphere, SkyLight, SpotLight, sky,
 };
 use crate::render_scene::{Light, ObjectInfo};
 use crate::scene::Diagnostic;
-use crate::scene::schema::{EmissionSpec, LightSpec};
+use crate::scene::schema::{EmissionSpec, LightSpec, SkySun};
 
 /// Largest radiance, in W/(m²·sr), a sphere light may have: f32 reaches 3.4e38, and this leaves
 /// eight orders of magnitude for the sums of samples and the exposure.
@@ -250,6 +250,7 @@ pub(super) fn scene_sphere(b: &GeometryBuilder, more: &[(Vec3, f32)]) -> SceneSp
 fn spec_light(
     index: usize,
     l: &LightSpec,
+    list: &[LightSpec],
     scene: SceneSphere,
     base_dir: &Path,
     builder: &GeometryBuilder,
@@ -341,6 +342,31 @@ fn spec_light(
             };
             Light::Environment(Arc::new(env))
         }
+        LightSpec::Sky {
+            sun,
+            turbidity,
+            ground_albedo,
+            scale,
+            ..
+        } => {
+            let sun = match *sun {
+                SkySun::Direction(d) => sky::SkySun::Direction(d.into()),
+                SkySun::Light(i) => match list.get(i) {
+                    Some(LightSpec::Distant {
+                        direction,
+                        irradiance,
+                        ..
+                    }) => sky::SkySun::Light {
+                        direction: (*direction).into(),
+                        irradiance: (*irradiance).into(),
+                    },
+                    _ => return Err(bad(&format!("lights[{i}] is not a `Distant` light"))),
+                },
+            };
+            let sky = SkyLight::new(sun, *turbidity, (*ground_albedo).into(), *scale, scene)
+                .map_err(|e| bad(&e.to_string()))?;
+            Light::Sky(Arc::new(sky))
+        }
     }))
 }
 
@@ -395,7 +421,7 @@ pub(super) fn compile_lights(
         infinity: None,
     };
     for (i, l) in list.iter().enumerate() {
-        let light = match spec_light(i, l, scene_sphere, base_dir, builder, eye) {
+        let light = match spec_light(i, l, list, scene_sphere, base_dir, builder, eye) {
             Ok(SpecLight::Light(light)) => light,
             Ok(SpecLight::Point { light, warning }) => {
                 warnings.push(warning);
@@ -457,7 +483,8 @@ fn light_sphere(l: &LightSpec) -> Option<(Vec3, f32)> {
         LightSpec::Point { .. }
         | LightSpec::Spot { .. }
         | LightSpec::Distant { .. }
-        | LightSpec::Environment { .. } => None,
+        | LightSpec::Environment { .. }
+        | LightSpec::Sky { .. } => None,
     }
 }
 

@@ -107,14 +107,17 @@ impl<'a> Whitted<'a> {
                 for (_, e) in scene.lights_escaped(ray) {
                     le += e.le;
                 }
-                let info = scene.escape_record(ray).filter(|_| O::ACTIVE).map(|e| TraceHit {
-                    t: e.hit.t,
-                    point: e.sp.p,
-                    normal: e.sp.ns,
-                    object: scene.objects[e.sp.object as usize].name.clone(),
-                    material: "light".into(),
-                    entering: true,
-                });
+                let info = scene
+                    .escape_record(ray)
+                    .filter(|_| O::ACTIVE)
+                    .map(|e| TraceHit {
+                        t: e.hit.t,
+                        point: e.sp.p,
+                        normal: e.sp.ns,
+                        object: scene.objects[e.sp.object as usize].name.clone(),
+                        material: "light".into(),
+                        entering: true,
+                    });
                 return (seen(le * tr), info);
             }
             Interaction::Emitter(e) => {

@@ -27,6 +27,7 @@ pub use distant::DistantLight;
 pub use environment::EnvironmentLight;
 pub use infinite::SceneSphere;
 pub use rect::RectLight;
+pub use sky::SkyLight;
 pub use spot::SpotLight;
 pub use triangle_mesh::MeshLight;
 
@@ -61,6 +62,8 @@ pub enum Light {
     Distant(DistantLight),
     /// Radiance from every direction at infinity (constant or an image).
     Environment(Arc<EnvironmentLight>),
+    /// A physical clear sky above a ground (Preetham et al. 1999), tabulated as an environment.
+    Sky(Arc<SkyLight>),
 }
 
 /// One sample of incident light at a point (from [`Light::sample_li`]).
@@ -134,7 +137,11 @@ impl Light {
         match self {
             Light::Distant(d) => d.is_delta(),
             Light::Point { .. } | Light::Spot(_) => true,
-            Light::Sphere { .. } | Light::Rect(_) | Light::Mesh(_) | Light::Environment(_) => false,
+            Light::Sphere { .. }
+            | Light::Rect(_)
+            | Light::Mesh(_)
+            | Light::Environment(_)
+            | Light::Sky(_) => false,
         }
     }
 
@@ -144,7 +151,7 @@ impl Light {
     #[must_use]
     pub fn is_infinite(&self) -> bool {
         match self {
-            Light::Distant(_) | Light::Environment(_) => true,
+            Light::Distant(_) | Light::Environment(_) | Light::Sky(_) => true,
             Light::Point { .. }
             | Light::Sphere { .. }
             | Light::Rect(_)
@@ -171,6 +178,10 @@ impl Light {
                 let wi = dir / dir.length();
                 (e.le(wi), wi)
             }
+            Light::Sky(s) => {
+                let wi = dir / dir.length();
+                (s.map.le(wi), wi)
+            }
             Light::Point { .. }
             | Light::Sphere { .. }
             | Light::Rect(_)
@@ -180,13 +191,13 @@ impl Light {
         (le != Vec3::ZERO).then_some(escape::Escape { le, wi })
     }
 
-    /// True for the lights at infinity that fill the sphere of directions (environment): ray
+    /// True for the lights at infinity that fill the sphere of directions (environment, sky): ray
     /// trees name escaping rays after the first of them, which compilation gives an object.
     #[inline]
     #[must_use]
     pub fn fills_sky(&self) -> bool {
         match self {
-            Light::Environment(_) => true,
+            Light::Environment(_) | Light::Sky(_) => true,
             Light::Point { .. }
             | Light::Sphere { .. }
             | Light::Rect(_)
@@ -204,6 +215,7 @@ impl Light {
         match self {
             Light::Distant(d) => Some(d.scene),
             Light::Environment(e) => Some(e.scene),
+            Light::Sky(s) => Some(s.map.scene),
             Light::Point { .. }
             | Light::Sphere { .. }
             | Light::Rect(_)
@@ -225,7 +237,8 @@ impl Light {
             | Light::Rect(_)
             | Light::Spot(_)
             | Light::Distant(_)
-            | Light::Environment(_) => false,
+            | Light::Environment(_)
+            | Light::Sky(_) => false,
         }
     }
 
@@ -324,6 +337,7 @@ impl Light {
             // are MIS-weighted against BSDF sampling as an environment's are.
             Light::Distant(ref d) => d.sample_li(p, u),
             Light::Environment(ref e) => e.sample_li(p, u),
+            Light::Sky(ref s) => s.map.sample_li(p, u),
         }
     }
 
@@ -363,6 +377,7 @@ impl Light {
             Light::Spot(ref s) => s.pdf_li(p, wi),
             Light::Distant(ref d) => d.pdf_li(p, wi),
             Light::Environment(ref e) => e.pdf_li(p, wi),
+            Light::Sky(ref s) => s.map.pdf_li(p, wi),
         }
     }
 
@@ -381,7 +396,8 @@ impl Light {
             | Light::Rect(_)
             | Light::Spot(_)
             | Light::Distant(_)
-            | Light::Environment(_) => self.pdf_li(p, wi),
+            | Light::Environment(_)
+            | Light::Sky(_) => self.pdf_li(p, wi),
         }
     }
 
@@ -408,6 +424,7 @@ impl Light {
             Light::Mesh(ref m) => m.le(n, w),
             Light::Spot(_) | Light::Distant(_) => Vec3::ZERO,
             Light::Environment(ref e) => e.le(-w),
+            Light::Sky(ref s) => s.map.le(-w),
         }
     }
 
@@ -467,6 +484,7 @@ impl Light {
             Light::Spot(ref s) => s.sample_le(u_pos, u_dir),
             Light::Distant(ref d) => d.sample_le(u_pos, u_dir),
             Light::Environment(ref e) => e.sample_le(u_pos, u_dir),
+            Light::Sky(ref s) => s.map.sample_le(u_pos, u_dir),
         }
     }
 
@@ -487,6 +505,7 @@ impl Light {
             Light::Spot(ref s) => s.pdf_le(dir),
             Light::Distant(ref d) => d.pdf_le(dir),
             Light::Environment(ref e) => e.pdf_le(dir),
+            Light::Sky(ref s) => s.map.pdf_le(dir),
         }
     }
 
@@ -503,6 +522,7 @@ impl Light {
             Light::Spot(ref s) => s.power(),
             Light::Distant(ref d) => d.power(),
             Light::Environment(ref e) => e.power(),
+            Light::Sky(ref s) => s.map.power(),
         }
     }
 }
@@ -521,7 +541,8 @@ impl Light {
             | Light::Rect(_)
             | Light::Mesh(_)
             | Light::Distant(_)
-            | Light::Environment(_) => per_area_light,
+            | Light::Environment(_)
+            | Light::Sky(_) => per_area_light,
         }
     }
 
@@ -558,7 +579,7 @@ impl Light {
             }
             // No surface to leave: a spot's photons start at its position, those of lights at
             // infinity on the disc of the scene's bounding sphere; flux le / (pdf_pos pdf_dir).
-            Light::Spot(_) | Light::Distant(_) | Light::Environment(_) => {
+            Light::Spot(_) | Light::Distant(_) | Light::Environment(_) | Light::Sky(_) => {
                 let u_pos = sampler.next_2d();
                 let u_dir = sampler.next_2d();
                 let e = self.sample_le(u_pos, u_dir)?;
@@ -659,6 +680,13 @@ impl Light {
             Light::Environment(ref e) => Self::emit_crossing(
                 e.sample_le((0.5, 0.5), sampler.next_2d()),
                 e.scene,
+                sampler,
+                cross,
+                n,
+            ),
+            Light::Sky(ref s) => Self::emit_crossing(
+                s.map.sample_le((0.5, 0.5), sampler.next_2d()),
+                s.map.scene,
                 sampler,
                 cross,
                 n,
@@ -764,6 +792,7 @@ pub mod environment;
 pub mod escape;
 pub mod infinite;
 pub mod rect;
+pub mod sky;
 pub mod spot;
 #[cfg(test)]
 mod test_support;

@@ -78,7 +78,9 @@ fn path_ppm_and_path_agree_within_noise_on_every_scene() {
                     | LightSpec::Distant {
                         caustic_photons, ..
                     } => *caustic_photons = Some(0),
-                    LightSpec::Sphere { .. } | LightSpec::Environment { .. } => {}
+                    LightSpec::Sphere { .. }
+                    | LightSpec::Environment { .. }
+                    | LightSpec::Sky { .. } => {}
                 }
                 if let LightSpec::Distant { angular_radius, .. } = light {
                     *angular_radius = 0.0;

@@ -101,6 +101,55 @@ pub enum LightSpec {
         #[serde(default)]
         caustic_photons: Option<u32>,
     },
+    /// A physical clear sky above a flat ground: the analytic daylight model of Preetham,
+    /// Shirley & Smits (1999) for the sun's direction and the air's `turbidity`. Its luminance
+    /// (cd/m² in the model) is scaled so that, beside the `Distant` sun it follows, sun and sky
+    /// keep the ratio of a clear atmosphere (see `docs/lights.md`). Below the horizon, a
+    /// Lambertian ground of `ground_albedo` lit by sky and sun. Rays leaving the scene see it;
+    /// `render.background` must then be black; at most one sky or environment per scene. The
+    /// sun's disc itself is the `Distant` light's.
+    Sky {
+        /// The sun the sky follows: `Light(i)`, the `Distant` light `lights[i]` (its direction,
+        /// and its irradiance sets the sky's brightness), or `Direction((x, y, z))` towards the
+        /// sun (then 1 scene radiance unit per kcd/m²). Above the horizon (+y up).
+        sun: SkySun,
+        /// Atmospheric turbidity, in [2, 10] (2: very clear, 3: clear, 6: hazy, 10: thin fog).
+        #[serde(default = "three")]
+        turbidity: f32,
+        /// Reflectance of the ground below the horizon, per channel in [0, 1].
+        #[serde(default = "ground")]
+        #[serde(deserialize_with = "exact_floats::<_, 3>")]
+        ground_albedo: Rgb,
+        /// Factor on the sky's (and ground's) radiance (> 0).
+        #[serde(default = "unit")]
+        scale: f32,
+        /// Caustic photons this light emits, instead of its power share of
+        /// `photons.caustic` (0: none).
+        #[serde(default)]
+        caustic_photons: Option<u32>,
+    },
+}
+
+/// The sun a `Sky` follows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub enum SkySun {
+    /// The `Distant` light at this index of the `lights` list.
+    Light(usize),
+    /// A direction towards the sun (any length > 0, with y > 0).
+    Direction(#[serde(deserialize_with = "exact_floats::<_, 3>")] Vec3Spec),
+}
+
+fn three() -> f32 {
+    3.0
+}
+
+fn unit() -> f32 {
+    1.0
+}
+
+fn ground() -> Rgb {
+    [0.3; 3]
 }
 
 /// Light emitted by a shape (a node's `emission`): the node becomes an area light of uniform
@@ -141,6 +190,9 @@ impl LightSpec {
             }
             | LightSpec::Environment {
                 caustic_photons, ..
+            }
+            | LightSpec::Sky {
+                caustic_photons, ..
             } => caustic_photons,
         }
     }
@@ -164,16 +216,19 @@ impl LightSpec {
             }
             | LightSpec::Environment {
                 caustic_photons, ..
+            }
+            | LightSpec::Sky {
+                caustic_photons, ..
             } => caustic_photons,
         }
     }
 
-    /// True for the lights that every escaping ray sees, which fill the sky: environment (at
-    /// most one per scene, and no background beside it).
+    /// True for the lights that every escaping ray sees, which fill the sky: environment and
+    /// sky (at most one per scene, and no background beside it).
     #[must_use]
     pub fn fills_sky(&self) -> bool {
         match self {
-            LightSpec::Environment { .. } => true,
+            LightSpec::Environment { .. } | LightSpec::Sky { .. } => true,
             LightSpec::Point { .. }
             | LightSpec::Sphere { .. }
             | LightSpec::Spot { .. }
@@ -190,6 +245,7 @@ impl LightSpec {
             LightSpec::Spot { .. } => "Spot",
             LightSpec::Distant { .. } => "Distant",
             LightSpec::Environment { .. } => "Environment",
+            LightSpec::Sky { .. } => "Sky",
         }
     }
 }

@@ -1,6 +1,7 @@
 //! Checks of the `lights` list.
 
 use super::*;
+use crate::scene::schema::SkySun;
 
 impl<'a> Validator<'a> {
     pub(super) fn light(&mut self, path: &str, l: &LightSpec) {
@@ -82,6 +83,51 @@ impl<'a> Validator<'a> {
                 self.radiometric(&format!("{path}.irradiance"), *irradiance);
                 return;
             }
+            LightSpec::Sky {
+                sun,
+                turbidity,
+                ground_albedo,
+                scale,
+                ..
+            } => {
+                if let SkySun::Direction(d) = sun {
+                    let at = format!("{path}.sun");
+                    self.direction(&at, *d);
+                    if d.iter().all(|c| c.is_finite()) && !(d[1] > 0.0) {
+                        self.out.push(
+                            Diagnostic::error(
+                                &at,
+                                format!(
+                                    "the sun must be above the horizon (y > 0), found {}",
+                                    fmt3(*d)
+                                ),
+                            )
+                            .with_help("the sky model holds for a sun above the horizon; +y is up"),
+                        );
+                    }
+                }
+                let at = format!("{path}.turbidity");
+                if self.finite(&at, *turbidity) && !(2.0..=10.0).contains(turbidity) {
+                    self.out.push(
+                        Diagnostic::error(&at, format!("must be within [2, 10], found {turbidity}"))
+                            .with_help("the range Preetham et al. fitted: 2 very clear, 3 clear, 6 hazy, 10 thin fog"),
+                    );
+                }
+                let at = format!("{path}.ground_albedo");
+                if self.finite3(&at, *ground_albedo)
+                    && ground_albedo.iter().any(|c| !(0.0..=1.0).contains(c))
+                {
+                    self.err(
+                        &at,
+                        format!(
+                            "must be within [0, 1] per channel, found {}",
+                            fmt3(*ground_albedo)
+                        ),
+                    );
+                }
+                self.positive(&format!("{path}.scale"), *scale, "scale");
+                return;
+            }
             LightSpec::Environment {
                 radiance,
                 file,
@@ -128,6 +174,51 @@ impl<'a> Validator<'a> {
         }
     }
 
+    /// A sky's sun `Light(index)`: an index of `lights` holding a `Distant` light above the
+    /// horizon.
+    fn sky_sun(&mut self, at: &str, lights: &[LightSpec], index: usize) {
+        match lights.get(index) {
+            Some(LightSpec::Distant { direction, .. }) => {
+                if direction.iter().all(|c| c.is_finite()) && !(direction[1] > 0.0) {
+                    self.out.push(
+                        Diagnostic::error(
+                            at,
+                            format!(
+                                "the sky's sun, lights[{index}], must be above the horizon (y > 0), its direction is {}",
+                                fmt3(*direction)
+                            ),
+                        )
+                        .with_help("the sky model holds for a sun above the horizon; +y is up"),
+                    );
+                }
+            }
+            Some(other) => self.out.push(
+                Diagnostic::error(
+                    at,
+                    format!(
+                        "must name a `Distant` light, but lights[{index}] is a `{}` light",
+                        other.kind()
+                    ),
+                )
+                .with_help(
+                    "give the index of the sun's `Distant` light, or `Direction((x, y, z))`",
+                ),
+            ),
+            None => self.out.push(
+                Diagnostic::error(
+                    at,
+                    format!(
+                        "lights[{index}] does not exist: the scene has {} lights",
+                        lights.len()
+                    ),
+                )
+                .with_help(
+                    "give the index of the sun's `Distant` light, or `Direction((x, y, z))`",
+                ),
+            ),
+        }
+    }
+
     /// An intensity, irradiance or radiance of a new light: finite, not negative, positive in
     /// some channel (a black light is a mistake; remove it instead), at most
     /// [`MAX_LIGHT_POWER`].
@@ -157,8 +248,18 @@ impl<'a> Validator<'a> {
         }
     }
 
-    /// At most one environment light, and no background beside it.
+    /// At most one environment or sky light, no background beside it, and a sky's `Light(i)`
+    /// sun a `Distant` light above the horizon.
     pub(super) fn environments(&mut self, scene: &SceneFile) {
+        for (i, l) in scene.lights.iter().enumerate() {
+            if let LightSpec::Sky {
+                sun: SkySun::Light(s),
+                ..
+            } = l
+            {
+                self.sky_sun(&format!("lights[{i}].sun"), &scene.lights, *s);
+            }
+        }
         let envs: Vec<usize> = (scene.lights.iter().enumerate())
             .filter(|(_, l)| l.fills_sky())
             .map(|(i, _)| i)
@@ -168,7 +269,7 @@ impl<'a> Validator<'a> {
                 Diagnostic::error(
                     format!("lights[{second}]"),
                     format!(
-                        "a scene has at most one environment light, found {} (lights {envs:?})",
+                        "a scene has at most one environment or sky light, found {} (lights {envs:?})",
                         envs.len()
                     ),
                 )
@@ -180,7 +281,7 @@ impl<'a> Validator<'a> {
                 Diagnostic::error(
                     "render.background",
                     format!(
-                        "must be black with an environment light (which is what escaping rays see), found {}",
+                        "must be black with an environment or sky light (which is what escaping rays see), found {}",
                         fmt3(scene.render.background)
                     ),
                 )
