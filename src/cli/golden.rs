@@ -14,7 +14,7 @@ use caustic::Error;
 use caustic::farm::part_meta::settings_hash;
 use caustic::pipeline::{SceneOverrides, prepare};
 use caustic::render::RenderOptions;
-use caustic::render::golden::floor::{self, DetectionFloor};
+use caustic::render::golden::floor::{self, DetectSearch, DetectStep, DetectionFloor};
 use caustic::render::golden::{
     BatchBlocks, BatchTest, GoldenImage, GoldenMeta, PixelEstimates, render_batches, report,
 };
@@ -102,12 +102,6 @@ struct CheckArgs {
     #[arg(short, long)]
     quiet: bool,
 }
-
-/// Renders `--detect` may take to find the samples per pixel.
-const DETECT_ROUNDS: usize = 4;
-/// The prediction aims this far below the requested floor, so that the measured floor (itself
-/// an estimate) usually reaches it at the first try.
-const DETECT_AIM: f64 = 0.9;
 
 fn parse_percent(text: &str) -> Result<f64, String> {
     let t = text.trim();
@@ -357,61 +351,43 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
         let mut r = render_scene(path, &overrides, a.block, a.threads, a.quiet, None)?;
         let mut floor = DetectionFloor::of(&r.batches, a.alpha);
         if let Some(target) = a.detect {
-            // Predict the samples per pixel from the measured floor, render, measure again:
-            // the prediction (noise ∝ 1/√spp) is only approximate for the progressive
-            // integrators, whose per-pass noise grows as their radius shrinks.
-            for _ in 0..DETECT_ROUNDS {
-                let (w, h) = (r.estimates.width, r.estimates.height);
-                let scale = floor.detect_scale(w, h);
-                let side = floor.scales[scale].side;
-                let reached = floor.scales[scale].median <= target;
-                let advice = floor::recommend_spp(
-                    &floor,
-                    scale,
-                    r.meta.spp,
-                    DETECT_AIM * target,
-                    a.alpha,
-                    None,
-                    a.detect_limit,
-                );
-                let spp = match advice {
-                    None if r.meta.spp >= a.detect_limit => break,
-                    None => a.detect_limit,
-                    Some(spp) if reached && spp >= r.meta.spp => break,
-                    Some(spp) if spp == r.meta.spp => break,
-                    Some(spp) => spp,
-                };
+            let (w, h) = (r.estimates.width, r.estimates.height);
+            let mut search = DetectSearch::new(target, a.alpha, a.detect_limit);
+            while let DetectStep::Render(spp) = search.next(&floor, r.meta.spp, w, h) {
+                let scale = &floor.scales[floor.detect_scale(w, h)];
                 println!(
                     "{}: {} spp catch a change of {} % over {side}×{side} px (≈ {} % of the image) in 95 % of checks; measuring at {spp} spp",
                     path.display(),
                     r.meta.spp,
-                    report::number((1000.0 * floor.scales[scale].median).round() / 10.0),
-                    report::number(100.0 * floor::DETECT_AREA)
+                    report::number((1000.0 * scale.median).round() / 10.0),
+                    report::number(100.0 * floor::DETECT_AREA),
+                    side = scale.side
                 );
                 let mut more = overrides.clone();
                 more.samples_per_pixel = Some(spp);
                 let next = render_scene(path, &more, a.block, a.threads, a.quiet, None)?;
                 let next_floor = DetectionFloor::of(&next.batches, a.alpha);
-                let now_reached = next_floor.scales[scale].median <= target;
-                // Fewer samples are only taken when they still reach the floor.
-                if now_reached || spp > r.meta.spp {
+                let (was, now) = (
+                    search.reached(&floor, w, h),
+                    search.reached(&next_floor, w, h),
+                );
+                let kept = r.meta.spp;
+                if search.keep_new(spp, kept, now) {
                     r = next;
                     floor = next_floor;
                 }
-                if (now_reached && !reached) || (!now_reached && spp < r.meta.spp) {
+                if search.stop_after(spp, kept, was, now) {
                     break;
                 }
             }
-            let (w, h) = (r.estimates.width, r.estimates.height);
-            let scale = floor.detect_scale(w, h);
-            if floor.scales[scale].median > target {
+            if !search.reached(&floor, w, h) {
                 println!(
                     "{}: warning: {} spp do not reach a floor of {} % over {side}×{side} px (--detect-limit {})",
                     path.display(),
                     r.meta.spp,
                     report::number(100.0 * target),
                     a.detect_limit,
-                    side = floor.scales[scale].side
+                    side = floor.scales[floor.detect_scale(w, h)].side
                 );
             }
         }

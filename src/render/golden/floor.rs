@@ -186,6 +186,101 @@ pub fn recommend_spp(
     Some(hi)
 }
 
+/// Renders `--detect` may take to find the samples per pixel.
+pub const DETECT_ROUNDS: usize = 4;
+/// The prediction aims this far below the requested floor, so that the measured floor (itself
+/// an estimate) usually reaches it at the first try.
+pub const DETECT_AIM: f64 = 0.9;
+
+/// The search for the samples per pixel that reach a requested floor (`golden update
+/// --detect`): predict from the floor measured (noise ∝ 1/√spp, limits from the batch count),
+/// render there, measure again, at most [`DETECT_ROUNDS`] times. The prediction is only
+/// approximate for the progressive integrators, whose per-pass noise grows as the radius
+/// shrinks, hence the renders: the floor a golden states is always the measured one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DetectSearch {
+    /// The requested floor (0.02 for 2 %).
+    pub target: f64,
+    /// The checks' false-alarm rate.
+    pub alpha: f64,
+    /// Most samples per pixel to try.
+    pub limit: u32,
+    rounds: usize,
+}
+
+/// What to do after a render in a [`DetectSearch`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DetectStep {
+    /// Render at these samples per pixel and call [`DetectSearch::next`] with the result.
+    Render(u32),
+    /// Keep the current render.
+    Done,
+}
+
+impl DetectSearch {
+    /// A search for `target` at false-alarm rate `alpha`, trying at most `limit` spp.
+    #[must_use]
+    pub fn new(target: f64, alpha: f64, limit: u32) -> Self {
+        Self {
+            target,
+            alpha,
+            limit,
+            rounds: 0,
+        }
+    }
+
+    /// Whether `floor` (of a `width`×`height` golden) reaches the target at the detect scale.
+    #[must_use]
+    pub fn reached(&self, floor: &DetectionFloor, width: u32, height: u32) -> bool {
+        floor.scales[floor.detect_scale(width, height)].median <= self.target
+    }
+
+    /// The next step from the kept render (`floor` at `spp`).
+    pub fn next(
+        &mut self,
+        floor: &DetectionFloor,
+        spp: u32,
+        width: u32,
+        height: u32,
+    ) -> DetectStep {
+        if self.rounds >= DETECT_ROUNDS {
+            return DetectStep::Done;
+        }
+        self.rounds += 1;
+        let scale = floor.detect_scale(width, height);
+        let reached = self.reached(floor, width, height);
+        let advice = recommend_spp(
+            floor,
+            scale,
+            spp,
+            DETECT_AIM * self.target,
+            self.alpha,
+            None,
+            self.limit,
+        );
+        match advice {
+            None if spp >= self.limit => DetectStep::Done,
+            None => DetectStep::Render(self.limit),
+            Some(next) if next == spp || (reached && next > spp) => DetectStep::Done,
+            Some(next) => DetectStep::Render(next),
+        }
+    }
+
+    /// Whether a render at `tried` spp replaces the kept one at `kept` spp: more samples
+    /// always do (closer to the target); fewer only when they still reach it.
+    #[must_use]
+    pub fn keep_new(&self, tried: u32, kept: u32, new_reaches: bool) -> bool {
+        new_reaches || tried > kept
+    }
+
+    /// Whether to stop after trying `tried` spp: the target was just reached from above, or
+    /// fewer samples than the kept render's failed it.
+    #[must_use]
+    pub fn stop_after(&self, tried: u32, kept: u32, was_reached: bool, new_reaches: bool) -> bool {
+        (new_reaches && !was_reached) || (!new_reaches && tried < kept)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -217,6 +312,29 @@ mod tests {
         assert_eq!(spp, 8);
         assert!(predicted_floor(&f, 0, 2, 7, 0.01, None) > at8);
         assert_eq!(recommend_spp(&f, 0, 2, 1e-9, 0.01, None, 64), None);
+    }
+
+    #[test]
+    fn the_detect_search_renders_more_until_the_floor_is_reached_and_no_more() {
+        // The floor of the first test (K = 2 batches): far above 1 %, so render more.
+        let mut b = BatchBlocks::new(4, 4, 4);
+        b.push_batch(&[DVec3::splat(1.0); 16], 1);
+        b.push_batch(&[DVec3::splat(3.0); 16], 1);
+        let f = DetectionFloor::of(&b, 0.01);
+        let mut search = DetectSearch::new(0.5, 0.01, 1 << 16);
+        assert!(!search.reached(&f, 4, 4));
+        let DetectStep::Render(spp) = search.next(&f, 2, 4, 4) else {
+            panic!("should render more")
+        };
+        assert!(predicted_floor(&f, 0, 2, spp, 0.01, None) <= 0.45);
+        assert!(predicted_floor(&f, 0, 2, spp - 1, 0.01, None) > 0.45);
+        assert!(search.keep_new(spp, 2, false) && search.stop_after(spp, 2, false, true));
+        // Fewer samples that fail are not kept and end the search.
+        assert!(!search.keep_new(3, 8, false) && search.stop_after(3, 8, true, false));
+        // A target out of reach renders at the limit once, then stops.
+        let mut far = DetectSearch::new(1e-9, 0.01, 64);
+        assert_eq!(far.next(&f, 2, 4, 4), DetectStep::Render(64));
+        assert_eq!(far.next(&f, 64, 4, 4), DetectStep::Done);
     }
 
     #[test]
