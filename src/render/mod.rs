@@ -1,5 +1,7 @@
 //! Rendering: the render job and its tile loop, the film and its mergeable sums, image output.
 
+pub mod auto_exposure;
+pub mod error_estimate;
 pub mod exr;
 pub mod film;
 pub mod golden;
