@@ -14,6 +14,7 @@ use caustic::Error;
 use caustic::farm::part_meta::settings_hash;
 use caustic::farm::{PartMeta, Shard};
 use caustic::pipeline::prepare;
+use caustic::render::auto_exposure::{resolve, tonemap_for};
 use caustic::render::output::{OutputFormat, write_image};
 use caustic::render::passes::{CheckpointPlan, PassPlan, render_in_passes};
 use caustic::render::tonemap::Display;
@@ -108,6 +109,26 @@ pub struct RenderArgs {
     /// halves need the samples per pixel in advance) or a `.part` output.
     #[arg(long, conflicts_with_all = ["time", "shard"])]
     pub(super) denoise: bool,
+    /// Linear scale of radiance for 8-bit images (`render.exposure`). Unset, and not in the
+    /// scene: chosen from the rendered image (Reinhard et al.'s key 0.18 over the log-average
+    /// luminance, lowered so at most 1 % of the pixels clip); the summary prints it. EXR and
+    /// `.part` outputs stay linear.
+    #[arg(long, value_name = "X", value_parser = parse_positive)]
+    pub(super) exposure: Option<f32>,
+    /// Render pass after pass until the estimated relMSE of the image (from each pixel's
+    /// sample variance) is at most X, e.g. `0.01` (`render.target_error`); `--time` and
+    /// `--spp`, if given, still stop it first. The summary states the estimate reached.
+    #[arg(long, value_name = "X", value_parser = parse_positive)]
+    pub(super) target_error: Option<f32>,
+}
+
+/// A positive finite number (`--exposure`, `--target-error`).
+fn parse_positive(text: &str) -> Result<f32, String> {
+    text.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("expected a positive number such as `0.5`, found `{text}`"))
 }
 
 fn parse_layers(text: &str) -> Result<Vec<Layer>, String> {
@@ -196,6 +217,11 @@ pub(super) fn default_output(scene: &Path) -> PathBuf {
         .file_stem()
         .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
     PathBuf::from(format!("{stem}.png"))
+}
+
+/// Whether `path` is a linear EXR image (no exposure applies).
+fn is_exr(path: &Path) -> bool {
+    matches!(OutputFormat::for_path(path), Ok(OutputFormat::Exr))
 }
 
 /// Whether `path` asks for the mergeable film (`.part`).
@@ -301,10 +327,24 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         return Err(Error::Usage("--threads must be at least 1".into()));
     }
     let mut overrides = args.scene.overrides();
-    if args.time.is_some() && overrides.samples_per_pixel.is_none() {
+    if let Some(x) = args.exposure {
+        overrides.sets.push(format!("render.exposure={x:?}"));
+    }
+    if let Some(x) = args.target_error {
+        overrides.sets.push(format!("render.target_error={x:?}"));
+    }
+    // A budget or a target decides when to stop; the sample count only caps it.
+    if (args.time.is_some() || args.target_error.is_some()) && overrides.samples_per_pixel.is_none()
+    {
         overrides.samples_per_pixel = Some(BUDGET_SPP_CAP);
     }
-    let prepared = prepare(&args.scene.scene, &overrides)?;
+    let mut prepared = prepare(&args.scene.scene, &overrides)?;
+    let target_error = prepared.scene.render.target_error;
+    if target_error.is_some() && overrides.samples_per_pixel.is_none() {
+        // The scene's own `render.target_error`: compiled again with the cap (rare).
+        overrides.samples_per_pixel = Some(BUDGET_SPP_CAP);
+        prepared = prepare(&args.scene.scene, &overrides)?;
+    }
     if !args.quiet {
         print_warnings(&prepared.warnings);
     }
@@ -315,11 +355,11 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         let p = &prepared.render_scene.params;
         super::max_rmse::check_size(reference, p.width, p.height, region)?;
     }
+    // `None`: automatic, chosen from the finished film (`auto_exposure`).
+    let stated_exposure = prepared.scene.render.exposure;
     let exposure = prepared.render_scene.params.exposure;
-    let display = Display {
-        exposure,
-        tonemap: prepared.render_scene.params.tonemap,
-    };
+    let tonemap = tonemap_for(stated_exposure, prepared.scene.render.tonemap);
+    let display = Display { exposure, tonemap };
     let spp = prepared.render_scene.params.samples_per_pixel;
     let samples = match &args.samples {
         Some(r) if r.end > spp => {
@@ -393,9 +433,11 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             path,
             every: args.checkpoint_every,
             display,
+            auto_exposure: stated_exposure.is_none(),
         }),
         time_budget: args.time,
         progress: terminal,
+        target_error: target_error.map(f64::from),
     };
     let first_half = if args.denoise {
         match job.render_pass(split - taken.start) {
@@ -413,6 +455,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     };
     let outcome = render_in_passes(job, &plan);
     let saved = outcome.checkpoint_spp;
+    let error = outcome.error;
     let interrupted = || {
         let kept = match (&args.checkpoint, saved) {
             (Some(cp), Some(n)) => format!(
@@ -475,6 +518,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         }
         _ => None,
     };
+    // The display of 8-bit outputs: the stated exposure, else the finished film's own.
+    let (display, auto) = resolve(
+        denoised.as_ref().unwrap_or(&out.film),
+        stated_exposure,
+        tonemap,
+    );
+    let auto = auto.filter(|_| hash.is_none() && !is_exr(&output));
     if let Some(hash) = hash {
         let p = &prepared.render_scene.params;
         let taken =
@@ -558,6 +608,26 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         st.threads,
         if st.threads == 1 { "" } else { "s" }
     );
+    if let (Some((e, reached)), Some(target)) = (error, target_error)
+        && !args.quiet
+    {
+        eprintln!(
+            "target error {target}: {} — estimated relMSE {:.5} (its worst 1 % of pixels: {:.4}) at {reached_spp} spp in {secs:.2} s",
+            if reached {
+                "reached"
+            } else {
+                "not reached (the time or samples ran out)"
+            },
+            e.image,
+            e.worst,
+            reached_spp = reached_spp(&out),
+        );
+    }
+    if let Some(auto) = &auto
+        && !args.quiet
+    {
+        eprintln!("{}", auto.describe());
+    }
     if !pictures.is_empty() && !args.quiet {
         let names: Vec<String> = pictures
             .iter()
@@ -602,12 +672,17 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             reference,
             denoised.as_ref().unwrap_or(&out.film),
             &output,
-            exposure,
+            display.exposure,
             region,
             args.max_rmse,
         )?;
     }
     Ok(())
+}
+
+/// Samples per pixel a render output holds.
+fn reached_spp(out: &caustic::render::RenderOutput) -> u64 {
+    out.stats.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1)
 }
 
 pub(super) fn print_stats(s: &caustic::compile::CompileStats) {

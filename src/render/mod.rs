@@ -1,6 +1,8 @@
 //! Rendering: the render job and its tile loop, the film and its mergeable sums, image output.
 
+pub mod auto_exposure;
 pub mod denoised;
+pub mod error_estimate;
 pub mod exr;
 pub mod features;
 pub mod film;
@@ -17,9 +19,9 @@ pub mod tonemap;
 pub mod trace_pixel;
 pub mod wide_sum;
 
+pub use features::{FeatureSample, Features};
 pub use film::Film;
 pub use job::{RenderJob, render};
-pub use features::{FeatureSample, Features};
 pub use layer_pictures::{
     NotAPicture, layer_path, picture_layers, write_with_extras, write_with_layers,
 };

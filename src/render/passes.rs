@@ -9,6 +9,8 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use super::auto_exposure::resolve;
+use super::error_estimate::ErrorEstimate;
 use super::output::write_image;
 use super::tonemap::Display;
 use super::{RenderError, RenderJob, RenderOutput};
@@ -22,6 +24,9 @@ pub struct CheckpointPlan<'a> {
     pub every: Duration,
     /// Exposure and tone curve for 8-bit checkpoints.
     pub display: Display,
+    /// Whether the exposure is automatic: each 8-bit checkpoint then gets its own snapshot's
+    /// ([`super::auto_exposure::AutoExposure::of_film`]) instead of `display.exposure`.
+    pub auto_exposure: bool,
 }
 
 /// How to split a render into passes.
@@ -34,6 +39,9 @@ pub struct PassPlan<'a> {
     pub time_budget: Option<Duration>,
     /// Show a time-based progress bar on stderr (for budgeted renders).
     pub progress: bool,
+    /// Stop once the estimated relMSE of the image ([`ErrorEstimate`]) is at most this
+    /// (`--target-error`), or when the time budget or the samples per pixel run out first.
+    pub target_error: Option<f64>,
 }
 
 /// The result of a render in passes.
@@ -43,6 +51,9 @@ pub struct PassesOutcome {
     pub result: Result<RenderOutput, RenderError>,
     /// Samples per pixel of the last checkpoint written, if any.
     pub checkpoint_spp: Option<u32>,
+    /// With a target error: the estimate after the last pass, and whether it reached the
+    /// target.
+    pub error: Option<(ErrorEstimate, bool)>,
 }
 
 /// The shortest pass worth scheduling (a pass costs a sweep over the tiles).
@@ -62,9 +73,11 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
     let mut last_save = Instant::now();
     let mut render_time = Duration::ZERO;
     let mut pass = 1;
+    let mut error = None;
     let fail = |e, saved| PassesOutcome {
         result: Err(e),
         checkpoint_spp: saved,
+        error: None,
     };
     while job.samples_done() < spp {
         let t = Instant::now();
@@ -74,11 +87,19 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
         render_time += t.elapsed();
         let end = job.samples_done();
         let done = end - first;
+        let estimate = plan.target_error.map(|target| {
+            let e = ErrorEstimate::of_sums(job.sums());
+            (e, e.reached(target))
+        });
+        error = estimate;
         if let (Some(b), Some(budget)) = (&bar, plan.time_budget) {
             b.set_position(start.elapsed().min(budget).as_millis() as u64);
-            b.set_message(format!("{done} spp"));
+            b.set_message(match estimate {
+                Some((e, _)) => format!("{done} spp, estimated relMSE {:.4}", e.image),
+                None => format!("{done} spp"),
+            });
         }
-        if end == spp {
+        if end == spp || estimate.is_some_and(|(_, reached)| reached) {
             break;
         }
         let per_sample = render_time.as_secs_f64() / f64::from(done);
@@ -94,7 +115,10 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
         }
         if let Some(cp) = &plan.checkpoint {
             if last_save.elapsed() >= cp.every {
-                match write_image(&job.snapshot(), cp.path, cp.display) {
+                let snapshot = job.snapshot();
+                let stated = (!cp.auto_exposure).then_some(cp.display.exposure);
+                let (display, _) = resolve(&snapshot, stated, cp.display.tonemap);
+                match write_image(&snapshot, cp.path, display) {
                     Ok(()) => saved = Some(done),
                     Err(e) => eprintln!("warning: checkpoint not saved: {e}"),
                 }
@@ -109,6 +133,9 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
         } else {
             ((target.as_secs_f64() / per_sample) as u32).max(1)
         };
+        if let (Some((e, _)), Some(goal)) = (estimate, plan.target_error) {
+            pass = pass.min(samples_towards(e, goal, done));
+        }
     }
     if let Some(b) = bar {
         b.finish_and_clear();
@@ -116,7 +143,23 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
     PassesOutcome {
         result: Ok(job.into_output()),
         checkpoint_spp: saved,
+        error,
     }
+}
+
+/// The next pass's samples per pixel towards a target error: the estimate falls as 1/n, so
+/// `done · estimate / target` samples in all are expected to reach it; a pass takes the
+/// difference, at least one sample and at most as many as are done (the estimate from few
+/// samples is itself noisy, so the render at most doubles before looking again). Until every
+/// pixel has [`super::error_estimate::MIN_SAMPLES`], passes just fill up to that.
+fn samples_towards(e: ErrorEstimate, target: f64, done: u32) -> u32 {
+    use super::error_estimate::MIN_SAMPLES;
+    if e.min_samples < MIN_SAMPLES {
+        return (MIN_SAMPLES - e.min_samples).max(1);
+    }
+    let needed = f64::from(done) * e.image / target.max(f64::MIN_POSITIVE);
+    // `as` saturates.
+    ((needed - f64::from(done)).ceil() as u32).clamp(1, done.max(1))
 }
 
 fn budget_bar(plan: &PassPlan<'_>) -> Option<ProgressBar> {

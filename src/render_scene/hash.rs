@@ -33,6 +33,7 @@ use super::light::distant::DistantLight;
 use super::light::environment::{EnvironmentLight, EnvironmentMap};
 use super::light::infinite::SceneSphere;
 use super::light::rect::RectLight;
+use super::light::sky::{SkyLight, SkyModel};
 use super::light::spot::SpotLight;
 use super::light::triangle_mesh::MeshLight;
 use super::texture::{Mapping, NoiseTexture};
@@ -284,7 +285,35 @@ impl KeyHash for Light {
             Light::Spot(l) => l.key_hash(h),
             Light::Distant(l) => l.key_hash(h),
             Light::Environment(l) => l.key_hash(h),
+            Light::Sky(l) => l.key_hash(h),
         }
+    }
+}
+
+impl KeyHash for SkyLight {
+    fn key_hash(&self, h: &mut Fnv) {
+        let SkyLight {
+            model,
+            k,
+            ground,
+            map,
+        } = self;
+        let SkyModel {
+            sun,
+            turbidity,
+            zenith: (y_z, x_z, yc_z),
+            coefficients,
+        } = model;
+        h.str("Sky");
+        sun.key_hash(h);
+        turbidity.key_hash(h);
+        y_z.key_hash(h);
+        x_z.key_hash(h);
+        yc_z.key_hash(h);
+        coefficients.key_hash(h);
+        k.key_hash(h);
+        ground.key_hash(h);
+        map.key_hash(h);
     }
 }
 

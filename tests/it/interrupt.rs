@@ -328,7 +328,15 @@ mod cli {
         let mut job =
             caustic::render::RenderJob::new(&scene, &super::options(2, None, None)).expect("job");
         job.render_pass(n).expect("n samples");
-        let expected = caustic::render::output::to_srgb8(&job.snapshot(), scene.params.exposure);
+        // Cornell states no exposure: the checkpoint's is automatic, its own snapshot's.
+        let snapshot = job.snapshot();
+        let (display, auto) = caustic::render::auto_exposure::resolve(
+            &snapshot,
+            None,
+            caustic::render::auto_exposure::tonemap_for(None, None),
+        );
+        assert!(auto.is_some());
+        let expected = caustic::render::output::to_srgb8(&snapshot, display);
         let stored = img.into_rgb8();
         let differing = stored
             .pixels()

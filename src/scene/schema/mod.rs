@@ -76,11 +76,18 @@ pub struct RenderSettings {
     /// Radiance seen by rays that leave the scene.
     #[serde(deserialize_with = "exact_floats::<_, 3>")]
     pub background: Rgb,
-    /// Linear scale applied to radiance before writing 8-bit images.
-    pub exposure: f32,
-    /// Tone-mapping curve for 8-bit images, applied after `exposure`: `Linear` (clip, the
-    /// default) or `Aces` (a filmic curve). EXR output stays linear.
-    pub tonemap: Tonemap,
+    /// Linear scale applied to radiance before writing 8-bit images. Unset: chosen per image
+    /// from the rendered film (Reinhard et al. 2002's key: the log-average luminance mapped to
+    /// 0.18, lowered so at most 1 % of the pixels clip; the render summary prints it). EXR
+    /// output stays linear either way.
+    #[serde(default)]
+    pub exposure: Option<f32>,
+    /// Tone-mapping curve for 8-bit images, applied after `exposure`: `Linear` (clip) or `Aces`
+    /// (a filmic curve). Unset: `Aces` when the exposure is automatic (unset too), `Linear`
+    /// when the scene states an exposure (today's images, byte for byte). EXR output stays
+    /// linear.
+    #[serde(default)]
+    pub tonemap: Option<Tonemap>,
     /// Light-transport algorithm. Unset: the default estimator, chosen per scene — `PathPpm`
     /// (path tracing with a progressive caustic photon map, per-pass photon counts and gather
     /// sizes chosen from the image size; see docs/progressive.md) when some object's material
@@ -96,6 +103,12 @@ pub struct RenderSettings {
     pub diffuse_depth: Option<u32>,
     /// How image textures are filtered.
     pub texture_filter: TextureFilter,
+    /// Render pass after pass until the estimated relative mean squared error of the image
+    /// (from each pixel's sample variance; docs/convergence.md) is at most this, e.g. 0.01;
+    /// `--time` and `--spp` still stop it first (without `--spp` the scene's
+    /// `samples_per_pixel` gives way to the target). Unset: render every sample.
+    #[serde(default)]
+    pub target_error: Option<f32>,
 }
 
 impl Default for RenderSettings {
@@ -109,12 +122,13 @@ impl Default for RenderSettings {
             light_samples: 1,
             seed: 0,
             background: [0.0; 3],
-            exposure: 1.0,
-            tonemap: Tonemap::Linear,
+            exposure: None,
+            tonemap: None,
             integrator: None,
             sampler: SamplerKind::Sobol,
             diffuse_depth: None,
             texture_filter: TextureFilter::Anisotropic,
+            target_error: None,
         }
     }
 }

@@ -56,7 +56,16 @@ impl<'a> Validator<'a> {
                 format!("must not be negative, found {}", fmt3(r.background)),
             );
         }
-        self.positive("render.exposure", r.exposure, "exposure");
+        if let Some(exposure) = r.exposure {
+            self.positive("render.exposure", exposure, "exposure");
+        }
+        if let Some(target) = r.target_error {
+            self.positive(
+                "render.target_error",
+                target,
+                "the target relMSE (e.g. 0.01)",
+            );
+        }
     }
 
     pub(super) fn camera(&mut self, c: &CameraSpec) {
