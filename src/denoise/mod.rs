@@ -114,10 +114,7 @@ pub fn denoise(input: &DenoiseInput, params: &DenoiseParams) -> Result<Vec<Vec3>
         radius: params.radius,
         patch: params.patch,
     };
-    let filtered = [
-        cross_filter(&guided, 0, Some(&guide_planes), &candidates, w, h),
-        cross_filter(&guided, 1, Some(&guide_planes), &candidates, w, h),
-    ];
+    let filtered = cross_filter(&guided, Some(&guide_planes), &candidates, w, h);
     let mut out = select(&input.guided, &filtered, albedo, shares, params, w, h);
     if let Some(unguided) = &input.unguided {
         let planes = LayerPlanes::new(unguided, albedo);
@@ -126,10 +123,7 @@ pub fn denoise(input: &DenoiseInput, params: &DenoiseParams) -> Result<Vec<Vec3>
             radius: params.unguided_radius,
             patch: params.patch,
         };
-        let filtered = [
-            cross_filter(&planes, 0, None, &candidates, w, h),
-            cross_filter(&planes, 1, None, &candidates, w, h),
-        ];
+        let filtered = cross_filter(&planes, None, &candidates, w, h);
         let c = select(unguided, &filtered, albedo, shares, params, w, h);
         for (o, c) in out.iter_mut().zip(c) {
             *o += c;
