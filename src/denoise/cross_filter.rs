@@ -13,14 +13,14 @@
 
 use rayon::prelude::*;
 
-use super::DenoiseParams;
 use super::fast_exp::exp_neg;
 use super::input::{Guide, HalfBuffers};
 use super::planes::box_rows;
+use super::DenoiseParams;
 
 /// Rows per work item: a fixed split (not by thread count), so any thread count gives the same
 /// bytes.
-const BAND: usize = 8;
+const BAND: usize = 16;
 /// Keeps the colour distance finite where both variances are zero (a noise-free pixel): any
 /// real difference then gives a distance far beyond the weights' range.
 const EPS: f32 = 1e-30;
@@ -57,8 +57,7 @@ impl LayerPlanes {
                 .map(|(v, a)| v[ch] / a.powi(power))
                 .collect()
         };
-        let half =
-            |values: &[glam::Vec3], power| std::array::from_fn(|ch| plane(values, ch, power));
+        let half = |values: &[glam::Vec3], power| std::array::from_fn(|ch| plane(values, ch, power));
         Self {
             c: std::array::from_fn(|h| half(&layer.mean[h], 1)),
             v: std::array::from_fn(|h| half(&layer.variance[h], 2)),
@@ -106,14 +105,8 @@ impl GuidePlanes {
                     let s = diff(a).min(diff(b));
                     if s.is_finite() { s } else { 0.0 }
                 };
-                let gx = one_sided(
-                    x.checked_sub(1).map(|_| i - 1),
-                    (x + 1 < w).then_some(i + 1),
-                );
-                let gy = one_sided(
-                    y.checked_sub(1).map(|_| i - w),
-                    (y + 1 < h).then_some(i + w),
-                );
+                let gx = one_sided(x.checked_sub(1).map(|_| i - 1), (x + 1 < w).then_some(i + 1));
+                let gy = one_sided(y.checked_sub(1).map(|_| i - w), (y + 1 < h).then_some(i + w));
                 gx.max(gy)
             })
             .collect();
@@ -132,137 +125,187 @@ impl GuidePlanes {
         }
     }
 
-    /// The feature distance of pixels `p` and `q`, `steps` pixels apart (|dx| + |dy|).
-    #[inline]
-    fn distance(&self, p: usize, q: usize, steps: f32) -> f32 {
-        let cancel = |a: f32, b: f32| a + a.min(b);
-        let vec_d = |f: &[Vec<f32>; 3], v: &[f32], sigma2: f32| {
-            let mut d2 = 0.0;
-            for c in f {
-                let t = c[p] - c[q];
-                d2 += t * t;
+    /// The feature distances of the pixels from `p_at` on to those from `q_at` on, `steps`
+    /// pixels apart (|dx| + |dy|), into `out` (one per pixel).
+    fn distances(&self, p_at: usize, q_at: usize, steps: f32, out: &mut [f32]) {
+        let len = out.len();
+        let (ps, qs) = (p_at..p_at + len, q_at..q_at + len);
+        // Depth first: it sets every distance.
+        let (dp, dq) = (&self.depth[ps.clone()], &self.depth[qs.clone()]);
+        let (vp, vq) = (&self.depth_var[ps.clone()], &self.depth_var[qs.clone()]);
+        let slope = &self.slope[ps.clone()];
+        for (((((o, &a), &b), &va), &vb), &g) in
+            out.iter_mut().zip(dp).zip(dq).zip(vp).zip(vq).zip(slope)
+        {
+            let s = self.sigma_depth * a.abs() + g * steps + 1e-6;
+            let t = a - b;
+            *o = (t * t - (va + va.min(vb))).max(0.0) / (s * s + va + vb);
+        }
+        let features = [
+            (&self.albedo, &self.albedo_var, self.sigma_albedo2),
+            (&self.normal, &self.normal_var, self.sigma_normal2),
+        ];
+        for (f, v, sigma2) in features {
+            let (f0p, f0q) = (&f[0][ps.clone()], &f[0][qs.clone()]);
+            let (f1p, f1q) = (&f[1][ps.clone()], &f[1][qs.clone()]);
+            let (f2p, f2q) = (&f[2][ps.clone()], &f[2][qs.clone()]);
+            let (vp, vq) = (&v[ps.clone()], &v[qs.clone()]);
+            for i in 0..len {
+                let (t0, t1, t2) = (f0p[i] - f0q[i], f1p[i] - f1q[i], f2p[i] - f2q[i]);
+                let (va, vb) = (vp[i], vq[i]);
+                let d2 = t0 * t0 + t1 * t1 + t2 * t2;
+                let d = (d2 - (va + va.min(vb))).max(0.0) / (sigma2 + va + vb);
+                out[i] = out[i].max(d);
             }
-            (d2 - cancel(v[p], v[q])).max(0.0) / (sigma2 + v[p] + v[q])
-        };
-        let da = vec_d(&self.albedo, &self.albedo_var, self.sigma_albedo2);
-        let dn = vec_d(&self.normal, &self.normal_var, self.sigma_normal2);
-        let (dp, dq) = (self.depth[p], self.depth[q]);
-        let s = self.sigma_depth * dp.abs() + self.slope[p] * steps + 1e-6;
-        let (vp, vq) = (self.depth_var[p], self.depth_var[q]);
-        let dd = ((dp - dq) * (dp - dq) - cancel(vp, vq)).max(0.0) / (s * s + vp + vq);
-        da.max(dn).max(dd)
+        }
     }
 }
 
-/// Per candidate and channel, the filtered half `half` less that half (albedo-divided):
+/// Per candidate and channel, the filtered half less that half (albedo-divided):
 /// `[candidate][channel][pixel]`.
 pub type Deltas = [[Vec<f32>; 3]; CANDIDATES];
 
-/// Filters half `half` of `layer` with each candidate, weights from the other half and, when
-/// given, the feature guide. Runs on the current rayon pool in fixed bands of rows.
+/// Filters both halves of `layer` with each candidate: half 0 with weights from half 1 and the
+/// other way round, with the feature guide when given. Runs on the current rayon pool in fixed
+/// bands of rows.
 #[must_use]
 pub fn cross_filter(
     layer: &LayerPlanes,
-    half: usize,
     guide: Option<&GuidePlanes>,
     candidates: &Candidates,
     w: usize,
     h: usize,
-) -> Deltas {
+) -> [Deltas; 2] {
     let bands: Vec<usize> = (0..h).step_by(BAND).collect();
-    let parts: Vec<Deltas> = bands
+    let parts: Vec<[Deltas; 2]> = bands
         .par_iter()
-        .map(|&y0| filter_band(layer, half, guide, candidates, w, h, y0..(y0 + BAND).min(h)))
+        .map(|&y0| filter_band(layer, guide, candidates, w, h, y0..(y0 + BAND).min(h)))
         .collect();
-    std::array::from_fn(|k| {
-        std::array::from_fn(|ch| {
-            parts
-                .iter()
-                .flat_map(|p| p[k][ch].iter().copied())
-                .collect()
+    std::array::from_fn(|half| {
+        std::array::from_fn(|k| {
+            std::array::from_fn(|ch| {
+                parts
+                    .iter()
+                    .flat_map(|p| p[half][k][ch].iter().copied())
+                    .collect()
+            })
         })
     })
+}
+
+/// Adds the colour distance of the pixels of `row` (row `y`) to those `dx, dy` away, in the
+/// guiding half's planes `c`, `v`, for the columns `xs` (all of whose neighbours are inside).
+#[inline]
+fn colour_distance(
+    c: &[Vec<f32>; 3],
+    v: &[Vec<f32>; 3],
+    p_at: usize,
+    q_at: usize,
+    len: usize,
+    row: &mut [f32],
+) {
+    for ch in 0..3 {
+        let (yp, yq) = (&c[ch][p_at..p_at + len], &c[ch][q_at..q_at + len]);
+        let (vp, vq) = (&v[ch][p_at..p_at + len], &v[ch][q_at..q_at + len]);
+        for ((((d, &a), &b), &va), &vb) in row.iter_mut().zip(yp).zip(yq).zip(vp).zip(vq) {
+            let t = a - b;
+            *d += (t * t - (va + va.min(vb))) / (EPS + va + vb);
+        }
+    }
 }
 
 /// [`cross_filter`] for the rows `rows`.
 fn filter_band(
     layer: &LayerPlanes,
-    half: usize,
     guide: Option<&GuidePlanes>,
     cand: &Candidates,
     w: usize,
     h: usize,
     rows: std::ops::Range<usize>,
-) -> Deltas {
+) -> [Deltas; 2] {
     let (r, f) = (cand.radius as isize, cand.patch);
     let n = rows.len() * w;
-    let inv_k2 = cand.k.map(|k| 1.0 / (k * k).max(1e-12));
-    let (cy, vy, cx) = (&layer.c[1 - half], &layer.v[1 - half], &layer.c[half]);
+    let inv_k2 = cand.k.map(|k| 1.0 / (3.0 * (k * k).max(1e-12)));
     let (p0, p1) = (rows.start.saturating_sub(f), (rows.end + f).min(h));
-    let mut dist = vec![0.0f32; (p1 - p0) * w];
-    let mut patch = vec![0.0f32; n];
+    // Per half: the colour distance of its guide (the other half), and its patch average.
+    let mut dist = [vec![0.0f32; (p1 - p0) * w], vec![0.0f32; (p1 - p0) * w]];
+    let mut patch = [vec![0.0f32; n], vec![0.0f32; n]];
     let mut scratch = Vec::new();
-    let mut acc: Deltas = std::array::from_fn(|_| std::array::from_fn(|_| vec![0.0; n]));
-    let mut wsum = [vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]];
+    let mut df = vec![0.0f32; w];
+    let mut wt = vec![0.0f32; w];
+    let zero = || -> Deltas { std::array::from_fn(|_| std::array::from_fn(|_| vec![0.0; n])) };
+    let mut acc = [zero(), zero()];
+    let mut wsum: [[Vec<f32>; CANDIDATES]; 2] =
+        std::array::from_fn(|_| std::array::from_fn(|_| vec![0.0; n]));
     for dy in -r..=r {
         for dx in -r..=r {
-            let xs = (-dx).max(0) as usize..(w as isize - dx.max(0)) as usize;
-            if xs.is_empty() {
+            let x0 = (-dx).max(0) as usize;
+            let x1 = (w as isize - dx.max(0)).max(0) as usize;
+            if x1 <= x0 {
                 continue;
             }
-            // The colour distance of every pixel the band's patches cover.
-            dist.fill(0.0);
-            for y in p0..p1 {
-                let qy = y as isize + dy;
-                if qy < 0 || qy >= h as isize {
-                    continue;
-                }
-                let (pr, qr) = (y * w, qy as usize * w);
-                let row = &mut dist[(y - p0) * w..(y - p0 + 1) * w];
-                for ch in 0..3 {
-                    let (yp, yq) = (&cy[ch][pr..pr + w], &cy[ch][qr..qr + w]);
-                    let (vp, vq) = (&vy[ch][pr..pr + w], &vy[ch][qr..qr + w]);
-                    for x in xs.clone() {
-                        let xq = (x as isize + dx) as usize;
-                        let t = yp[x] - yq[xq];
-                        let (a, b) = (vp[x], vq[xq]);
-                        row[x] += (t * t - (a + a.min(b))) / (EPS + a + b);
+            let len = x1 - x0;
+            // The colour distance of every pixel the band's patches cover, for each half's
+            // guide (the other half).
+            for (half, d) in dist.iter_mut().enumerate() {
+                d.fill(0.0);
+                let (c, v) = (&layer.c[1 - half], &layer.v[1 - half]);
+                for y in p0..p1 {
+                    let qy = y as isize + dy;
+                    if qy < 0 || qy >= h as isize {
+                        continue;
                     }
+                    let p_at = y * w + x0;
+                    let q_at = (qy as usize * w + x0) as isize + dx;
+                    let row = &mut d[(y - p0) * w + x0..(y - p0) * w + x1];
+                    colour_distance(c, v, p_at, q_at as usize, len, row);
                 }
+                box_rows(d, p0, w, h, f, rows.clone(), &mut scratch, &mut patch[half]);
             }
-            box_rows(&dist, p0, w, h, f, rows.clone(), &mut scratch, &mut patch);
             let steps = (dx.abs() + dy.abs()) as f32;
             for y in rows.clone() {
                 let qy = y as isize + dy;
                 if qy < 0 || qy >= h as isize {
                     continue;
                 }
-                let (pr, qr, br) = (y * w, qy as usize * w, (y - rows.start) * w);
-                for x in xs.clone() {
-                    let (p, q, i) = (pr + x, qr + (x as isize + dx) as usize, br + x);
-                    let dc = (patch[i] * (1.0 / 3.0)).max(0.0);
-                    let df = guide.map_or(0.0, |g| g.distance(p, q, steps));
-                    let diff = [
-                        cx[0][q] - cx[0][p],
-                        cx[1][q] - cx[1][p],
-                        cx[2][q] - cx[2][p],
-                    ];
+                let p_at = y * w + x0;
+                let q_at = ((qy as usize * w + x0) as isize + dx) as usize;
+                let b_at = (y - rows.start) * w + x0;
+                let df = &mut df[..len];
+                match guide {
+                    Some(g) => g.distances(p_at, q_at, steps, df),
+                    None => df.fill(0.0),
+                }
+                for half in 0..2 {
+                    let cx = &layer.c[half];
+                    let dc = &patch[half][b_at..b_at + len];
                     for k in 0..CANDIDATES {
-                        let wt = exp_neg((dc * inv_k2[k]).max(df));
-                        wsum[k][i] += wt;
+                        let wt = &mut wt[..len];
+                        for ((o, &d), &e) in wt.iter_mut().zip(dc).zip(df.iter()) {
+                            *o = exp_neg((d * inv_k2[k]).max(e));
+                        }
+                        for (s, &o) in wsum[half][k][b_at..b_at + len].iter_mut().zip(wt.iter()) {
+                            *s += o;
+                        }
                         for ch in 0..3 {
-                            acc[k][ch][i] += wt * diff[ch];
+                            let (cp, cq) = (&cx[ch][p_at..p_at + len], &cx[ch][q_at..q_at + len]);
+                            let a = &mut acc[half][k][ch][b_at..b_at + len];
+                            for (((a, &o), &p), &q) in a.iter_mut().zip(wt.iter()).zip(cp).zip(cq) {
+                                *a += o * (q - p);
+                            }
                         }
                     }
                 }
             }
         }
     }
-    for k in 0..CANDIDATES {
-        for ch in 0..3 {
-            for (a, s) in acc[k][ch].iter_mut().zip(&wsum[k]) {
-                // Σw ≥ 1: the pixel itself has weight 1.
-                *a /= s.max(1.0);
+    for half in 0..2 {
+        for k in 0..CANDIDATES {
+            for ch in 0..3 {
+                for (a, s) in acc[half][k][ch].iter_mut().zip(&wsum[half][k]) {
+                    // Σw ≥ 1: the pixel itself has weight 1.
+                    *a /= s.max(1.0);
+                }
             }
         }
     }

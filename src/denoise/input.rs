@@ -44,11 +44,12 @@ pub struct DenoiseInput {
     pub height: usize,
     /// Samples in each half (all pixels alike), which weigh the halves in the output.
     pub half_samples: [u32; 2],
-    /// The light the features guide: the image less its caustic light, or the whole image.
+    /// The light the features guide: the image less its unguided light, or the whole image.
     pub guided: HalfBuffers,
-    /// The caustic light (through mirrors or glass onto a diffuse surface), filtered by its own
-    /// colour and variance only; `None` when the image is not split.
-    pub caustic: Option<HalfBuffers>,
+    /// The light the features do not follow: caustic (through mirrors or glass onto a diffuse
+    /// surface) and specular (emitters seen directly or through mirrors and glass), filtered by
+    /// its own colour and variance only; `None` when the image is not split.
+    pub unguided: Option<HalfBuffers>,
     /// The feature guide (required).
     pub features: Option<Guide>,
 }
@@ -116,7 +117,7 @@ impl DenoiseInput {
                 .unwrap_or(v.min_element())
         };
         let layers = std::iter::once(("light", &self.guided))
-            .chain(self.caustic.as_ref().map(|c| ("caustic light", c)));
+            .chain(self.unguided.as_ref().map(|c| ("unguided light", c)));
         for (name, layer) in layers {
             for half in 0..2 {
                 let mean = format!("{name} (half {half} mean)");

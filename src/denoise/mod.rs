@@ -16,9 +16,13 @@
 //! light sampling and are nearly noise-free ([`input::Guide`]).
 //!
 //! Caustics: the light the renderer marks as caustic (through mirrors or glass onto a diffuse
-//! surface) is given separately ([`DenoiseInput::caustic`]) and filtered with its own variance
-//! and colour weights only, never guided by albedo or normal, which it follows neither; the
-//! rest of the light is filtered with the feature guidance. Their sum is the image.
+//! surface), and the specular light (emitters seen through mirrors and glass: highlights), are
+//! given separately ([`DenoiseInput::unguided`]) and filtered with their own variance and
+//! colour weights only, never guided by albedo or normal, which they follow neither; the rest
+//! of the light is filtered with the feature guidance. Their sum is the image. Last, what a
+//! filter removed is given back where the two halves agree it was structure rather than noise
+//! (a Wiener gain on the box-averaged residuals of both halves, [`select`]): a caustic's or a
+//! shadow's local mean survives even where no feature marks it.
 //!
 //! The module knows nothing of scenes or renders: plain arrays in, an image out. Every pixel's
 //! arithmetic runs in a fixed order in bands of rows whose split does not depend on the thread
@@ -47,15 +51,15 @@ use select::select;
 pub struct DenoiseParams {
     /// Search window radius in pixels for the guided light ((2r+1)² neighbours).
     pub radius: usize,
-    /// Search window radius for the caustic light.
-    pub caustic_radius: usize,
+    /// Search window radius for the unguided (caustic and specular) light.
+    pub unguided_radius: usize,
     /// Patch radius of the colour distance (non-local means).
     pub patch: usize,
     /// Candidate colour bandwidths `k` of the guided light (larger: smoother), from which the
     /// cross-validation picks per pixel.
     pub guided_k: [f32; 3],
-    /// Candidate colour bandwidths of the caustic light.
-    pub caustic_k: [f32; 3],
+    /// Candidate colour bandwidths of the unguided light.
+    pub unguided_k: [f32; 3],
     /// Albedo difference (Euclidean, RGB) at which the feature weight is 1/e.
     pub sigma_albedo: f32,
     /// Normal difference (Euclidean between unit normals; 0.2 ≈ 11.5°) at which it is 1/e.
@@ -64,6 +68,9 @@ pub struct DenoiseParams {
     pub sigma_depth: f32,
     /// Radius of the box filter that smooths the error estimates before the per-pixel choice.
     pub select_radius: usize,
+    /// Radius of the box over which the residual is averaged before the structure the halves
+    /// agree on is given back ([`select`]'s last step).
+    pub residual_radius: usize,
     /// Added to the albedo before the light is divided by it (keeps black surfaces and
     /// emitters, of albedo 0, filtered as plain radiance).
     pub albedo_epsilon: f32,
@@ -73,21 +80,22 @@ impl Default for DenoiseParams {
     fn default() -> Self {
         Self {
             radius: 7,
-            caustic_radius: 5,
+            unguided_radius: 5,
             patch: 2,
             guided_k: [0.5, 1.0, 2.0],
-            caustic_k: [0.35, 0.7, 1.4],
+            unguided_k: [0.35, 0.7, 1.4],
             sigma_albedo: 0.05,
             sigma_normal: 0.2,
             sigma_depth: 0.02,
             select_radius: 3,
+            residual_radius: 3,
             albedo_epsilon: 0.01,
         }
     }
 }
 
 /// Denoises `input` (on the current rayon pool): the guided light filtered with the feature
-/// weights plus the caustic light filtered by its colour alone, each by the candidate the two
+/// weights plus the unguided (caustic and specular) light filtered by its colour alone, each by the candidate the two
 /// halves' cross-validation picks per pixel. Row-major RGB, `width × height`.
 ///
 /// # Errors
@@ -109,26 +117,21 @@ pub fn denoise(input: &DenoiseInput, params: &DenoiseParams) -> Result<Vec<Vec3>
         radius: params.radius,
         patch: params.patch,
     };
-    let filtered = [
-        cross_filter(&guided, 0, Some(&guide_planes), &candidates, w, h),
-        cross_filter(&guided, 1, Some(&guide_planes), &candidates, w, h),
-    ];
+    let filtered = cross_filter(&guided, Some(&guide_planes), &candidates, w, h);
     let mut out = select(&input.guided, &filtered, albedo, shares, params, w, h);
-    if let Some(caustic) = &input.caustic {
-        let planes = LayerPlanes::new(caustic, albedo);
+    if let Some(unguided) = &input.unguided {
+        let planes = LayerPlanes::new(unguided, albedo);
         let candidates = Candidates {
-            k: params.caustic_k,
-            radius: params.caustic_radius,
+            k: params.unguided_k,
+            radius: params.unguided_radius,
             patch: params.patch,
         };
-        let filtered = [
-            cross_filter(&planes, 0, None, &candidates, w, h),
-            cross_filter(&planes, 1, None, &candidates, w, h),
-        ];
-        let c = select(caustic, &filtered, albedo, shares, params, w, h);
+        let filtered = cross_filter(&planes, None, &candidates, w, h);
+        let c = select(unguided, &filtered, albedo, shares, params, w, h);
         for (o, c) in out.iter_mut().zip(c) {
             *o += c;
         }
     }
     Ok(out)
 }
+

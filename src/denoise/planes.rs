@@ -5,8 +5,9 @@
 /// `r`, clamped at the image edges (each output is the mean of the in-image values), into
 /// `out` (rows `rows`, row-major from `rows.start`). `h` is the image height: rows of the
 /// window outside `first..first + src.len() / w` must not be needed (the caller gives
-/// `first ≤ rows.start − r` or 0, and enough rows below). `scratch` holds one row per source
-/// row.
+/// `first ≤ rows.start − r` or 0, and enough rows below). `scratch` holds one row.
+/// Each sum is taken over its own window (no running sum: a huge value leaving the window
+/// would take the small ones added after it with it).
 pub fn box_rows(
     src: &[f32],
     first: usize,
@@ -19,29 +20,38 @@ pub fn box_rows(
 ) {
     let have = src.len() / w;
     scratch.clear();
-    scratch.resize(src.len(), 0.0);
-    // Horizontal sums, each over its own window (no running sum: a huge value leaving the
-    // window would take the small ones added after it with it).
-    for (row, hs) in src.chunks_exact(w).zip(scratch.chunks_exact_mut(w)) {
-        for (x, o) in hs.iter_mut().enumerate() {
-            *o = row[x.saturating_sub(r)..=(x + r).min(w - 1)].iter().sum();
-        }
-    }
+    scratch.resize(w, 0.0);
     for y in rows.clone() {
         let top = y.saturating_sub(r).max(first);
         let bottom = (y + r).min(h - 1).min(first + have - 1);
-        let o = &mut out[(y - rows.start) * w..(y - rows.start + 1) * w];
-        o.fill(0.0);
+        // Vertical sum into the scratch row.
+        let v = &mut scratch[..w];
+        v.fill(0.0);
         for yy in top..=bottom {
-            let hs = &scratch[(yy - first) * w..(yy - first + 1) * w];
-            for (o, v) in o.iter_mut().zip(hs) {
-                *o += v;
+            for (o, s) in v.iter_mut().zip(&src[(yy - first) * w..(yy - first + 1) * w]) {
+                *o += s;
+            }
+        }
+        // Horizontal sum of shifted copies, then the mean.
+        let o = &mut out[(y - rows.start) * w..(y - rows.start + 1) * w];
+        o.copy_from_slice(v);
+        for j in 1..=r.min(w - 1) {
+            for (o, s) in o[j..].iter_mut().zip(&v[..w - j]) {
+                *o += s;
+            }
+            for (o, s) in o[..w - j].iter_mut().zip(&v[j..]) {
+                *o += s;
             }
         }
         let ny = (bottom + 1 - top) as f32;
+        let full = 1.0 / ((2 * r + 1).min(w) as f32 * ny);
         for (x, o) in o.iter_mut().enumerate() {
-            let nx = ((x + r).min(w - 1) + 1 - x.saturating_sub(r)) as f32;
-            *o /= nx * ny;
+            if x >= r && x + r < w {
+                *o *= full;
+            } else {
+                let nx = ((x + r).min(w - 1) + 1 - x.saturating_sub(r)) as f32;
+                *o /= nx * ny;
+            }
         }
     }
 }

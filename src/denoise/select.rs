@@ -48,7 +48,7 @@ pub fn select(
             .collect();
         box_filter(&raw, w, h, params.select_radius)
     });
-    (0..n)
+    let out: Vec<Vec3> = (0..n)
         .map(|i| {
             let mut best = 0;
             for k in 1..CANDIDATES {
@@ -59,5 +59,41 @@ pub fn select(
             let (fa, fb) = filtered(best, i);
             fa + shares[1] * (fb - fa)
         })
-        .collect()
+        .collect();
+    restore_structure(out, layer, shares, params.residual_radius, w, h)
+}
+
+/// Gives back what the filter removed where the two halves agree it was structure, not noise:
+/// the residuals `A − F` and `B − F`, box-averaged, have independent noise, so the product of
+/// the two averages estimates the squared bias of the output (the structure it smoothed away)
+/// and their mean's square that plus the noise; their ratio is a Wiener gain in [0, 1] by which
+/// the averaged residual is added back. Where the filter removed only noise the gain is near 0;
+/// a smoothed caustic or shadow edge gets its local mean back. Exactly `out` where the
+/// residuals are zero (a noise-free or constant image).
+fn restore_structure(
+    mut out: Vec<Vec3>,
+    layer: &HalfBuffers,
+    shares: [f32; 2],
+    radius: usize,
+    w: usize,
+    h: usize,
+) -> Vec<Vec3> {
+    let [ma, mb] = &layer.mean;
+    for ch in 0..3 {
+        let ra: Vec<f32> = (0..out.len()).map(|i| ma[i][ch] - out[i][ch]).collect();
+        let rb: Vec<f32> = (0..out.len()).map(|i| mb[i][ch] - out[i][ch]).collect();
+        // A tent (a box twice): a box's square edges would show around a bright residual.
+        let tent = |r: &[f32]| box_filter(&box_filter(r, w, h, radius), w, h, radius);
+        let (ba, bb) = (tent(&ra), tent(&rb));
+        for (i, o) in out.iter_mut().enumerate() {
+            let (a, b) = (ba[i], bb[i]);
+            let mean = shares[0] * a + shares[1] * b;
+            let m2 = mean * mean;
+            if m2 > 0.0 {
+                let gain = ((a * b).max(0.0) / m2).min(1.0);
+                o[ch] += gain * mean;
+            }
+        }
+    }
+    out
 }

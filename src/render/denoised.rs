@@ -3,8 +3,9 @@
 //! renders the first half, the caller keeps a copy of its sums, then the job takes the rest:
 //! the finished film is the same bytes as without the stop, [`super::RenderJob`]), so the
 //! second half is the whole less the first, worked out from the means, variances and counts
-//! in `f64`. With the light-path layers kept, the caustic light is handed to the denoiser on
-//! its own (filtered without feature guidance) and the rest of the light as the guided part.
+//! in `f64`. With the light-path layers kept, the caustic and specular light is handed to the
+//! denoiser on its own (filtered without feature guidance: the features follow neither) and
+//! the direct and indirect light as the guided part.
 //! The features ([`Features`]) are traced over the same samples and split at the same index.
 
 use glam::{DVec3, Vec3};
@@ -65,18 +66,24 @@ pub fn denoise_render(
         }
     }
     let n = w as usize * h as usize;
-    let caustic = LightPath::Caustic as usize;
-    let (guided, caustic) = match (all_parts, first.parts.as_deref()) {
+    let (guided, unguided) = match (all_parts, first.parts.as_deref()) {
         (Some(all_parts), Some(first_parts)) => {
-            let others: Vec<usize> = (0..all_parts.len()).filter(|&p| p != caustic).collect();
-            let guided = halves_of(n, |i, into| {
-                for &p in &others {
-                    into.add(split(&all_parts[p], &first_parts[p], i));
+            let (mut unguided, mut others) = (Vec::new(), Vec::new());
+            for (p, &kind) in LightPath::ALL.iter().enumerate().take(all_parts.len()) {
+                match kind {
+                    LightPath::Caustic | LightPath::Specular => unguided.push(p),
+                    LightPath::Direct | LightPath::Indirect => others.push(p),
                 }
-            });
-            let c = halves_of(n, |i, into| {
-                into.add(split(&all_parts[caustic], &first_parts[caustic], i));
-            });
+            }
+            let layer = |which: &[usize]| {
+                halves_of(n, |i, into| {
+                    for &p in which {
+                        into.add(split(&all_parts[p], &first_parts[p], i));
+                    }
+                })
+            };
+            let guided = layer(&others);
+            let c = layer(&unguided);
             (guided, Some(c))
         }
         (None, None) => (
@@ -98,7 +105,7 @@ pub fn denoise_render(
         height: h as usize,
         half_samples: counts,
         guided,
-        caustic,
+        unguided,
         features: Some(guide(features)),
     };
     let threads = threads.unwrap_or_else(rayon::current_num_threads).max(1);
@@ -198,3 +205,4 @@ fn guide(f: &Features) -> Guide {
     }
     g
 }
+
