@@ -182,6 +182,49 @@ fn lane_t(near: &[f32; WIDTH], c: usize) -> f32 {
     near[c & (WIDTH - 1)]
 }
 
+/// Runs `query(test, stack)` on the thread's traversal stack that `pick` chooses, or on a fresh
+/// one if that stack is in use (a `test` callback that itself traces a ray) or the thread is
+/// shutting down.
+#[inline(always)]
+fn on_thread_stack<E: Copy + Default, T, R>(
+    test: T,
+    pick: impl FnOnce(&mut Stacks) -> &mut [E; STACK_SMALL],
+    query: impl Fn(T, &mut [E; STACK_SMALL]) -> R,
+) -> R {
+    let mut test = Some(test);
+    let done = STACKS.try_with(|cell| {
+        let mut stacks = cell.try_borrow_mut().ok()?;
+        let test = test.take()?;
+        Some(query(test, pick(&mut stacks)))
+    });
+    match (done, test) {
+        (Ok(Some(r)), _) => r,
+        (_, Some(test)) => query(test, &mut [E::default(); STACK_SMALL]),
+        (_, None) => unreachable!("the callback is only taken when the query runs"),
+    }
+}
+
+/// `by_octant!(ray, OCT => expr)`: `expr` with the constant `OCT` set to the ray's octant
+/// (0–7), so that each octant gets its own copy of the traversal loop with the slab planes at
+/// fixed offsets (closest and any-hit share it).
+macro_rules! by_octant {
+    ($ray:expr, $oct:ident => $e:expr) => {
+        by_octant!(@arms $ray, $oct => $e; 0 1 2 3 4 5 6)
+    };
+    (@arms $ray:expr, $oct:ident => $e:expr; $($k:literal)*) => {
+        match $ray.octant() {
+            $($k => {
+                const $oct: usize = $k;
+                $e
+            })*
+            _ => {
+                const $oct: usize = 7;
+                $e
+            }
+        }
+    };
+}
+
 impl Bvh {
     /// Visits every leaf the ray may reach before `t_max`, nearest child first.
     /// `test(first, count, t_max)` intersects the primitives in slots `first .. first + count`
@@ -201,20 +244,11 @@ impl Bvh {
             let stack = &mut [Entry::default(); STACK_MAX];
             return self.closest_with::<STACK_MAX, 8>(ray, t_max, test, stack);
         }
-        // The thread's stack, or a fresh one if a `test` callback is itself tracing a ray.
-        let mut test = Some(test);
-        let done = STACKS.try_with(|cell| {
-            let mut stacks = cell.try_borrow_mut().ok()?;
-            let test = test.take()?;
-            Some(self.closest_octant(ray, t_max, test, &mut stacks.closest))
-        });
-        match (done, test) {
-            (Ok(Some(t)), _) => t,
-            (_, Some(test)) => {
-                self.closest_octant(ray, t_max, test, &mut [Entry::default(); STACK_SMALL])
-            }
-            (_, None) => unreachable!("the callback is only taken when the query runs"),
-        }
+        on_thread_stack(
+            test,
+            |stacks| &mut stacks.closest,
+            |test, stack| self.closest_octant(ray, t_max, test, stack),
+        )
     }
 
     /// [`Bvh::closest`] with one copy of the loop per ray octant, so the slab planes are fixed
@@ -227,16 +261,7 @@ impl Bvh {
         test: impl FnMut(u32, u32, f32) -> Option<f32>,
         stack: &mut [Entry; STACK_SMALL],
     ) -> f32 {
-        match ray.octant() {
-            0 => self.closest_with::<STACK_SMALL, 0>(ray, t_max, test, stack),
-            1 => self.closest_with::<STACK_SMALL, 1>(ray, t_max, test, stack),
-            2 => self.closest_with::<STACK_SMALL, 2>(ray, t_max, test, stack),
-            3 => self.closest_with::<STACK_SMALL, 3>(ray, t_max, test, stack),
-            4 => self.closest_with::<STACK_SMALL, 4>(ray, t_max, test, stack),
-            5 => self.closest_with::<STACK_SMALL, 5>(ray, t_max, test, stack),
-            6 => self.closest_with::<STACK_SMALL, 6>(ray, t_max, test, stack),
-            _ => self.closest_with::<STACK_SMALL, 7>(ray, t_max, test, stack),
-        }
+        by_octant!(ray, OCT => self.closest_with::<STACK_SMALL, OCT>(ray, t_max, test, stack))
     }
 
     #[inline(always)]
@@ -342,17 +367,11 @@ impl Bvh {
             let stack = &mut [(0, 0); STACK_MAX];
             return self.any_with::<STACK_MAX, 8>(ray, t_max, test, stack);
         }
-        let mut test = Some(test);
-        let done = STACKS.try_with(|cell| {
-            let mut stacks = cell.try_borrow_mut().ok()?;
-            let test = test.take()?;
-            Some(self.any_octant(ray, t_max, test, &mut stacks.any))
-        });
-        match (done, test) {
-            (Ok(Some(hit)), _) => hit,
-            (_, Some(test)) => self.any_octant(ray, t_max, test, &mut [(0, 0); STACK_SMALL]),
-            (_, None) => unreachable!("the callback is only taken when the query runs"),
-        }
+        on_thread_stack(
+            test,
+            |stacks| &mut stacks.any,
+            |test, stack| self.any_octant(ray, t_max, test, stack),
+        )
     }
 
     /// [`Bvh::any`] with one copy of the loop per ray octant.
@@ -364,16 +383,7 @@ impl Bvh {
         test: impl FnMut(u32, u32, f32) -> bool,
         stack: &mut [(u32, u32); STACK_SMALL],
     ) -> bool {
-        match ray.octant() {
-            0 => self.any_with::<STACK_SMALL, 0>(ray, t_max, test, stack),
-            1 => self.any_with::<STACK_SMALL, 1>(ray, t_max, test, stack),
-            2 => self.any_with::<STACK_SMALL, 2>(ray, t_max, test, stack),
-            3 => self.any_with::<STACK_SMALL, 3>(ray, t_max, test, stack),
-            4 => self.any_with::<STACK_SMALL, 4>(ray, t_max, test, stack),
-            5 => self.any_with::<STACK_SMALL, 5>(ray, t_max, test, stack),
-            6 => self.any_with::<STACK_SMALL, 6>(ray, t_max, test, stack),
-            _ => self.any_with::<STACK_SMALL, 7>(ray, t_max, test, stack),
-        }
+        by_octant!(ray, OCT => self.any_with::<STACK_SMALL, OCT>(ray, t_max, test, stack))
     }
 
     #[inline(always)]
