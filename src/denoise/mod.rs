@@ -134,4 +134,3 @@ pub fn denoise(input: &DenoiseInput, params: &DenoiseParams) -> Result<Vec<Vec3>
     }
     Ok(out)
 }
-

@@ -205,4 +205,3 @@ fn guide(f: &Features) -> Guide {
     }
     g
 }
-
