@@ -156,7 +156,13 @@ fn hash_geometry(h: &mut Fnv, g: &Geometry) {
         tri_attrs,
         spheres,
         ellipsoids,
+        quadrics,
     } = g;
+    // Discs and cylinders (after the scene key of scenes without them, which stays as it was).
+    if !quadrics.is_empty() {
+        h.bytes(b"quadrics");
+        h.debug("quadrics", quadrics);
+    }
     h.bytes(b"triangles");
     h.u64(triangles.len() as u64);
     for (t, a) in triangles.iter().zip(tri_attrs) {
