@@ -1,7 +1,7 @@
 """Mitsuba 3 renders of the issue #25 comparison scenes, one per light (and the thin lens).
 
 Use:  /root/.cache/mitsuba3-venv/bin/python scripts/mitsuba/lights.py SCENE [--spp N] [-o out.exr]
-      SCENE ∈ quad, mesh, spot, sun, env_constant, env_image, thin_lens (or `all`).
+      SCENE ∈ quad, mesh, spot, sun, env_constant, env_image, thin_lens, disc_cylinder (or `all`).
 
 Every scene: 96×72 pixels, a floor y = 0 (Lambert 0.5), a grey sphere (Lambert 0.7, radius 0.5
 at (0, 0.5, 0)), camera at (0, 2, 5) looking at (0, 0.5, 0), fov_y 40°, path tracing with
@@ -168,10 +168,26 @@ def scene_thin_lens(mi, spp, seed):
     return d
 
 
+def scene_disc_cylinder(mi, spp, seed):
+    """Issue 41: a disc area light (radius 0.4 at y = 2.2 facing down, L = 10: Mitsuba's `disk`
+    with an `area` emitter, one-sided along its +z normal turned to −y, as caustic's `Disc`) over
+    the floor, the sphere and an open cylinder (Mitsuba's `cylinder` has no caps; caustic's
+    `Cylinder` without `caps`): radius 0.3 from (1.2, 0, 0) to (1.2, 0.8, 0), Lambert 0.7
+    two-sided, its inside seen from above."""
+    d = base(mi, spp, seed)
+    d["disc"] = {"type": "disk", "bsdf": common.black(),
+                 "to_world": mi.ScalarTransform4f().translate([0, 2.2, 0]).rotate([1, 0, 0], 90).scale(0.4),
+                 "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [10, 10, 10]}}}
+    d["column"] = {"type": "cylinder", "p0": [1.2, 0, 0], "p1": [1.2, 0.8, 0], "radius": 0.3,
+                   "bsdf": common.diffuse([0.7, 0.7, 0.7])}
+    return d
+
+
 SCENES = {
     "quad": scene_quad, "mesh": scene_mesh, "spot": scene_spot, "sun": scene_sun,
     "sun_wide": lambda mi, spp, seed: scene_sun(mi, spp, seed, alpha=SUN_WIDE_ALPHA),
     "env_constant": scene_env_constant, "env_image": scene_env_image, "thin_lens": scene_thin_lens,
+    "disc_cylinder": scene_disc_cylinder,
 }
 
 

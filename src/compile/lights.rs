@@ -25,7 +25,8 @@ use glam::Vec3;
 use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::render_scene::light::escape::InfinityRef;
 use crate::render_scene::light::{
-    DistantLight, EnvironmentLight, MeshLight, RectLight, SceneSphere, SkyLight, SpotLight, sky,
+    DistantLight, EnvironmentLight, MeshLight, QuadricLight, RectLight, SceneSphere, SkyLight,
+    SpotLight, sky,
 };
 use crate::render_scene::{Light, ObjectInfo};
 use crate::scene::Diagnostic;
@@ -99,8 +100,13 @@ pub(super) fn reach(builder: &GeometryBuilder, center: Vec3, eye: Vec3) -> f64 {
             + m.y_axis.length()
             + m.z_axis.length()
     });
+    let quadrics = builder.quadrics.iter().flat_map(|q| {
+        (q.shape.corners().into_iter())
+            .map(|p| (q.world_from_object.transform_point3(p) - c).length())
+    });
     tris.chain(spheres)
         .chain(ellipsoids)
+        .chain(quadrics)
         .fold(far(eye), f64::max)
 }
 
@@ -111,6 +117,7 @@ pub(super) struct PrimCounts {
     triangles: usize,
     spheres: usize,
     ellipsoids: usize,
+    quadrics: usize,
 }
 
 impl PrimCounts {
@@ -119,6 +126,7 @@ impl PrimCounts {
             triangles: b.triangles.len(),
             spheres: b.spheres.len(),
             ellipsoids: b.ellipsoids.len(),
+            quadrics: b.quadrics.len(),
         }
     }
 }
@@ -158,6 +166,18 @@ pub(super) fn node_light(b: &GeometryBuilder, e: &NodeEmitter) -> Result<Light, 
             "an emissive sphere must keep its shape: its transforms scale it unevenly (an ellipsoid cannot be a light)",
         )
         .with_help("scale it by the same factor along every axis"));
+    }
+    if e.end.quadrics > e.first.quadrics {
+        let q = b.quadrics[e.first.quadrics];
+        return QuadricLight::new(q.shape, q.world_from_object, radiance, two_sided)
+            .map(Light::Quadric)
+            .ok_or_else(|| {
+                Diagnostic::error(
+                    format!("{}.transform", e.path),
+                    "an emissive cylinder must stay round: its transforms scale it unevenly across its axis or shear it (its area light is sampled by a uniform area element)",
+                )
+                .with_help("scale it by the same factor along x and y, or make it a mesh")
+            });
     }
     if e.end.spheres > e.first.spheres {
         let s = b.spheres[e.first.spheres];
@@ -231,6 +251,13 @@ pub(super) fn scene_sphere(b: &GeometryBuilder, more: &[(Vec3, f32)]) -> SceneSp
         );
         lo = lo.min(c - half);
         hi = hi.max(c + half);
+    }
+    for q in &b.quadrics {
+        for c in q.shape.corners() {
+            let p = q.world_from_object.transform_point3(c).as_vec3();
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
     }
     if !(lo.cmple(hi).all()) {
         return SceneSphere::new(Vec3::ZERO, 1.0);

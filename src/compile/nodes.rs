@@ -7,10 +7,11 @@ use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 
 use super::materials::MaterialTable;
 use super::mesh::{MeshCache, ObjMesh};
+use crate::geometry::quadric::QuadricShape;
 use crate::geometry::triangle::is_degenerate;
 use crate::render_scene::ObjectInfo;
 use crate::render_scene::geometry::{
-    EllipsoidPrim, GeometryBuilder, MAX_PRIMS_PER_KIND, SpherePrim, TriAttrs,
+    EllipsoidPrim, GeometryBuilder, MAX_PRIMS_PER_KIND, QuadricPrim, SpherePrim, TriAttrs,
 };
 use crate::scene::Diagnostic;
 use crate::scene::diagnostic::{did_you_mean, quoted_list};
@@ -114,6 +115,32 @@ impl Flattener<'_> {
                 },
                 xf,
             ),
+            NodeSpec::Disc { radius, .. } => {
+                let m = xf * DAffine3::from_scale(DVec3::splat(f64::from(*radius)));
+                self.quadric(QuadricShape::Disc, m, object);
+            }
+            NodeSpec::Cylinder {
+                radius,
+                height,
+                caps,
+                ..
+            } => {
+                let (r, h) = (f64::from(*radius), f64::from(*height));
+                let m = xf * DAffine3::from_scale(DVec3::new(r, r, h));
+                if self.resolvable(path, "cylinder", &m, MIN_ELLIPSOID_THICKNESS) {
+                    self.quadric(QuadricShape::Cylinder, m, object);
+                    if *caps {
+                        // The ends: unit discs at z = ±½ facing outwards (the bottom one turned
+                        // over about x).
+                        let top = m * DAffine3::from_translation(DVec3::new(0.0, 0.0, 0.5));
+                        let bottom = m
+                            * DAffine3::from_translation(DVec3::new(0.0, 0.0, -0.5))
+                            * DAffine3::from_rotation_x(std::f64::consts::PI);
+                        self.quadric(QuadricShape::Disc, top, object);
+                        self.quadric(QuadricShape::Disc, bottom, object);
+                    }
+                }
+            }
             NodeSpec::Mesh {
                 file,
                 smooth,
@@ -242,6 +269,17 @@ impl Flattener<'_> {
                 object,
             });
         }
+    }
+
+    /// A unit disc or cylinder under `m`.
+    fn quadric(&mut self, shape: QuadricShape, m: DAffine3, object: u32) {
+        self.builder.quadrics.push(QuadricPrim {
+            shape,
+            object_from_world: m.inverse(),
+            world_from_object: m,
+            normal_to_world: normal_matrix(m.matrix3),
+            object,
+        });
     }
 
     /// Two triangles for a unit square face given by its corners, counter-clockwise seen from outside.

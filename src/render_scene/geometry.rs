@@ -4,6 +4,7 @@ use glam::{DAffine3, DMat3, DVec3, Vec2, Vec3};
 
 use crate::accel::bvh::{LEAF_BLOCK, PAD};
 use crate::accel::{Bvh, RayBoxTest};
+use crate::geometry::quadric::QuadricShape;
 use crate::geometry::sphere::{intersect_sphere, intersect_unit_quadric};
 use crate::geometry::triangle::{
     TriPack4, TriRay, intersect_pack_k, intersect_pack8_k, intersect_triangle_k,
@@ -23,6 +24,8 @@ pub enum PrimKind {
     Sphere,
     /// A sphere under a general affine transform.
     Ellipsoid,
+    /// A disc or an open cylinder under an affine transform ([`QuadricPrim`]).
+    Quadric,
 }
 
 impl PrimRef {
@@ -36,6 +39,7 @@ impl PrimRef {
             PrimKind::Triangle => 0,
             PrimKind::Sphere => 1,
             PrimKind::Ellipsoid => 2,
+            PrimKind::Quadric => 3,
         };
         Self((k << Self::SHIFT) | (index as u32 & Self::MASK))
     }
@@ -47,7 +51,8 @@ impl PrimRef {
         match self.0 >> Self::SHIFT {
             0 => PrimKind::Triangle,
             1 => PrimKind::Sphere,
-            _ => PrimKind::Ellipsoid,
+            2 => PrimKind::Ellipsoid,
+            _ => PrimKind::Quadric,
         }
     }
 
@@ -97,6 +102,22 @@ pub struct EllipsoidPrim {
     pub object: u32,
 }
 
+/// A unit disc or open cylinder ([`QuadricShape`]) in its object space, mapped to the world by
+/// an affine transform (the node's radius and height are part of it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuadricPrim {
+    /// Which surface.
+    pub shape: QuadricShape,
+    /// Object-from-world transform (f64 for accuracy).
+    pub object_from_world: DAffine3,
+    /// World-from-object transform.
+    pub world_from_object: DAffine3,
+    /// Inverse transpose of the linear part, for normals.
+    pub normal_to_world: DMat3,
+    /// Owning object.
+    pub object: u32,
+}
+
 /// Whether leaves test two triangle packs at a time ([`intersect_pack8_k`]): where AVX is
 /// enabled at build time, so that eight lanes are one register.
 const PACK_PAIRS: bool = cfg!(all(target_arch = "x86_64", target_feature = "avx"));
@@ -125,6 +146,8 @@ pub struct GeometryBuilder {
     pub spheres: Vec<SpherePrim>,
     /// Ellipsoids.
     pub ellipsoids: Vec<EllipsoidPrim>,
+    /// Discs and cylinders.
+    pub quadrics: Vec<QuadricPrim>,
 }
 
 /// The scene's primitives, stored in BVH leaf order, and their BVH.
@@ -152,13 +175,15 @@ pub struct Geometry {
     pub spheres: Vec<SpherePrim>,
     /// Ellipsoids.
     pub ellipsoids: Vec<EllipsoidPrim>,
+    /// Discs and cylinders.
+    pub quadrics: Vec<QuadricPrim>,
 }
 
 impl GeometryBuilder {
     /// Number of primitives collected.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.triangles.len() + self.spheres.len() + self.ellipsoids.len()
+        self.triangles.len() + self.spheres.len() + self.ellipsoids.len() + self.quadrics.len()
     }
 
     /// True if nothing was collected.
@@ -187,6 +212,10 @@ impl GeometryBuilder {
             refs.push(PrimRef::new(PrimKind::Ellipsoid, i));
             bounds.push(ellipsoid_bounds(&e.world_from_object));
         }
+        for (i, q) in self.quadrics.iter().enumerate() {
+            refs.push(PrimRef::new(PrimKind::Quadric, i));
+            bounds.push(quadric_bounds(q));
+        }
         // Spheres and ellipsoids are tested one at a time, triangles in packs.
         let solo: Vec<bool> = refs
             .iter()
@@ -199,8 +228,11 @@ impl GeometryBuilder {
             tri_attrs: Vec::with_capacity(self.triangles.len()),
             spheres: Vec::with_capacity(self.spheres.len()),
             ellipsoids: Vec::with_capacity(self.ellipsoids.len()),
+            quadrics: Vec::with_capacity(self.quadrics.len()),
             tri_packs: vec![TriPack4::EMPTY; bvh.order.len() / LEAF_BLOCK],
-            has_quadrics: !self.spheres.is_empty() || !self.ellipsoids.is_empty(),
+            has_quadrics: !self.spheres.is_empty()
+                || !self.ellipsoids.is_empty()
+                || !self.quadrics.is_empty(),
             quadric_packs: vec![false; bvh.order.len() / LEAF_BLOCK],
             bvh: Bvh::default(),
         };
@@ -227,6 +259,10 @@ impl GeometryBuilder {
                     g.ellipsoids.push(self.ellipsoids[r.index()]);
                     PrimRef::new(PrimKind::Ellipsoid, g.ellipsoids.len() - 1)
                 }
+                PrimKind::Quadric => {
+                    g.quadrics.push(self.quadrics[r.index()]);
+                    PrimRef::new(PrimKind::Quadric, g.quadrics.len() - 1)
+                }
             };
             g.quadric_packs[slot / LEAF_BLOCK] |= new.kind() != PrimKind::Triangle;
             g.slots.push(new);
@@ -250,6 +286,41 @@ fn ellipsoid_bounds(m: &DAffine3) -> Aabb {
         .as_vec3()
         .to_array()
         .map(crate::geometry::float::next_up);
+    Aabb {
+        min: lo.into(),
+        max: hi.into(),
+    }
+}
+
+impl QuadricPrim {
+    /// World bounds (see [`quadric_bounds`]).
+    #[must_use]
+    pub fn bounds(&self) -> Aabb {
+        quadric_bounds(self)
+    }
+
+    /// Surface area (m²), [`QuadricShape::area`].
+    #[must_use]
+    pub fn area(&self) -> f64 {
+        self.shape.area(self.world_from_object.matrix3)
+    }
+}
+
+/// Bounds of a disc or cylinder: its object-space box's corners mapped to the world, rounded
+/// outwards so the f32 box contains the f64 surface.
+fn quadric_bounds(q: &QuadricPrim) -> Aabb {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for c in q.shape.corners() {
+        let p = q.world_from_object.transform_point3(c);
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    let lo = lo
+        .as_vec3()
+        .to_array()
+        .map(crate::geometry::float::next_down);
+    let hi = hi.as_vec3().to_array().map(crate::geometry::float::next_up);
     Aabb {
         min: lo.into(),
         max: hi.into(),
@@ -471,6 +542,12 @@ impl Geometry {
                 let d = e.object_from_world.transform_vector3(ray.dir.as_dvec3());
                 intersect_unit_quadric(o, d, 1.0, t_max).map(|t| (t, 0.0, 0.0))
             }
+            PrimKind::Quadric => {
+                let q = &self.quadrics[prim.index()];
+                let o = q.object_from_world.transform_point3(ray.origin.as_dvec3());
+                let d = q.object_from_world.transform_vector3(ray.dir.as_dvec3());
+                q.shape.intersect(o, d, t_max).map(|t| (t, 0.0, 0.0))
+            }
         }
     }
 
@@ -481,6 +558,7 @@ impl Geometry {
             PrimKind::Triangle => self.tri_attrs[prim.index()].object,
             PrimKind::Sphere => self.spheres[prim.index()].object,
             PrimKind::Ellipsoid => self.ellipsoids[prim.index()].object,
+            PrimKind::Quadric => self.quadrics[prim.index()].object,
         }
     }
 }

@@ -28,10 +28,11 @@
 //! path, the thread count: the same bytes on any thread count).
 
 use super::camera::Lens;
-use super::geometry::{EllipsoidPrim, SpherePrim, TriAttrs};
+use super::geometry::{EllipsoidPrim, QuadricPrim, SpherePrim, TriAttrs};
 use super::light::distant::DistantLight;
 use super::light::environment::{EnvironmentLight, EnvironmentMap};
 use super::light::infinite::SceneSphere;
+use super::light::quadric::QuadricLight;
 use super::light::rect::RectLight;
 use super::light::sky::{SkyLight, SkyModel};
 use super::light::spot::SpotLight;
@@ -42,6 +43,7 @@ use super::{
     Texture,
 };
 use crate::binfile::{Fnv, KeyHash};
+use crate::geometry::quadric::QuadricShape;
 
 /// The bytes every photon key starts with. They are the photon cache's file signature of the
 /// day the key was defined; they stay fixed.
@@ -286,6 +288,7 @@ impl KeyHash for Light {
             Light::Distant(l) => l.key_hash(h),
             Light::Environment(l) => l.key_hash(h),
             Light::Sky(l) => l.key_hash(h),
+            Light::Quadric(l) => l.key_hash(h),
         }
     }
 }
@@ -437,11 +440,13 @@ impl KeyHash for Geometry {
             tri_attrs,
             spheres,
             ellipsoids,
+            quadrics,
         } = self;
         triangles.key_hash(h);
         tri_attrs.key_hash(h);
         spheres.key_hash(h);
         ellipsoids.key_hash(h);
+        quadrics.key_hash(h);
     }
 }
 
@@ -456,6 +461,33 @@ crate::key_hash_struct!(SpherePrim {
     radius,
     object
 });
+
+crate::key_hash_struct!(QuadricPrim {
+    shape,
+    object_from_world,
+    world_from_object,
+    normal_to_world,
+    object,
+});
+
+crate::key_hash_struct!(QuadricLight {
+    shape,
+    world_from_object,
+    object_from_world,
+    normal_to_world,
+    radiance,
+    two_sided,
+    area,
+});
+
+impl KeyHash for QuadricShape {
+    fn key_hash(&self, h: &mut Fnv) {
+        h.str(match self {
+            QuadricShape::Disc => "Disc",
+            QuadricShape::Cylinder => "Cylinder",
+        });
+    }
+}
 
 crate::key_hash_struct!(EllipsoidPrim {
     object_from_world,

@@ -26,6 +26,7 @@ use crate::sampling::warp::{cosine_hemisphere, uniform_sphere};
 pub use distant::DistantLight;
 pub use environment::EnvironmentLight;
 pub use infinite::SceneSphere;
+pub use quadric::QuadricLight;
 pub use rect::RectLight;
 pub use sky::SkyLight;
 pub use spot::SpotLight;
@@ -56,6 +57,8 @@ pub enum Light {
     Rect(RectLight),
     /// An emissive triangle mesh (a `Cube` or `Mesh` node with `emission`), sampled by area.
     Mesh(Arc<MeshLight>),
+    /// An emissive disc or cylinder (a `Disc` or `Cylinder` node with `emission`), by area.
+    Quadric(QuadricLight),
     /// A spot light (a point light with a cone and pbrt-v4's smooth fall-off).
     Spot(SpotLight),
     /// A distant light (the sun), optionally with an angular radius.
@@ -140,6 +143,7 @@ impl Light {
             Light::Sphere { .. }
             | Light::Rect(_)
             | Light::Mesh(_)
+            | Light::Quadric(_)
             | Light::Environment(_)
             | Light::Sky(_) => false,
         }
@@ -156,6 +160,7 @@ impl Light {
             | Light::Sphere { .. }
             | Light::Rect(_)
             | Light::Mesh(_)
+            | Light::Quadric(_)
             | Light::Spot(_) => false,
         }
     }
@@ -186,6 +191,7 @@ impl Light {
             | Light::Sphere { .. }
             | Light::Rect(_)
             | Light::Mesh(_)
+            | Light::Quadric(_)
             | Light::Spot(_) => return None,
         };
         (le != Vec3::ZERO).then_some(escape::Escape { le, wi })
@@ -202,6 +208,7 @@ impl Light {
             | Light::Sphere { .. }
             | Light::Rect(_)
             | Light::Mesh(_)
+            | Light::Quadric(_)
             | Light::Spot(_)
             | Light::Distant(_) => false,
         }
@@ -220,6 +227,7 @@ impl Light {
             | Light::Sphere { .. }
             | Light::Rect(_)
             | Light::Mesh(_)
+            | Light::Quadric(_)
             | Light::Spot(_) => None,
         }
     }
@@ -232,6 +240,7 @@ impl Light {
     pub fn can_shadow_itself(&self) -> bool {
         match self {
             Light::Mesh(_) => true,
+            Light::Quadric(q) => q.shape.can_shadow_itself(),
             Light::Point { .. }
             | Light::Sphere { .. }
             | Light::Rect(_)
@@ -332,6 +341,7 @@ impl Light {
             }
             Light::Rect(ref r) => r.sample_li(p, u),
             Light::Mesh(ref m) => m.sample_li(p, u).map(|s| s.light),
+            Light::Quadric(ref q) => q.sample_li(p, u),
             Light::Spot(ref s) => s.sample_li(p, u),
             // The sun's cone: escaping rays see it too (`Light::le_escaped`), so its samples
             // are MIS-weighted against BSDF sampling as an environment's are.
@@ -374,6 +384,7 @@ impl Light {
             }
             Light::Rect(ref r) => r.pdf_li(p, wi),
             Light::Mesh(ref m) => m.pdf_li(p, wi),
+            Light::Quadric(ref q) => q.pdf_li(p, wi),
             Light::Spot(ref s) => s.pdf_li(p, wi),
             Light::Distant(ref d) => d.pdf_li(p, wi),
             Light::Environment(ref e) => e.pdf_li(p, wi),
@@ -391,6 +402,7 @@ impl Light {
     pub fn pdf_li_hit(&self, p: Vec3, wi: Vec3, point: Vec3, n: Vec3) -> f32 {
         match self {
             Light::Mesh(m) => m.pdf_li_hit(p, point, n),
+            Light::Quadric(q) => q.pdf_li_hit(p, point, n),
             Light::Point { .. }
             | Light::Sphere { .. }
             | Light::Rect(_)
@@ -422,6 +434,7 @@ impl Light {
             }
             Light::Rect(ref r) => r.le(w),
             Light::Mesh(ref m) => m.le(n, w),
+            Light::Quadric(ref q) => q.le(n, w),
             Light::Spot(_) | Light::Distant(_) => Vec3::ZERO,
             Light::Environment(ref e) => e.le(-w),
             Light::Sky(ref s) => s.map.le(-w),
@@ -481,6 +494,7 @@ impl Light {
             }
             Light::Rect(ref r) => r.sample_le(u_pos, u_dir),
             Light::Mesh(ref m) => m.sample_le(u_pos, u_dir),
+            Light::Quadric(ref q) => q.sample_le(u_pos, u_dir),
             Light::Spot(ref s) => s.sample_le(u_pos, u_dir),
             Light::Distant(ref d) => d.sample_le(u_pos, u_dir),
             Light::Environment(ref e) => e.sample_le(u_pos, u_dir),
@@ -502,6 +516,7 @@ impl Light {
             ),
             Light::Rect(ref r) => r.pdf_le(dir),
             Light::Mesh(ref m) => m.pdf_le(normal, dir),
+            Light::Quadric(ref q) => q.pdf_le(normal, dir),
             Light::Spot(ref s) => s.pdf_le(dir),
             Light::Distant(ref d) => d.pdf_le(dir),
             Light::Environment(ref e) => e.pdf_le(dir),
@@ -519,6 +534,7 @@ impl Light {
             } => radiance * 4.0 * PI * PI * radius * radius,
             Light::Rect(ref r) => r.power(),
             Light::Mesh(ref m) => m.power(),
+            Light::Quadric(ref q) => q.power(),
             Light::Spot(ref s) => s.power(),
             Light::Distant(ref d) => d.power(),
             Light::Environment(ref e) => e.power(),
@@ -540,6 +556,7 @@ impl Light {
             Light::Sphere { .. }
             | Light::Rect(_)
             | Light::Mesh(_)
+            | Light::Quadric(_)
             | Light::Distant(_)
             | Light::Environment(_)
             | Light::Sky(_) => per_area_light,
@@ -566,7 +583,7 @@ impl Light {
                 let power = self.power() / n;
                 (power.max_element() > 0.0).then(|| (Ray::new(position, dir.normalize()), power))
             }
-            Light::Sphere { .. } | Light::Rect(_) | Light::Mesh(_) => {
+            Light::Sphere { .. } | Light::Rect(_) | Light::Mesh(_) | Light::Quadric(_) => {
                 let u_pos = sampler.next_2d();
                 let u_dir = sampler.next_2d();
                 let e = self.sample_le(u_pos, u_dir)?;
@@ -650,6 +667,17 @@ impl Light {
                     area: r.area,
                     radiance: r.radiance,
                     two_sided: r.two_sided,
+                };
+                surface.emit_aimed(sampler, aim, n)
+            }
+            Light::Quadric(ref q) => {
+                let (origin, normal) = q.sample_position(sampler.next_2d());
+                let surface = AreaEmitter {
+                    origin,
+                    normal,
+                    area: q.area,
+                    radiance: q.radiance,
+                    two_sided: q.two_sided,
                 };
                 surface.emit_aimed(sampler, aim, n)
             }
@@ -791,6 +819,7 @@ pub mod distant;
 pub mod environment;
 pub mod escape;
 pub mod infinite;
+pub mod quadric;
 pub mod rect;
 pub mod sky;
 pub mod spot;

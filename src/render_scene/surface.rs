@@ -173,6 +173,32 @@ impl Geometry {
                     },
                 }
             }
+            PrimKind::Quadric => {
+                let q = &self.quadrics[hit.prim.index()];
+                let o = q.object_from_world.transform_point3(ray.origin.as_dvec3());
+                let d = q.object_from_world.transform_vector3(ray.dir.as_dvec3());
+                // Re-solved in f64 (as for ellipsoids), then moved exactly onto the surface.
+                let t = q.shape.hit_t(o, d).unwrap_or(f64::from(hit.t));
+                let po = q.shape.reproject(o + d * t);
+                let p = q.world_from_object.transform_point3(po).as_vec3();
+                let n = (q.normal_to_world * q.shape.normal(po))
+                    .as_vec3()
+                    .normalize();
+                SurfacePoint {
+                    p,
+                    p_outside: p,
+                    p_error: p.abs() * gamma(3),
+                    ng: n,
+                    ns: n,
+                    object: q.object,
+                    local: Local {
+                        prim: hit.prim,
+                        b1: 0.0,
+                        b2: 0.0,
+                        unit: po.as_vec3(),
+                    },
+                }
+            }
         }
     }
 
@@ -207,6 +233,16 @@ impl Geometry {
                     dpdv: (l * dv.as_dvec3()).as_vec3(),
                 }
             }
+            PrimKind::Quadric => {
+                let q = &self.quadrics[prim.index()];
+                let (uv, du, dv) = q.shape.uv(unit.as_dvec3());
+                let l = q.world_from_object.matrix3;
+                SurfaceParams {
+                    uv: uv.as_vec2(),
+                    dpdu: (l * du).as_vec3(),
+                    dpdv: (l * dv).as_vec3(),
+                }
+            }
         }
     }
 }
@@ -228,6 +264,10 @@ impl Geometry {
                 let shortest = axes.iter().copied().fold(f64::INFINITY, f64::min);
                 let longest = axes.iter().copied().fold(0.0, f64::max);
                 (longest / (shortest * shortest)) as f32
+            }
+            PrimKind::Quadric => {
+                let q = &self.quadrics[hit.prim.index()];
+                q.shape.curvature(q.world_from_object.matrix3) as f32
             }
             PrimKind::Triangle => {
                 let i = hit.prim.index();

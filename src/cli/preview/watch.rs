@@ -34,7 +34,11 @@ pub fn asset_files(scene: &SceneFile, base_dir: &Path) -> BTreeSet<PathBuf> {
             NodeSpec::Mesh { file, .. } | NodeSpec::Gltf { file, .. } => {
                 files.insert(base_dir.join(file));
             }
-            NodeSpec::Sphere { .. } | NodeSpec::Cube { .. } | NodeSpec::Quad { .. } => {}
+            NodeSpec::Sphere { .. }
+            | NodeSpec::Cube { .. }
+            | NodeSpec::Quad { .. }
+            | NodeSpec::Disc { .. }
+            | NodeSpec::Cylinder { .. } => {}
         }
     }
     files

@@ -125,6 +125,10 @@ impl CausticTargets {
             let (lo, hi) = ellipsoid_box(&e.world_from_object);
             add(e.object, ObjectBounds::Box(lo, hi));
         }
+        for q in &g.quadrics {
+            let b = q.bounds();
+            add(q.object, ObjectBounds::Box(b.min, b.max));
+        }
         let spheres = bounds
             .into_iter()
             .zip(share)

@@ -286,6 +286,11 @@ pub(super) fn diffuse_area(scene: &RenderScene) -> f64 {
             area += 4.0 * std::f64::consts::PI * r * r;
         }
     }
+    for q in &g.quadrics {
+        if diffuse(q.object) {
+            area += q.area();
+        }
+    }
     area
 }
 

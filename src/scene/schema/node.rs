@@ -84,6 +84,51 @@ pub enum NodeSpec {
         #[serde(deserialize_with = "exact_floats::<_, 2>")]
         size: [f32; 2],
     },
+    /// A disc in the object's xy plane, centred on the origin, facing +z (analytic, like the
+    /// sphere; Mitsuba 3's `disk`).
+    Disc {
+        /// Optional name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Transform steps.
+        #[serde(default)]
+        transform: Vec<TransformStep>,
+        /// Material name (required unless the node has `emission`).
+        #[serde(default)]
+        material: Option<String>,
+        /// Light the shape emits, making it an area light without a material.
+        #[serde(default)]
+        emission: Option<EmissionSpec>,
+        /// Radius in object space (> 0).
+        #[serde(default = "one")]
+        radius: f32,
+    },
+    /// A cylinder about the object's z axis, centred on the origin (z from −height/2 to
+    /// height/2), analytic, open at both ends like Mitsuba 3's `cylinder` unless `caps` closes
+    /// them with two discs. Its normal points outwards.
+    Cylinder {
+        /// Optional name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Transform steps.
+        #[serde(default)]
+        transform: Vec<TransformStep>,
+        /// Material name (required unless the node has `emission`).
+        #[serde(default)]
+        material: Option<String>,
+        /// Light the side emits, making it an area light without a material (no caps then).
+        #[serde(default)]
+        emission: Option<EmissionSpec>,
+        /// Radius in object space (> 0).
+        #[serde(default = "one")]
+        radius: f32,
+        /// Height along z in object space (> 0).
+        #[serde(default = "one")]
+        height: f32,
+        /// Close both ends with discs of the same material (default: open, as Mitsuba's).
+        #[serde(default)]
+        caps: bool,
+    },
     /// A triangle mesh from a Wavefront OBJ file (path relative to the scene file), with one
     /// material or one per OBJ group.
     Mesh {
@@ -176,6 +221,8 @@ impl NodeSpec {
             NodeSpec::Sphere { .. } => "Sphere",
             NodeSpec::Cube { .. } => "Cube",
             NodeSpec::Quad { .. } => "Quad",
+            NodeSpec::Disc { .. } => "Disc",
+            NodeSpec::Cylinder { .. } => "Cylinder",
             NodeSpec::Mesh { .. } => "Mesh",
             NodeSpec::Gltf { .. } => "Gltf",
         }
@@ -189,6 +236,8 @@ impl NodeSpec {
             | NodeSpec::Sphere { transform, .. }
             | NodeSpec::Cube { transform, .. }
             | NodeSpec::Quad { transform, .. }
+            | NodeSpec::Disc { transform, .. }
+            | NodeSpec::Cylinder { transform, .. }
             | NodeSpec::Mesh { transform, .. }
             | NodeSpec::Gltf { transform, .. } => transform,
         }
@@ -202,6 +251,8 @@ impl NodeSpec {
             | NodeSpec::Sphere { name, .. }
             | NodeSpec::Cube { name, .. }
             | NodeSpec::Quad { name, .. }
+            | NodeSpec::Disc { name, .. }
+            | NodeSpec::Cylinder { name, .. }
             | NodeSpec::Mesh { name, .. }
             | NodeSpec::Gltf { name, .. } => name.as_deref(),
         }
@@ -216,6 +267,8 @@ impl NodeSpec {
             NodeSpec::Sphere { material, .. }
             | NodeSpec::Cube { material, .. }
             | NodeSpec::Quad { material, .. }
+            | NodeSpec::Disc { material, .. }
+            | NodeSpec::Cylinder { material, .. }
             | NodeSpec::Mesh { material, .. } => material.as_deref(),
         }
     }
@@ -229,6 +282,8 @@ impl NodeSpec {
             NodeSpec::Sphere { emission, .. }
             | NodeSpec::Cube { emission, .. }
             | NodeSpec::Quad { emission, .. }
+            | NodeSpec::Disc { emission, .. }
+            | NodeSpec::Cylinder { emission, .. }
             | NodeSpec::Mesh { emission, .. } => emission.as_ref(),
         }
     }

@@ -195,6 +195,8 @@ fn has_emission(n: &NodeSpec) -> bool {
         NodeSpec::Sphere { .. }
         | NodeSpec::Cube { .. }
         | NodeSpec::Quad { .. }
+        | NodeSpec::Disc { .. }
+        | NodeSpec::Cylinder { .. }
         | NodeSpec::Mesh { .. } => n.emission().is_some(),
         // Its emissive materials and punctual lights are known only once the file is read.
         NodeSpec::Gltf { .. } => true,

@@ -70,6 +70,29 @@ impl<'a> Validator<'a> {
                     );
                 }
             }
+            NodeSpec::Disc { radius, .. } => {
+                self.shape_material(path, n);
+                self.positive(&format!("{path}.radius"), *radius, "radius");
+            }
+            NodeSpec::Cylinder {
+                radius,
+                height,
+                caps,
+                ..
+            } => {
+                self.shape_material(path, n);
+                self.positive(&format!("{path}.radius"), *radius, "radius");
+                self.positive(&format!("{path}.height"), *height, "height");
+                if *caps && n.emission().is_some() {
+                    self.out.push(
+                        Diagnostic::error(
+                            format!("{path}.caps"),
+                            "an emissive cylinder is open: `emission` lights its side only, and `caps` would add discs it cannot emit from",
+                        )
+                        .with_help("remove `caps`, and add `Disc` nodes with their own `emission` for glowing ends"),
+                    );
+                }
+            }
             NodeSpec::Mesh {
                 file,
                 material,

@@ -1,0 +1,214 @@
+//! Disc and cylinder area lights (a `Disc` or `Cylinder` node with `emission`): uniform radiance
+//! on the side the surface normal faces (+z of a disc, outwards on a cylinder), or both sides.
+//! Sampled uniformly by area (pdf `1/A`, `d²/(A |cos θ_l|)` in solid angle: pbrt-v4 §12.3's
+//! area sampling, the same as a mesh light's).
+//!
+//! A point is uniform on the object-space surface and mapped by the node's affine transform,
+//! whose Jacobian on the surface is constant for a disc (any transform: an ellipse of area
+//! `π |M x × M y|`) and for a round cylinder (`M x ⟂ M y`, equal lengths r, the axis `M z` of
+//! length h perpendicular to both: area `2π r h`), so the world points are uniform too.
+//! Compilation refuses an emissive cylinder that is not round.
+
+use glam::{DAffine3, DMat3, DVec3, Vec3};
+use std::f32::consts::{PI, TAU};
+
+use super::{EmissionSample, LightSample};
+use crate::geometry::quadric::QuadricShape;
+use crate::sampling::warp::{concentric_disk, cosine_hemisphere};
+
+/// An emitting disc or cylinder.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuadricLight {
+    /// Which surface.
+    pub shape: QuadricShape,
+    /// World-from-object transform of the unit shape.
+    pub world_from_object: DAffine3,
+    /// Object-from-world transform.
+    pub object_from_world: DAffine3,
+    /// Inverse transpose of the linear part (normals).
+    pub normal_to_world: DMat3,
+    /// Emitted radiance (W/(m²·sr) per channel).
+    pub radiance: Vec3,
+    /// Emits on both sides.
+    pub two_sided: bool,
+    /// Area of one side (m²).
+    pub area: f32,
+}
+
+impl QuadricLight {
+    /// The light of the unit `shape` under `m`. `None` for a cylinder that is not round (its
+    /// area element would vary) or a shape of no area.
+    #[must_use]
+    pub fn new(shape: QuadricShape, m: DAffine3, radiance: Vec3, two_sided: bool) -> Option<Self> {
+        let l = m.matrix3;
+        let (x, y, z) = (l.x_axis, l.y_axis, l.z_axis);
+        if shape == QuadricShape::Cylinder {
+            let r = x.length();
+            let tol = 1e-6 * r.max(z.length());
+            let round = (y.length() - r).abs() <= tol
+                && x.dot(y).abs() <= tol * r
+                && x.dot(z).abs() <= tol * z.length()
+                && y.dot(z).abs() <= tol * z.length();
+            if !round {
+                return None;
+            }
+        }
+        let area = shape.area(l);
+        let area = area as f32;
+        (area > 0.0 && area.is_finite() && l.determinant() != 0.0).then(|| Self {
+            shape,
+            world_from_object: m,
+            object_from_world: m.inverse(),
+            normal_to_world: l.inverse().transpose(),
+            radiance,
+            two_sided,
+            area,
+        })
+    }
+
+    /// Total flux (W): `π L A`, twice that for a two-sided light.
+    #[must_use]
+    pub fn power(&self) -> Vec3 {
+        self.radiance * (PI * self.area * if self.two_sided { 2.0 } else { 1.0 })
+    }
+
+    /// Radiance leaving a point with unit normal `n` (the surface's) in direction `w`.
+    #[inline]
+    #[must_use]
+    pub fn le(&self, n: Vec3, w: Vec3) -> Vec3 {
+        if self.two_sided || n.dot(w) > 0.0 {
+            self.radiance
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// A uniform point of the surface (from `u ∈ [0, 1)²`) and its unit normal.
+    #[must_use]
+    pub fn sample_position(&self, u: (f32, f32)) -> (Vec3, Vec3) {
+        let po = match self.shape {
+            QuadricShape::Disc => {
+                let (a, b) = concentric_disk(u);
+                DVec3::new(f64::from(a), f64::from(b), 0.0)
+            }
+            QuadricShape::Cylinder => {
+                let phi = f64::from(TAU * u.0);
+                DVec3::new(phi.cos(), phi.sin(), f64::from(u.1) - 0.5)
+            }
+        };
+        self.at(po)
+    }
+
+    /// The world point and unit normal of the object-space surface point `po`.
+    fn at(&self, po: DVec3) -> (Vec3, Vec3) {
+        let p = self.world_from_object.transform_point3(po).as_vec3();
+        let n = (self.normal_to_world * self.shape.normal(po))
+            .as_vec3()
+            .normalize();
+        (p, n)
+    }
+
+    /// A direction towards a uniform point of the light from `p`, density `d²/(A |cos θ_l|)`.
+    /// `None` behind a one-sided light, for a black light, or where the density is not finite.
+    #[must_use]
+    pub fn sample_li(&self, p: Vec3, u: (f32, f32)) -> Option<LightSample> {
+        if self.radiance == Vec3::ZERO {
+            return None;
+        }
+        let (point, n) = self.sample_position(u);
+        let d = point - p;
+        let dist2 = d.length_squared();
+        let distance = dist2.sqrt();
+        let wi = d / distance;
+        let cos_l = -n.dot(wi);
+        if !(self.two_sided || cos_l > 0.0) {
+            return None;
+        }
+        let pdf = dist2 / (self.area * cos_l.abs());
+        let weight = self.radiance / pdf;
+        (pdf.is_finite() && pdf > 0.0 && weight.is_finite()).then_some(LightSample {
+            wi,
+            distance,
+            point,
+            radiance: self.radiance,
+            pdf,
+            delta: false,
+            weight,
+        })
+    }
+
+    /// [`QuadricLight::sample_li`]'s density of the direction to the surface point `point`
+    /// (unit normal `n`) from `p`: a BSDF-sampled ray's MIS partner when it hits the light.
+    #[inline]
+    #[must_use]
+    pub fn pdf_li_hit(&self, p: Vec3, point: Vec3, n: Vec3) -> f32 {
+        let d = point - p;
+        let dist2 = d.length_squared();
+        let cos_l = -n.dot(d) / dist2.sqrt();
+        if !(self.two_sided || cos_l > 0.0) {
+            return 0.0;
+        }
+        let pdf = dist2 / (self.area * cos_l.abs());
+        if pdf.is_finite() { pdf } else { 0.0 }
+    }
+
+    /// Density of the direction `wi` from `p`: the sum over every point where the line meets
+    /// the surface (a cylinder can be met twice).
+    #[must_use]
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3) -> f32 {
+        let o = self.object_from_world.transform_point3(p.as_dvec3());
+        let d = self.object_from_world.transform_vector3(wi.as_dvec3());
+        self.shape
+            .hit_ts(o, d)
+            .into_iter()
+            .flatten()
+            .map(|t| {
+                let (point, n) = self.at(self.shape.reproject(o + d * t));
+                self.pdf_li_hit(p, point, n)
+            })
+            .fold(0.0, |a, b| a + b)
+    }
+
+    /// A ray leaving the light: a uniform point (`pdf_pos = 1/A`), a cosine-distributed
+    /// direction about the normal (on a random side for a two-sided light).
+    #[must_use]
+    pub fn sample_le(&self, u_pos: (f32, f32), u_dir: (f32, f32)) -> Option<EmissionSample> {
+        if self.radiance == Vec3::ZERO || !self.radiance.is_finite() {
+            return None;
+        }
+        let (origin, n) = self.sample_position(u_pos);
+        let (normal, u, side_pdf) = if !self.two_sided {
+            (n, u_dir, 1.0)
+        } else if u_dir.0 < 0.5 {
+            (n, (2.0 * u_dir.0, u_dir.1), 0.5)
+        } else {
+            (-n, (2.0 * u_dir.0 - 1.0, u_dir.1), 0.5)
+        };
+        let dir = cosine_hemisphere(u, normal);
+        let cos_t = dir.dot(normal);
+        (cos_t > 0.0).then(|| EmissionSample {
+            origin,
+            normal,
+            dir,
+            le: self.radiance,
+            pdf_pos: 1.0 / self.area,
+            pdf_dir: side_pdf * cos_t / PI,
+        })
+    }
+
+    /// `(pdf_pos, pdf_dir)` of [`QuadricLight::sample_le`] for a ray along `dir` from a point
+    /// with unit normal `n`.
+    #[must_use]
+    pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+        let c = n.dot(dir);
+        let pdf_dir = if self.two_sided {
+            c.abs() / (2.0 * PI)
+        } else {
+            c.max(0.0) / PI
+        };
+        (1.0 / self.area, pdf_dir)
+    }
+}
+
+#[cfg(test)]
+mod tests;
