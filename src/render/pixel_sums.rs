@@ -49,8 +49,8 @@ struct WideSums {
 impl WideSums {
     fn add(&mut self, other: &WideSums) {
         for c in 0..3 {
-            self.sums[c] = self.sums[c].add(other.sums[c]);
-            self.squares[c] = self.squares[c].add(other.squares[c]);
+            self.sums[c] = self.sums[c] + other.sums[c];
+            self.squares[c] = self.squares[c] + other.squares[c];
         }
     }
 }
@@ -123,8 +123,8 @@ impl PixelSums {
             } else {
                 // Integral at both scales (|l| ≥ 2³⁰), so the conversion is exact.
                 let w = self.wide.entry(index as u32).or_default();
-                w.sums[c] = w.sums[c].add(WideSum::from_integral_f64(l[c] * SCALE));
-                w.squares[c] = w.squares[c].add(WideSum::from_integral_f64(l[c] * l[c] * SCALE_SQ));
+                w.sums[c] = w.sums[c] + WideSum::from_integral_f64(l[c] * SCALE);
+                w.squares[c] = w.squares[c] + WideSum::from_integral_f64(l[c] * l[c] * SCALE_SQ);
             }
         }
         self.counts[index] += 1;
@@ -219,7 +219,7 @@ impl PixelSums {
             None => m.map(|v| v as f64),
             Some(w) => {
                 let w = part(w);
-                [0, 1, 2].map(|c| WideSum::from_i128(m[c]).add(w[c]).to_f64())
+                [0, 1, 2].map(|c| (WideSum::from_i128(m[c]) + w[c]).to_f64())
             }
         }
     }

@@ -69,20 +69,6 @@ impl WideSum {
         self.0[LIMBS - 1] >> 63 == 1
     }
 
-    /// `self + other`, exact (wrapping only past ±2³⁸³, which film sums never reach).
-    #[must_use]
-    pub fn add(self, other: Self) -> Self {
-        let mut out = [0u64; LIMBS];
-        let mut carry = false;
-        for (o, (a, b)) in out.iter_mut().zip(self.0.iter().zip(other.0)) {
-            let (s1, c1) = a.overflowing_add(b);
-            let (s2, c2) = s1.overflowing_add(u64::from(carry));
-            *o = s2;
-            carry = c1 || c2;
-        }
-        Self(out)
-    }
-
     /// The value as an `i128`, if it fits.
     #[must_use]
     pub fn to_i128(self) -> Option<i128> {
@@ -143,6 +129,23 @@ impl WideSum {
     }
 }
 
+impl std::ops::Add for WideSum {
+    type Output = Self;
+
+    /// `self + other`, exact (wrapping only past ±2³⁸³, which film sums never reach).
+    fn add(self, other: Self) -> Self {
+        let mut out = [0u64; LIMBS];
+        let mut carry = false;
+        for (o, (a, b)) in out.iter_mut().zip(self.0.iter().zip(other.0)) {
+            let (s1, c1) = a.overflowing_add(b);
+            let (s2, c2) = s1.overflowing_add(u64::from(carry));
+            *o = s2;
+            carry = c1 || c2;
+        }
+        Self(out)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -156,9 +159,7 @@ mod tests {
             assert_eq!(WideSum::from_le_bytes(w.to_le_bytes()), w);
         }
         assert_eq!(
-            WideSum::from_i128(i128::MAX)
-                .add(WideSum::from_i128(1))
-                .to_i128(),
+            (WideSum::from_i128(i128::MAX) + WideSum::from_i128(1)).to_i128(),
             None
         );
     }
@@ -179,9 +180,9 @@ mod tests {
             let mut sum = WideSum::default();
             let mut add = w;
             for _ in 0..32 {
-                add = add.add(add);
+                add = add + add;
             }
-            sum = sum.add(add);
+            sum = sum + add;
             assert_eq!(sum.to_f64(), x * 2f64.powi(32), "{x}");
         }
         // Order does not matter, and opposite values cancel exactly.
@@ -190,8 +191,8 @@ mod tests {
             WideSum::from_integral_f64(-1e40),
         );
         let c = WideSum::from_i128(7);
-        assert_eq!(a.add(b).add(c), c.add(b).add(a));
-        assert_eq!(a.add(b).add(c).to_i128(), Some(7));
+        assert_eq!(a + b + c, c + b + a);
+        assert_eq!((a + b + c).to_i128(), Some(7));
     }
 
     #[test]
@@ -199,9 +200,9 @@ mod tests {
         // 2¹³⁰ + 1: the nearest f64 is 2¹³⁰; 2¹³⁰ + 2⁷⁷ + 1 rounds up past the tie.
         let big = WideSum::from_integral_f64(2f64.powi(130));
         let one = WideSum::from_i128(1);
-        assert_eq!(big.add(one).to_f64(), 2f64.powi(130));
+        assert_eq!((big + one).to_f64(), 2f64.powi(130));
         let tie = WideSum::from_integral_f64(2f64.powi(77));
-        let up = big.add(tie).add(one).to_f64();
+        let up = (big + tie + one).to_f64();
         assert_eq!(up, 2f64.powi(130) + 2f64.powi(78));
     }
 }
