@@ -13,6 +13,7 @@ use caustic::Error;
 use caustic::farm::PartMeta;
 use caustic::farm::part_meta::format_ranges;
 use caustic::render::PixelSums;
+use caustic::render::auto_exposure::{resolve, tonemap_for};
 use caustic::render::output::{OutputFormat, check_writable, write_image};
 
 use super::render::is_part;
@@ -210,7 +211,11 @@ pub fn run(args: &MergeArgs) -> Result<(), Error> {
         if is_part(out) {
             merged.sums.write(out, &meta.to_text())?;
         } else {
-            write_image(&film, out, meta.exposure)?;
+            // A non-finite exposure is an automatic one (`render` writes NaN): chosen from the
+            // merged film, as the single render chooses it from its own.
+            let stated = meta.exposure.is_finite().then_some(meta.exposure);
+            let (display, _) = resolve(&film, stated, tonemap_for(stated, None));
+            write_image(&film, out, display)?;
         }
     }
     let names: Vec<String> = args

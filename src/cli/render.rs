@@ -542,7 +542,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             height: p.height,
             region,
             integrator: format!("{:?}", p.integrator),
-            exposure,
+            // NaN: automatic (`merge` then chooses it from the merged film).
+            exposure: stated_exposure.unwrap_or(f32::NAN),
             scene: args.scene.scene.display().to_string(),
             shard: shard.map(|s| s.to_string()),
             seconds: out.stats.elapsed.as_secs_f64(),

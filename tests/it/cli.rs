@@ -133,6 +133,10 @@ fn small_render(dir: &std::path::Path, name: &str, seed: &str) -> String {
         "2",
         "--seed",
         seed,
+        // Exposure 1 with the linear clip: a PNG is then its EXR clamped to [0, 1] (an
+        // automatic exposure would scale it).
+        "--exposure",
+        "1",
         "--quiet",
         "-o",
         &path,
