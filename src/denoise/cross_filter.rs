@@ -13,10 +13,10 @@
 
 use rayon::prelude::*;
 
+use super::DenoiseParams;
 use super::fast_exp::exp_neg;
 use super::input::{Guide, HalfBuffers};
 use super::planes::box_rows;
-use super::DenoiseParams;
 
 /// Rows per work item: a fixed split (not by thread count), so any thread count gives the same
 /// bytes.
@@ -57,7 +57,8 @@ impl LayerPlanes {
                 .map(|(v, a)| v[ch] / a.powi(power))
                 .collect()
         };
-        let half = |values: &[glam::Vec3], power| std::array::from_fn(|ch| plane(values, ch, power));
+        let half =
+            |values: &[glam::Vec3], power| std::array::from_fn(|ch| plane(values, ch, power));
         Self {
             c: std::array::from_fn(|h| half(&layer.mean[h], 1)),
             v: std::array::from_fn(|h| half(&layer.variance[h], 2)),
@@ -105,8 +106,14 @@ impl GuidePlanes {
                     let s = diff(a).min(diff(b));
                     if s.is_finite() { s } else { 0.0 }
                 };
-                let gx = one_sided(x.checked_sub(1).map(|_| i - 1), (x + 1 < w).then_some(i + 1));
-                let gy = one_sided(y.checked_sub(1).map(|_| i - w), (y + 1 < h).then_some(i + w));
+                let gx = one_sided(
+                    x.checked_sub(1).map(|_| i - 1),
+                    (x + 1 < w).then_some(i + 1),
+                );
+                let gy = one_sided(
+                    y.checked_sub(1).map(|_| i - w),
+                    (y + 1 < h).then_some(i + w),
+                );
                 gx.max(gy)
             })
             .collect();

@@ -32,7 +32,9 @@ pub enum DenoiseError {
         expected: usize,
     },
     /// A value is NaN or infinite, or a variance is negative.
-    #[error("the {buffer} buffer is {what} at pixel ({x}, {y}): the denoiser needs finite values and non-negative variances")]
+    #[error(
+        "the {buffer} buffer is {what} at pixel ({x}, {y}): the denoiser needs finite values and non-negative variances"
+    )]
     BadValue {
         /// Which buffer.
         buffer: String,

@@ -128,7 +128,10 @@ impl DenoiseInput {
                 finite(&var, &mut layer.variance[half].iter().map(max3), true)?;
             }
         }
-        let g = self.features.as_ref().ok_or(DenoiseError::MissingFeatures)?;
+        let g = self
+            .features
+            .as_ref()
+            .ok_or(DenoiseError::MissingFeatures)?;
         let vectors = [("albedo", &g.albedo), ("normal", &g.normal)];
         for (name, v) in vectors {
             size(name, v.len())?;

@@ -103,7 +103,10 @@ impl Default for DenoiseParams {
 /// 2×2, or a NaN, infinite or negative-variance value (naming the buffer and the pixel).
 pub fn denoise(input: &DenoiseInput, params: &DenoiseParams) -> Result<Vec<Vec3>, DenoiseError> {
     input.check()?;
-    let guide = input.features.as_ref().ok_or(DenoiseError::MissingFeatures)?;
+    let guide = input
+        .features
+        .as_ref()
+        .ok_or(DenoiseError::MissingFeatures)?;
     let (w, h) = (input.width, input.height);
     let guide_planes = GuidePlanes::new(guide, w, params);
     let albedo = &guide_planes.demodulate;
@@ -131,4 +134,3 @@ pub fn denoise(input: &DenoiseInput, params: &DenoiseParams) -> Result<Vec<Vec3>
     }
     Ok(out)
 }
-

@@ -28,7 +28,10 @@ pub fn box_rows(
         let v = &mut scratch[..w];
         v.fill(0.0);
         for yy in top..=bottom {
-            for (o, s) in v.iter_mut().zip(&src[(yy - first) * w..(yy - first + 1) * w]) {
+            for (o, s) in v
+                .iter_mut()
+                .zip(&src[(yy - first) * w..(yy - first + 1) * w])
+            {
                 *o += s;
             }
         }

@@ -34,7 +34,8 @@ pub fn select(
         Vec3::new(d[0][i], d[1][i], d[2][i])
     };
     // The filtered halves of candidate k at pixel i.
-    let filtered = |k: usize, i: usize| (ma[i] + a(i) * delta(0, k, i), mb[i] + a(i) * delta(1, k, i));
+    let filtered =
+        |k: usize, i: usize| (ma[i] + a(i) * delta(0, k, i), mb[i] + a(i) * delta(1, k, i));
     let errors: [Vec<f32>; CANDIDATES] = std::array::from_fn(|k| {
         let raw: Vec<f32> = (0..n)
             .map(|i| {

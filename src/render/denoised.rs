@@ -157,7 +157,11 @@ fn split(all: &PixelSums, first: &PixelSums, i: usize) -> Split {
     let nb = n - na;
     let (m, ma) = (all.mean(i).as_dvec3(), first.mean(i).as_dvec3());
     let va_samples = first.variance(i).as_dvec3();
-    let va = if na > 0.0 { va_samples / na } else { DVec3::ZERO };
+    let va = if na > 0.0 {
+        va_samples / na
+    } else {
+        DVec3::ZERO
+    };
     if nb <= 0.0 {
         return Split {
             mean: [ma.as_vec3(); 2],
@@ -201,4 +205,3 @@ fn guide(f: &Features) -> Guide {
     }
     g
 }
-

@@ -12,9 +12,9 @@
 use std::path::{Path, PathBuf};
 
 use super::layers::{Layer, LayerExtras, write_layers_with};
-use super::{Film, PixelSums};
 use super::output::{OutputError, OutputFormat, encode, write_atomic_all};
 use super::tonemap::Display;
+use super::{Film, PixelSums};
 use crate::integrators::LightPath;
 
 #[cfg(doc)]
@@ -121,14 +121,7 @@ pub fn write_with_layers(
     output: &Path,
     display: Display,
 ) -> Result<(), OutputError> {
-    write_with_extras(
-        sums,
-        parts,
-        LayerExtras::default(),
-        layers,
-        output,
-        display,
-    )
+    write_with_extras(sums, parts, LayerExtras::default(), layers, output, display)
 }
 
 /// [`write_with_layers`] with the feature buffers and the denoised image of `extras`: an EXR
@@ -157,9 +150,7 @@ pub fn write_with_extras(
                     &noisy
                 }
             };
-            write_atomic_all(&encode_pictures_of(
-                image, parts, layers, output, display,
-            )?)
+            write_atomic_all(&encode_pictures_of(image, parts, layers, output, display)?)
         }
     }
 }

@@ -15,8 +15,8 @@ use exr::prelude::{AnyChannel, FlatSamples};
 
 use super::exr::{encode_channels, rgb_channels};
 use super::features::{FeatureSample, Features};
-use super::{Film, PixelSums};
 use super::output::{OutputError, write_atomic};
+use super::{Film, PixelSums};
 use crate::integrators::LightPath;
 
 /// One layer a render can write beside the combined image.
@@ -220,7 +220,11 @@ fn named3(
     let rename = |c: AnyChannel<FlatSamples>, to: &str| {
         AnyChannel::new(format!("{name}.{to}").as_str(), c.sample_data)
     };
-    [rename(x, names[0]), rename(y, names[1]), rename(z, names[2])]
+    [
+        rename(x, names[0]),
+        rename(y, names[1]),
+        rename(z, names[2]),
+    ]
 }
 
 /// [`encode_layers_with`], written to `path` atomically.

@@ -16,9 +16,9 @@ pub mod tiles;
 pub mod tonemap;
 pub mod trace_pixel;
 
+pub use features::{FeatureSample, Features};
 pub use film::Film;
 pub use job::{RenderJob, render};
-pub use features::{FeatureSample, Features};
 pub use layer_pictures::{
     NotAPicture, layer_path, picture_layers, write_with_extras, write_with_layers,
 };
