@@ -306,10 +306,10 @@ fn filter_band(
             }
         }
     }
-    for half in 0..2 {
-        for k in 0..CANDIDATES {
-            for ch in 0..3 {
-                for (a, s) in acc[half][k][ch].iter_mut().zip(&wsum[half][k]) {
+    for (acc, wsum) in acc.iter_mut().zip(&wsum) {
+        for (acc, wsum) in acc.iter_mut().zip(wsum) {
+            for plane in acc.iter_mut() {
+                for (a, s) in plane.iter_mut().zip(wsum) {
                     // Σw ≥ 1: the pixel itself has weight 1.
                     *a /= s.max(1.0);
                 }

@@ -9,7 +9,7 @@
 pub fn exp_neg(x: f32) -> f32 {
     // 2^f on [0, 1): the Taylor series of e^(f ln 2) to the sixth power.
     const C: [f32; 6] = [
-        0.693_147_2,
+        std::f32::consts::LN_2,
         0.240_226_5,
         0.055_504_11,
         0.009_618_129,

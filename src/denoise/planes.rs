@@ -8,6 +8,10 @@
 /// `first ≤ rows.start − r` or 0, and enough rows below). `scratch` holds one row.
 /// Each sum is taken over its own window (no running sum: a huge value leaving the window
 /// would take the small ones added after it with it).
+#[allow(
+    clippy::too_many_arguments,
+    reason = "the plane, its first row, the image size, the radius, the rows, the scratch and the output: all needed, none belongs with another"
+)]
 pub fn box_rows(
     src: &[f32],
     first: usize,

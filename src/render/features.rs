@@ -144,9 +144,10 @@ impl Features {
                             let ray = camera_sample(scene, &mut sampler, x, y, s);
                             let f = trace_sample(scene, ray, &mut sampler).to_array();
                             let half = &mut halves[usize::from(s >= split)];
-                            for c in 0..FEATURE_CHANNELS {
-                                half.sums[i][c] += f[c];
-                                half.squares[i][c] += f[c] * f[c];
+                            let (sums, squares) = (&mut half.sums[i], &mut half.squares[i]);
+                            for ((s, q), v) in sums.iter_mut().zip(squares.iter_mut()).zip(f) {
+                                *s += v;
+                                *q += v * v;
                             }
                             half.counts[i] += 1;
                         }
