@@ -11,22 +11,10 @@ use glam::DAffine3;
 
 use super::mesh::ObjMesh;
 use super::mesh_file::{MAX_MESH_FILE_BYTES, MeshFormat, read_mesh_file};
-use super::nodes::Flattener;
+use super::nodes::{Flattener, GltfNode};
 use crate::scene::Diagnostic;
 use crate::scene::diagnostic::{did_you_mean, quoted_list};
 use crate::scene::schema::{MaterialSpec, TextureSpec};
-
-/// What [`Flattener::gltf_node`] needs from a `Gltf` node.
-pub(super) struct GltfNode<'a> {
-    /// The file as written (relative to the scene file).
-    pub file: &'a str,
-    /// The file's material names → scene materials.
-    pub materials: &'a BTreeMap<String, String>,
-    /// The camera to render from, by name.
-    pub camera: Option<&'a str>,
-    /// Import the punctual lights.
-    pub lights: bool,
-}
 
 impl Flattener<'_> {
     /// Imports a `Gltf` node under the world transform `xf`: its nodes are flattened as the

@@ -313,3 +313,14 @@ mod tests {
         assert_eq!(bytes_text(1536), "1.5 KiB");
     }
 }
+
+/// Why a PLY file could not be read: the file, where (header line, element and property, or
+/// byte offset), what was found and what is valid.
+#[derive(Debug, thiserror::Error)]
+#[error("`{}` (PLY): {problem}", path.display())]
+pub struct PlyError {
+    /// The PLY file.
+    pub path: PathBuf,
+    /// What is wrong, and where.
+    pub problem: String,
+}

@@ -7,6 +7,7 @@ mod gltf_node;
 pub mod lights;
 mod materials;
 pub mod mesh;
+mod mesh_data;
 pub mod mesh_file;
 pub mod mtl;
 mod nodes;

@@ -13,22 +13,12 @@
 //! ignored: caustic's meshes carry no per-vertex colour. Every other element and property is
 //! read past.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use super::mesh::{Corner, FaceNames, ObjMesh, push_polygon};
-
-/// Why a PLY file could not be read: the file, where (header line, element and property, or
-/// byte offset), what was found and what is valid.
-#[derive(Debug, thiserror::Error)]
-#[error("`{}` (PLY): {problem}", path.display())]
-pub struct PlyError {
-    /// The PLY file.
-    pub path: PathBuf,
-    /// What is wrong, and where.
-    pub problem: String,
-}
+use super::mesh_data::{Corner, FaceNames, ObjMesh, push_polygon};
+pub use super::mesh_file::PlyError;
 
 /// How the records after the header are stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -386,7 +386,10 @@ fn the_preview_page_refines_follows_edits_shows_diagnostics_and_saves() {
         Some(browser.canvas()).filter(|c| c.spp == 256)
     });
     let reference = dir.path().join("ref.png");
-    assert!(render(&scene, FLAGS, &reference).0);
+    // The preview displays at the scene's exposure (1 when unstated, linear), which `render`
+    // gives when the exposure is stated: its automatic exposure is for 8-bit files only.
+    let pinned: Vec<&str> = FLAGS.iter().copied().chain(["--exposure", "1"]).collect();
+    assert!(render(&scene, &pinned, &reference).0);
     assert_eq!(
         done.rgb,
         png_rgb(&reference),
@@ -405,7 +408,7 @@ fn the_preview_page_refines_follows_edits_shows_diagnostics_and_saves() {
     let restarted = wait_for("the edited scene's image", long, || {
         Some(browser.canvas()).filter(|c| c.generation > done.generation && c.spp == 256)
     });
-    assert!(render(&scene, FLAGS, &reference).0);
+    assert!(render(&scene, &pinned, &reference).0);
     let edited_pixels = png_rgb(&reference);
     assert_eq!(
         restarted.rgb, edited_pixels,
@@ -460,7 +463,7 @@ fn the_preview_page_refines_follows_edits_shows_diagnostics_and_saves() {
         .find(|w| w.contains(".."))
         .unwrap_or_else(|| panic!("sample range in {message:?}"));
     assert!(out.exists(), "{message}");
-    let mut same = FLAGS.to_vec();
+    let mut same = pinned.clone();
     same.extend(["--samples", samples]);
     assert!(render(&scene, &same, &reference).0);
     assert_eq!(
