@@ -170,7 +170,7 @@ pub(super) fn node_light(b: &GeometryBuilder, e: &NodeEmitter) -> Result<Light, 
     if e.end.quadrics > e.first.quadrics {
         let q = b.quadrics[e.first.quadrics];
         return QuadricLight::new(q.shape, q.world_from_object, radiance, two_sided)
-            .map(Light::Quadric)
+            .map(|q| Light::Quadric(Box::new(q)))
             .ok_or_else(|| {
                 Diagnostic::error(
                     format!("{}.transform", e.path),

@@ -593,6 +593,18 @@ const CUBE_FACES: [[[f64; 3]; 4]; 6] = [
     ], // -y
 ];
 
+/// What [`Flattener::gltf_node`] needs from a `Gltf` node.
+pub(super) struct GltfNode<'a> {
+    /// The file as written (relative to the scene file).
+    pub file: &'a str,
+    /// The file's material names → scene materials.
+    pub materials: &'a BTreeMap<String, String>,
+    /// The camera to render from, by name.
+    pub camera: Option<&'a str>,
+    /// Import the punctual lights.
+    pub lights: bool,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -617,16 +629,4 @@ mod tests {
         assert!((smallest_singular_value(shear) - 1.0 / phi).abs() < 1e-12);
         assert_eq!(smallest_singular_value(DMat3::ZERO), 0.0);
     }
-}
-
-/// What [`Flattener::gltf_node`] needs from a `Gltf` node.
-pub(super) struct GltfNode<'a> {
-    /// The file as written (relative to the scene file).
-    pub file: &'a str,
-    /// The file's material names → scene materials.
-    pub materials: &'a BTreeMap<String, String>,
-    /// The camera to render from, by name.
-    pub camera: Option<&'a str>,
-    /// Import the punctual lights.
-    pub lights: bool,
 }

@@ -58,7 +58,7 @@ pub enum Light {
     /// An emissive triangle mesh (a `Cube` or `Mesh` node with `emission`), sampled by area.
     Mesh(Arc<MeshLight>),
     /// An emissive disc or cylinder (a `Disc` or `Cylinder` node with `emission`), by area.
-    Quadric(QuadricLight),
+    Quadric(Box<QuadricLight>),
     /// A spot light (a point light with a cone and pbrt-v4's smooth fall-off).
     Spot(SpotLight),
     /// A distant light (the sun), optionally with an angular radius.
