@@ -815,6 +815,7 @@ fn cone_one_minus_cos(r2: f32, dist2: f32) -> f32 {
 mod tests;
 
 // The light shapes of issue #25, standalone until they are wired in as `Light` variants.
+mod area_emission;
 pub mod distant;
 pub mod environment;
 pub mod escape;

@@ -12,9 +12,10 @@
 use glam::{DAffine3, DMat3, DVec3, Vec3};
 use std::f32::consts::{PI, TAU};
 
+use super::area_emission::{pdf_area_le, sample_area_le};
 use super::{EmissionSample, LightSample};
 use crate::geometry::quadric::QuadricShape;
-use crate::sampling::warp::{concentric_disk, cosine_hemisphere};
+use crate::sampling::warp::concentric_disk;
 
 /// An emitting disc or cylinder.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -177,36 +178,14 @@ impl QuadricLight {
             return None;
         }
         let (origin, n) = self.sample_position(u_pos);
-        let (normal, u, side_pdf) = if !self.two_sided {
-            (n, u_dir, 1.0)
-        } else if u_dir.0 < 0.5 {
-            (n, (2.0 * u_dir.0, u_dir.1), 0.5)
-        } else {
-            (-n, (2.0 * u_dir.0 - 1.0, u_dir.1), 0.5)
-        };
-        let dir = cosine_hemisphere(u, normal);
-        let cos_t = dir.dot(normal);
-        (cos_t > 0.0).then(|| EmissionSample {
-            origin,
-            normal,
-            dir,
-            le: self.radiance,
-            pdf_pos: 1.0 / self.area,
-            pdf_dir: side_pdf * cos_t / PI,
-        })
+        sample_area_le(origin, n, self.radiance, self.area, self.two_sided, u_dir)
     }
 
     /// `(pdf_pos, pdf_dir)` of [`QuadricLight::sample_le`] for a ray along `dir` from a point
     /// with unit normal `n`.
     #[must_use]
     pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
-        let c = n.dot(dir);
-        let pdf_dir = if self.two_sided {
-            c.abs() / (2.0 * PI)
-        } else {
-            c.max(0.0) / PI
-        };
-        (1.0 / self.area, pdf_dir)
+        pdf_area_le(n.dot(dir), self.area, self.two_sided)
     }
 }
 

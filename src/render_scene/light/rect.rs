@@ -14,8 +14,8 @@
 use glam::{DVec3, Vec3};
 use std::f32::consts::PI;
 
+use super::area_emission::{pdf_area_le, sample_area_le};
 use super::{EmissionSample, LightSample};
-use crate::sampling::warp::cosine_hemisphere;
 
 /// Solid angle (sr) below which the rectangle is sampled by area rather than by solid angle
 /// (pbrt-v4 uses the same order of magnitude for its bilinear patches).
@@ -201,23 +201,14 @@ impl RectLight {
             return None;
         }
         let origin = self.corner + self.edge_u * u_pos.0 + self.edge_v * u_pos.1;
-        let (normal, u, side_pdf) = if !self.two_sided {
-            (self.normal, u_dir, 1.0)
-        } else if u_dir.0 < 0.5 {
-            (self.normal, (2.0 * u_dir.0, u_dir.1), 0.5)
-        } else {
-            (-self.normal, (2.0 * u_dir.0 - 1.0, u_dir.1), 0.5)
-        };
-        let dir = cosine_hemisphere(u, normal);
-        let cos_t = dir.dot(normal);
-        (cos_t > 0.0).then(|| EmissionSample {
+        sample_area_le(
             origin,
-            normal,
-            dir,
-            le: self.radiance,
-            pdf_pos: 1.0 / self.area,
-            pdf_dir: side_pdf * cos_t / PI,
-        })
+            self.normal,
+            self.radiance,
+            self.area,
+            self.two_sided,
+            u_dir,
+        )
     }
 
     /// The densities `(pdf_pos, pdf_dir)` of [`RectLight::sample_le`] for a ray leaving in the
@@ -225,13 +216,7 @@ impl RectLight {
     /// `pdf_dir = 0` behind a one-sided light.
     #[must_use]
     pub fn pdf_le(&self, dir: Vec3) -> (f32, f32) {
-        let cos_t = self.normal.dot(dir);
-        let pdf_dir = if self.two_sided {
-            cos_t.abs() / (2.0 * PI)
-        } else {
-            cos_t.max(0.0) / PI
-        };
-        (1.0 / self.area, pdf_dir)
+        pdf_area_le(self.normal.dot(dir), self.area, self.two_sided)
     }
 }
 

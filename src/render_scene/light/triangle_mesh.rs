@@ -11,11 +11,11 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
+use super::area_emission::{pdf_area_le, sample_area_le};
 use super::{EmissionSample, LightSample};
 use crate::geometry::Ray;
 use crate::geometry::triangle::{TriRay, intersect_triangle};
 use crate::sampling::alias::AliasTable;
-use crate::sampling::warp::cosine_hemisphere;
 
 /// An emissive triangle mesh (world space).
 #[derive(Debug, Clone, PartialEq)]
@@ -213,36 +213,14 @@ impl MeshLight {
         }
         let (i, _, origin) = self.sample_point(u_pos)?;
         let n = self.normal(i);
-        let (normal, u, side_pdf) = if !self.two_sided {
-            (n, u_dir, 1.0)
-        } else if u_dir.0 < 0.5 {
-            (n, (2.0 * u_dir.0, u_dir.1), 0.5)
-        } else {
-            (-n, (2.0 * u_dir.0 - 1.0, u_dir.1), 0.5)
-        };
-        let dir = cosine_hemisphere(u, normal);
-        let cos_t = dir.dot(normal);
-        (cos_t > 0.0).then(|| EmissionSample {
-            origin,
-            normal,
-            dir,
-            le: self.radiance,
-            pdf_pos: 1.0 / self.area,
-            pdf_dir: side_pdf * cos_t / PI,
-        })
+        sample_area_le(origin, n, self.radiance, self.area, self.two_sided, u_dir)
     }
 
     /// `(pdf_pos, pdf_dir)` of [`MeshLight::sample_le`] for a ray leaving a point of the
     /// triangle with geometric normal `n` in the unit `dir`.
     #[must_use]
     pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
-        let c = n.dot(dir);
-        let pdf_dir = if self.two_sided {
-            c.abs() / (2.0 * PI)
-        } else {
-            c.max(0.0) / PI
-        };
-        (1.0 / self.area, pdf_dir)
+        pdf_area_le(n.dot(dir), self.area, self.two_sided)
     }
 }
 

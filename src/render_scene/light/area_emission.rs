@@ -1,0 +1,55 @@
+//! Emission from a point of an area light (rectangle, triangle mesh, disc, cylinder): the one
+//! cosine-weighted direction sampling, one- or two-sided, that every area light's `sample_le`
+//! and `pdf_le` share, so photons leave every shape by the same rule.
+
+use glam::Vec3;
+use std::f32::consts::PI;
+
+use super::EmissionSample;
+use crate::sampling::warp::cosine_hemisphere;
+
+/// A ray leaving `origin` (a uniformly chosen point, `pdf_pos = 1/area`, `area` in m²) of a
+/// surface with unit normal `n` and radiance `radiance`: a cosine-weighted direction about the
+/// emitting side's normal (`pdf_dir = cos θ/π`); two-sided, the side is chosen by
+/// `u_dir.0 < ½` and `pdf_dir = |cos θ|/(2π)`. The sample's `normal` is the side it leaves
+/// from. `None` for a grazing direction.
+#[must_use]
+pub(super) fn sample_area_le(
+    origin: Vec3,
+    n: Vec3,
+    radiance: Vec3,
+    area: f32,
+    two_sided: bool,
+    u_dir: (f32, f32),
+) -> Option<EmissionSample> {
+    let (normal, u, side_pdf) = if !two_sided {
+        (n, u_dir, 1.0)
+    } else if u_dir.0 < 0.5 {
+        (n, (2.0 * u_dir.0, u_dir.1), 0.5)
+    } else {
+        (-n, (2.0 * u_dir.0 - 1.0, u_dir.1), 0.5)
+    };
+    let dir = cosine_hemisphere(u, normal);
+    let cos_t = dir.dot(normal);
+    (cos_t > 0.0).then(|| EmissionSample {
+        origin,
+        normal,
+        dir,
+        le: radiance,
+        pdf_pos: 1.0 / area,
+        pdf_dir: side_pdf * cos_t / PI,
+    })
+}
+
+/// The densities `(pdf_pos, pdf_dir)` of [`sample_area_le`] for a ray whose direction makes
+/// cosine `cos_t` with the surface's normal: `(1/A, cos θ/π)` on the emitting side
+/// (`(1/A, |cos θ|/(2π))` two-sided), `pdf_dir = 0` behind a one-sided light.
+#[must_use]
+pub(super) fn pdf_area_le(cos_t: f32, area: f32, two_sided: bool) -> (f32, f32) {
+    let pdf_dir = if two_sided {
+        cos_t.abs() / (2.0 * PI)
+    } else {
+        cos_t.max(0.0) / PI
+    };
+    (1.0 / area, pdf_dir)
+}
