@@ -363,7 +363,18 @@ fn run_doc(doc: &Path) -> DocRun {
         }
         let line = reduce(&c.text);
         out.ran += 1;
-        if let Err(e) = run(&dir, &line) {
+        let start = std::time::Instant::now();
+        let result = run(&dir, &line);
+        if std::env::var_os("DOC_COMMAND_TIMES").is_some() {
+            // The cost of each documented command, to keep the suite's time in check.
+            eprintln!(
+                "{:7.2} s  {}:{}  {line}",
+                start.elapsed().as_secs_f64(),
+                c.doc.display(),
+                c.line
+            );
+        }
+        if let Err(e) = result {
             out.failures.push(format!(
                 "{}:{}: `{}` (run as `{line}`): {e}",
                 c.doc.display(),
