@@ -68,7 +68,8 @@ fn the_schema_check_rejects_what_the_schema_forbids() {
         common::json_schema::errors(&schema, &scene),
         Vec::<String>::new()
     );
-    let mutations: [(&str, fn(&mut serde_json::Value)); 5] = [
+    type Mutation = (&'static str, fn(&mut serde_json::Value));
+    let mutations: [Mutation; 5] = [
         ("an unknown top-level field", |v| {
             v["lights_extra"] = serde_json::json!(1)
         }),
