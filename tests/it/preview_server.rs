@@ -341,13 +341,14 @@ fn fuzzed_requests_never_abort_stall_or_stop_the_preview() {
     let before = server.spp_when_rendering();
     let stop = std::sync::atomic::AtomicBool::new(false);
     let worst = std::thread::scope(|scope| {
-        // Eight clients send 40 random requests each, some held open up to 3 s.
-        let clients: Vec<_> = (0..8u64)
+        // Twelve clients send 16 random requests each (192 in all), some held open up to 3 s
+        // (past the server's 2-s request time).
+        let clients: Vec<_> = (0..12u64)
             .map(|c| {
                 scope.spawn(move || {
                     let mut f =
                         Fuzz(0x9e37_79b9_7f4a_7c15 ^ (c + 1).wrapping_mul(0x1234_5678_9abc));
-                    for _ in 0..40 {
+                    for _ in 0..16 {
                         let (bytes, cut) = fuzz_request(&mut f, port);
                         let Ok(mut s) = TcpStream::connect(("127.0.0.1", port)) else {
                             continue;
