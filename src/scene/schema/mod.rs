@@ -13,6 +13,7 @@ pub use crate::settings::{IntegratorKind, SamplerKind, TextureFilter, Tonemap};
 
 mod light;
 mod material;
+mod medium;
 mod node;
 mod values;
 
@@ -21,6 +22,7 @@ pub use material::{
     AbsorptionSpec, CONDUCTOR_PRESETS, CoatSpec, ColorAtDepth, ColorSpec, ConductorSpec,
     ConductorTint, Mapping, MaterialSpec, RoughnessSpec, TextureSpec,
 };
+pub use medium::MediumSpec;
 pub use node::{NodeSpec, TransformStep};
 pub use values::ScaleSpec;
 use values::{exact_floats, unique_keys};
@@ -45,6 +47,14 @@ pub struct SceneFile {
     /// Named materials, referenced by name from nodes.
     #[serde(deserialize_with = "unique_keys")]
     pub materials: BTreeMap<String, MaterialSpec>,
+    /// Named participating media (docs/media.md), referenced by name from a material's
+    /// `medium` (inside its closed surfaces) and from the scene's `medium`.
+    #[serde(default, deserialize_with = "unique_keys")]
+    pub media: BTreeMap<String, MediumSpec>,
+    /// The medium around every object, where the camera and the lights are (fog, steam):
+    /// the name of one of `media`. Unset: clear air.
+    #[serde(default)]
+    pub medium: Option<String>,
     /// Photon-map settings (the `photon` integrator): counts, gathering and filtering.
     #[serde(default)]
     pub photons: PhotonSettings,
