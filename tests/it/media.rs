@@ -335,3 +335,61 @@ fn integrators_without_media_refuse_them_and_bad_media_are_located() {
         "{d:?}"
     );
 }
+
+#[test]
+fn caustic_photons_under_a_murky_slab_carry_the_unscattered_share() {
+    // A horizontal glass slab 0.4 thick filled with a scattering medium over a white floor; a
+    // vertical beam of irradiance E₀ over 1 m². Caustic photons are the light that crosses
+    // without scattering, so the floor receives E₀ (1 − F)² τ / (1 − F² τ²) per channel with
+    // τ = exp(−σt·0.4) (the slab's internal reflections summed), F the normal-incidence
+    // Fresnel reflectance ((η − 1)/(η + 1))².
+    use caustic::integrators::photon::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
+    use caustic::sampling::Sampler;
+    let scene = scene_from_text(
+        r#"Scene(
+    render: (width: 8, height: 8, seed: 5, integrator: Path),
+    camera: Pinhole(eye: (0, 3, 3), look_at: (0, 0, 0), fov_y: 40),
+    materials: {
+        "white": (color: (1, 1, 1)),
+        "murky": (color: (1, 1, 1), diffuse: 0, transmit: 1, ior: 1.5, medium: "silt"),
+    },
+    media: { "silt": (sigma_a: (0.5, 0.2, 1.0), sigma_s: (0.5, 1.5, 0.3), g: 0.6) },
+    lights: [ Point(position: (0, 3, 0), power: (1, 1, 1)) ],
+    nodes: [
+        Cube(material: "murky", transform: [Scale((4, 0.4, 4))]),
+        Quad(material: "white", size: (4, 4), transform: [RotateX(-90), Translate(0, -1, 0)]),
+    ],
+)"#,
+    );
+    let n = 200_000u64;
+    let e0 = 2.0f32;
+    let settings = TraceSettings {
+        kind: MapKind::Caustic,
+        min_bounces: 0,
+        any_bounce: false,
+        max_bounces: 64,
+        pass: None,
+        near_specular: None,
+    };
+    let mut sampler = Sampler::new(scene.params.sampler, 3, 1);
+    let (mut out, mut counts) = (Vec::new(), TraceCounts::default());
+    for i in 0..n {
+        sampler.start_stream(1, i);
+        let (u, v) = sampler.next_2d();
+        let ray = Ray::new(Vec3::new(u - 0.5, 2.0, v - 0.5), -Vec3::Y);
+        let power = Vec3::splat(e0 / n as f32);
+        trace_photon(&scene, ray, power, settings, &mut sampler, &mut out, &mut counts);
+    }
+    for ph in &out {
+        let p = ph.position();
+        assert!((p.y + 1.0).abs() < 1e-4 && p.x.abs() <= 0.5 && p.z.abs() <= 0.5, "{p}");
+    }
+    let f = (0.5f64 / 2.5).powi(2);
+    for (c, st) in [1.0f64, 1.7, 1.3].into_iter().enumerate() {
+        let tau = (-st * 0.4).exp();
+        let want = f64::from(e0) * (1.0 - f).powi(2) * tau / (1.0 - f * f * tau * tau);
+        let got = f64::from(counts.stored_flux[c]);
+        println!("murky slab channel {c}: {got:.5} vs {want:.5}");
+        assert!((got / want - 1.0).abs() < 0.01, "channel {c}: {got} vs {want}");
+    }
+}
