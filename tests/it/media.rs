@@ -378,11 +378,22 @@ fn caustic_photons_under_a_murky_slab_carry_the_unscattered_share() {
         let (u, v) = sampler.next_2d();
         let ray = Ray::new(Vec3::new(u - 0.5, 2.0, v - 0.5), -Vec3::Y);
         let power = Vec3::splat(e0 / n as f32);
-        trace_photon(&scene, ray, power, settings, &mut sampler, &mut out, &mut counts);
+        trace_photon(
+            &scene,
+            ray,
+            power,
+            settings,
+            &mut sampler,
+            &mut out,
+            &mut counts,
+        );
     }
     for ph in &out {
         let p = ph.position();
-        assert!((p.y + 1.0).abs() < 1e-4 && p.x.abs() <= 0.5 && p.z.abs() <= 0.5, "{p}");
+        assert!(
+            (p.y + 1.0).abs() < 1e-4 && p.x.abs() <= 0.5 && p.z.abs() <= 0.5,
+            "{p}"
+        );
     }
     let f = (0.5f64 / 2.5).powi(2);
     for (c, st) in [1.0f64, 1.7, 1.3].into_iter().enumerate() {
@@ -390,6 +401,9 @@ fn caustic_photons_under_a_murky_slab_carry_the_unscattered_share() {
         let want = f64::from(e0) * (1.0 - f).powi(2) * tau / (1.0 - f * f * tau * tau);
         let got = f64::from(counts.stored_flux[c]);
         println!("murky slab channel {c}: {got:.5} vs {want:.5}");
-        assert!((got / want - 1.0).abs() < 0.01, "channel {c}: {got} vs {want}");
+        assert!(
+            (got / want - 1.0).abs() < 0.01,
+            "channel {c}: {got} vs {want}"
+        );
     }
 }

@@ -47,14 +47,6 @@ pub struct SceneFile {
     /// Named materials, referenced by name from nodes.
     #[serde(deserialize_with = "unique_keys")]
     pub materials: BTreeMap<String, MaterialSpec>,
-    /// Named participating media (docs/media.md), referenced by name from a material's
-    /// `medium` (inside its closed surfaces) and from the scene's `medium`.
-    #[serde(default, deserialize_with = "unique_keys")]
-    pub media: BTreeMap<String, MediumSpec>,
-    /// The medium around every object, where the camera and the lights are (fog, steam):
-    /// the name of one of `media`. Unset: clear air.
-    #[serde(default)]
-    pub medium: Option<String>,
     /// Photon-map settings (the `photon` integrator): counts, gathering and filtering.
     #[serde(default)]
     pub photons: PhotonSettings,
@@ -63,6 +55,14 @@ pub struct SceneFile {
     pub lights: Vec<LightSpec>,
     /// The scene graph: a list of nodes forming an implicit root group.
     pub nodes: Vec<NodeSpec>,
+    /// Named participating media (docs/media.md), referenced by name from a material's
+    /// `medium` (inside its closed surfaces) and from the scene's `medium`.
+    #[serde(default, deserialize_with = "unique_keys")]
+    pub media: BTreeMap<String, MediumSpec>,
+    /// The medium around every object, where the camera and the lights are (fog, steam):
+    /// the name of one of `media`. Unset: clear air.
+    #[serde(default)]
+    pub medium: Option<String>,
 }
 
 /// Image and sampling settings (the report's Settings.hpp constants that concern rendering).
