@@ -8,7 +8,7 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 
 use crate::render_scene::texture::{Mapping as RenderMapping, NoiseTexture};
-use crate::render_scene::{SurfaceMaterial, Texture};
+use crate::render_scene::{Interior, SurfaceMaterial, Texture};
 use crate::scene::Diagnostic;
 use crate::scene::schema::{
     AbsorptionSpec, ColorSpec, ConductorSpec, Mapping, SceneFile, TextureSpec,
@@ -120,15 +120,36 @@ impl MaterialTable {
             ));
             Absorption::CLEAR
         });
-        let bsdf = Bsdf::new(
-            color,
-            Vec3::from(m.specular),
-            m.shininess,
-            [m.diffuse, m.reflect, m.transmit],
-            m.ior,
-        )
-        .with_microfacets(distribution, conductor)
-        .with_coat(m.coat.map(|c| c.ior));
+        let bsdf = if m.interface {
+            // No surface: the index-matched pass-through (a dielectric of index 1, white).
+            Bsdf::new(Vec3::ONE, Vec3::ZERO, 1.0, [None, None, Some(1.0)], 1.0)
+        } else {
+            Bsdf::new(
+                color,
+                Vec3::from(m.specular),
+                m.shininess,
+                [m.diffuse, m.reflect, m.transmit],
+                m.ior,
+            )
+            .with_microfacets(distribution, conductor)
+            .with_coat(m.coat.map(|c| c.ior))
+        };
+        let medium = m
+            .medium
+            .as_deref()
+            .and_then(|n| super::media::medium_index(scene, n));
+        let ior = if m.interface { None } else { bsdf.ior() };
+        let interior = Interior {
+            encloses: ior.is_some()
+                || !absorption.is_clear()
+                || medium.is_some()
+                || m.priority.is_some()
+                || m.interface,
+            priority: m.priority,
+            medium,
+            interface: m.interface,
+            ior,
+        };
         let filtered = [color_texture, bump, normal_map, roughness_texture]
             .into_iter()
             .flatten()
@@ -145,6 +166,7 @@ impl MaterialTable {
                 conductor,
                 filtered,
                 absorption,
+                interior,
             },
         ));
         self.index.insert(name.to_string(), i);

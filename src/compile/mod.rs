@@ -6,6 +6,7 @@ pub mod gltf;
 mod gltf_node;
 pub mod lights;
 mod materials;
+mod media;
 pub mod mesh;
 mod mesh_data;
 pub mod mesh_file;
@@ -208,6 +209,11 @@ pub fn compile(
         None => camera,
     };
     let textures = std::mem::take(&mut materials.textures.list);
+    let (media, camera_medium) = media::compile_media(scene);
+    let volumetric = camera_medium.is_some()
+        || materials.list.iter().any(|(_, m)| {
+            m.interior.priority.is_some() || m.interior.medium.is_some() || m.interior.interface
+        });
     let (material_names, materials) = materials.list.into_iter().unzip();
     Ok((
         RenderScene {
@@ -221,6 +227,9 @@ pub fn compile(
             infinity,
             objects,
             geometry,
+            media,
+            camera_medium,
+            volumetric,
         },
         stats,
     ))

@@ -62,6 +62,9 @@ pub(super) fn default_material() -> MaterialSpec {
         conductor: None,
         absorption: None,
         coat: None,
+        medium: None,
+        priority: None,
+        interface: false,
     }
 }
 

@@ -8,17 +8,24 @@ use glam::Vec3;
 use super::context::{Context, PathObserver};
 use super::light_guide::LightGuide;
 use super::photon::{PhotonMap, SHORT_GATHER, SHORT_GATHER_BOUNCES};
-use super::shadow::{LightConnection, RayCone, connect_light, shadow_ray};
+use super::shadow::{LightConnection, RayCone, SHADOW_EPSILON, connect_light, shadow_ray};
 use super::trace_log::{RayKind, ShadowRecord};
 use super::whitted::shadow_transmittance;
 use super::{LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Interaction, Medium, RenderScene, SurfaceHit, SurfacePoint};
+use crate::render_scene::participating::FreeFlight;
+use crate::render_scene::{
+    HomogeneousMedium, Interaction, Medium, RenderScene, SurfaceHit, SurfacePoint,
+};
 use crate::shading::{BsdfAt, TransportMode};
 
 /// Bounces after which Russian roulette may end a path.
 const ROULETTE_DEPTH: u32 = 3;
+
+/// Most surfaces a branch may cross straight on (interfaces, false hits of nested volumes)
+/// before it is dropped: a guard against a ray caught on one surface by rounding.
+const MAX_SKIPPED: u32 = 1024;
 
 /// Photon maps a camera path reads ([`PathTracer::li_with_maps`]); none by default.
 #[derive(Debug, Clone, Copy, Default)]
@@ -198,7 +205,7 @@ impl<'a> PathTracer<'a> {
             kind: RayKind::Camera,
             parent: None,
             depth: 0,
-            medium: Medium::OUTSIDE,
+            medium: Medium::outside(scene),
             splits: 0,
         });
         while let Some(b) = next.take().or_else(|| {
@@ -224,6 +231,8 @@ impl<'a> PathTracer<'a> {
                 mut medium,
                 splits,
             } = b;
+            // Surfaces crossed straight on (interfaces, false hits) by this branch.
+            let mut skipped = 0u32;
             loop {
                 cx.counters.rays += 1;
                 let node = cx.observer.ray(depth, kind, &ray, beta, parent);
@@ -232,9 +241,92 @@ impl<'a> PathTracer<'a> {
                 }
                 root = root.or(node);
                 let mut textured = None;
-                let it = scene.interact(&ray, |t| cone.width_at(&ray, t), &mut textured);
-                // Beer–Lambert absorption along the segment just travelled (1 outside media).
-                beta *= medium.transmittance(&ray, &it);
+                let mut nested = None;
+                let mut it = scene.interact(&ray, |t| cone.width_at(&ray, t), &mut textured);
+                if scene.volumetric {
+                    // Participating media (docs/media.md): free-flight sampling along the
+                    // segment; an event before the surface is a medium vertex.
+                    if let Some(m) = medium.participating(scene) {
+                        let len = ray.dir.length();
+                        let t_hit = match &it {
+                            Interaction::Escaped => f32::INFINITY,
+                            Interaction::Emitter(e) => e.hit.t * len,
+                            Interaction::Surface(v) => v.hit.t * len,
+                        };
+                        match m.sample_distance(t_hit, cx.sampler.next_2d()) {
+                            FreeFlight::Pass { weight } => beta *= weight,
+                            FreeFlight::Scatter { t, weight } => {
+                                beta *= weight;
+                                if depth >= params.max_depth
+                                    || diffuse_bounces >= params.diffuse_depth
+                                    || !beta.is_finite()
+                                    || beta.max_element() <= 0.0
+                                {
+                                    cx.observer.note(node, "depth reached in a medium");
+                                    break;
+                                }
+                                let p = ray.origin + ray.dir * (t / len);
+                                let d_in = ray.dir / len;
+                                let u_light = cx.sampler.next_1d();
+                                let u_point = cx.sampler.next_2d();
+                                if !background_only
+                                    && let Some((index, pmf)) = self.lights.choose(p, || u_light)
+                                {
+                                    let c = self.direct_in_medium(
+                                        p, d_in, m, medium, index, pmf, u_point, cx,
+                                    );
+                                    l.add(
+                                        LightPath::classify(diffuse_bounces + 1, false),
+                                        beta * c,
+                                    );
+                                }
+                                let s = m.phase.sample(d_in, cx.sampler.next_2d());
+                                let u_rr = cx.sampler.next_1d();
+                                diffuse_bounces += 1;
+                                depth += 1;
+                                if depth > ROULETTE_DEPTH {
+                                    let q = (beta / eta_scale).max_element().min(1.0);
+                                    if u_rr >= q {
+                                        cx.observer.note(node, "ended by Russian roulette");
+                                        break;
+                                    }
+                                    beta /= q;
+                                }
+                                cone = cone.scatter(&ray, t / len, s.pdf);
+                                specular = false;
+                                since_local = Some(0);
+                                map_read = false;
+                                prev_pdf = s.pdf;
+                                prev_p = p;
+                                kind = RayKind::Scatter;
+                                parent = node;
+                                ray = Ray::new(p, s.wi);
+                                continue;
+                            }
+                        }
+                    } else {
+                        beta *= medium.transmittance(&ray, &it);
+                    }
+                    if let Interaction::Surface(v) = &mut it {
+                        // An interface or a surface inside a volume of higher priority: not
+                        // there, the path goes straight on (not a bounce).
+                        if medium.skips(scene, v.material) {
+                            skipped += 1;
+                            if skipped > MAX_SKIPPED {
+                                break;
+                            }
+                            (ray, medium) = medium.pass_through(scene, &ray, v);
+                            continue;
+                        }
+                        // Two dielectrics touching: the index ratio of the volumes they separate.
+                        if let Some(eta) = medium.interface_ior(scene, v.material) {
+                            v.bsdf = nested.insert(v.bsdf.with_ior(eta));
+                        }
+                    }
+                } else {
+                    // Beer–Lambert absorption along the segment just travelled (1 outside media).
+                    beta *= medium.transmittance(&ray, &it);
+                }
                 // After a vertex that read the caustic map and at least one specular bounce, the
                 // map holds the light of the lights it carries.
                 let in_map =
@@ -341,7 +433,8 @@ impl<'a> PathTracer<'a> {
                     let u = cx.sampler.get_2d(u_point);
                     let scatter = may_scatter && !read_global;
                     // At diffuse depth 0 direct light is Whitted's: through glass too.
-                    let through = (params.diffuse_depth == 0).then_some((v, medium));
+                    let through =
+                        (params.diffuse_depth == 0 || scene.volumetric).then_some((v, medium));
                     let c = self.direct(sp, &at, index, pmf, u, scatter, through, cx, node);
                     l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
                 }
@@ -507,7 +600,9 @@ impl PathTracer<'_> {
     /// crosses transmitting surfaces in a straight line as Whitted's do
     /// ([`shadow_transmittance`]). At a deeper diffuse depth's last vertex it stays blocked: a
     /// straight line through a refracting surface is not a light path (it would add light that
-    /// refraction sends elsewhere). Logged as a shadow record.
+    /// refraction sends elsewhere). In a volumetric scene `through` is always given and the
+    /// shadow ray keeps the media's transmittance, crossing interfaces and false hits only
+    /// ([`Medium::transmittance_through`]). Logged as a shadow record.
     #[allow(clippy::too_many_arguments)]
     fn direct<O: PathObserver>(
         &self,
@@ -537,6 +632,18 @@ impl PathTracer<'_> {
         let transmittance = match through {
             None if blocked => Vec3::ZERO,
             None => Vec3::ONE,
+            // Volumetric scenes: the media's transmittance along the shadow ray, through
+            // interfaces (docs/media.md).
+            Some((v, medium)) if self.scene.volumetric => {
+                let start = medium.after(self.scene, v, ls.wi);
+                if blocked {
+                    let shadow = shadow_ray(sp, at.frame().ng, ls.point);
+                    let light = Some(index as u32);
+                    start.transmittance_through(self.scene, &shadow, light, &mut cx.counters.rays)
+                } else {
+                    start.transmittance_in_scene(self.scene, ls.distance)
+                }
+            }
             Some(_) if !blocked => Vec3::ONE,
             Some((v, medium)) => {
                 let shadow = shadow_ray(sp, at.frame().ng, ls.point);
@@ -563,6 +670,48 @@ impl PathTracer<'_> {
             cx.observer.shadow(node, record);
         }
         c
+    }
+}
+
+impl PathTracer<'_> {
+    /// Next-event estimation at a medium vertex `p` (light arrived travelling along unit
+    /// `d_in`) in medium `m`, where the path's volumes are `medium`: light `index` (chosen with
+    /// probability `pmf`) sampled from `u`, scattered by the phase function, attenuated by the
+    /// media and interfaces on the way ([`Medium::transmittance_through`]) and MIS-weighted
+    /// against phase sampling by the power heuristic.
+    #[allow(clippy::too_many_arguments)]
+    fn direct_in_medium<O: PathObserver>(
+        &self,
+        p: Vec3,
+        d_in: Vec3,
+        m: &HomogeneousMedium,
+        medium: Medium,
+        index: usize,
+        pmf: f32,
+        u: (f32, f32),
+        cx: &mut Context<'_, O>,
+    ) -> Vec3 {
+        let scene = self.scene;
+        let Some(ls) = scene.lights[index].sample_li(p, u) else {
+            return Vec3::ZERO;
+        };
+        if !(ls.pdf > 0.0) {
+            return Vec3::ZERO;
+        }
+        let phase = m.phase.p(d_in, ls.wi);
+        let w = if ls.delta {
+            1.0
+        } else {
+            power_heuristic(ls.pdf * pmf, phase)
+        };
+        let shadow = Ray {
+            origin: p,
+            dir: ls.point - p,
+            t_max: 1.0 - SHADOW_EPSILON,
+        };
+        let light = Some(index as u32);
+        let tr = medium.transmittance_through(scene, &shadow, light, &mut cx.counters.rays);
+        ls.radiance * tr * (phase * w / (ls.pdf * pmf))
     }
 }
 

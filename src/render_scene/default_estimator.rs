@@ -103,8 +103,10 @@ impl DefaultEstimator {
             .iter()
             .filter_map(|o| o.material)
             .filter(|&m| {
-                material(m as usize)
-                    .is_some_and(|m| m.bsdf.focusing_share(Some(NEAR_SPECULAR_ALPHA)) > 0.0)
+                // An interface (no surface, docs/media.md) focuses nothing.
+                material(m as usize).is_some_and(|m| {
+                    !m.interior.interface && m.bsdf.focusing_share(Some(NEAR_SPECULAR_ALPHA)) > 0.0
+                })
             })
             .count();
         if specular_casters == 0 {

@@ -39,8 +39,8 @@ use super::light::spot::SpotLight;
 use super::light::triangle_mesh::MeshLight;
 use super::texture::{Mapping, NoiseTexture};
 use super::{
-    Camera, Geometry, Light, ObjectInfo, PhotonParams, RenderParams, RenderScene, SurfaceMaterial,
-    Texture,
+    Camera, Geometry, Interior, Light, ObjectInfo, PhotonParams, RenderParams, RenderScene,
+    SurfaceMaterial, Texture,
 };
 use crate::binfile::{Fnv, KeyHash};
 use crate::geometry::quadric::QuadricShape;
@@ -72,6 +72,10 @@ pub fn photon_key(scene: &RenderScene) -> u64 {
         infinity: _,
         objects,
         geometry,
+        media,
+        camera_medium,
+        // Derived from the materials' interiors and `camera_medium`.
+        volumetric: _,
     } = scene;
     let mut h = Fnv::new();
     h.bytes(SALT);
@@ -83,6 +87,19 @@ pub fn photon_key(scene: &RenderScene) -> u64 {
     textures.key_hash(&mut h);
     lights.key_hash(&mut h);
     geometry.key_hash(&mut h);
+    // Media change photon paths; a scene without any feeds nothing, so its key is the one it
+    // had before media existed.
+    if !media.is_empty() || camera_medium.is_some() {
+        h.str("media");
+        h.u64(media.len() as u64);
+        for m in media {
+            for v in [m.sigma_a, m.sigma_s] {
+                v.to_array().key_hash(&mut h);
+            }
+            h.u32(m.phase.g.to_bits());
+        }
+        camera_medium.key_hash(&mut h);
+    }
     h.finish()
 }
 
@@ -208,16 +225,46 @@ impl KeyHash for ObjectInfo {
     }
 }
 
-crate::key_hash_struct!(SurfaceMaterial {
-    bsdf,
-    color_texture,
-    bump,
-    normal_map,
-    roughness_texture,
-    conductor,
-    filtered,
-    absorption,
-});
+impl KeyHash for SurfaceMaterial {
+    /// Every field; the interior only when it states a medium, priority or interface (its
+    /// other fields derive from the BSDF and absorption), so materials without those keep the
+    /// key they had before media existed.
+    fn key_hash(&self, h: &mut Fnv) {
+        let Self {
+            bsdf,
+            color_texture,
+            bump,
+            normal_map,
+            roughness_texture,
+            conductor,
+            filtered,
+            absorption,
+            interior,
+        } = self;
+        h.str("SurfaceMaterial");
+        bsdf.key_hash(h);
+        color_texture.key_hash(h);
+        bump.key_hash(h);
+        normal_map.key_hash(h);
+        roughness_texture.key_hash(h);
+        conductor.key_hash(h);
+        filtered.key_hash(h);
+        absorption.key_hash(h);
+        let Interior {
+            encloses: _,
+            priority,
+            medium,
+            interface,
+            ior: _,
+        } = interior;
+        if priority.is_some() || medium.is_some() || *interface {
+            h.str("interior");
+            priority.map(|p| p as u32).key_hash(h);
+            medium.key_hash(h);
+            interface.key_hash(h);
+        }
+    }
+}
 
 impl KeyHash for Texture {
     fn key_hash(&self, h: &mut Fnv) {

@@ -44,6 +44,9 @@ pub struct SurfaceMaterial {
     /// Beer–Lambert absorption inside the object (the side its geometric normal points away
     /// from), applied along path segments inside it ([`super::Medium`]).
     pub absorption: Absorption,
+    /// The volume its closed surfaces enclose in a volumetric scene: medium, priority,
+    /// interface ([`super::Interior`]).
+    pub interior: super::Interior,
 }
 
 /// The BSDF and frame at one hit, as seen from the outgoing direction `wo`, with its own copy

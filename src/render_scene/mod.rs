@@ -9,6 +9,7 @@ pub mod light;
 pub mod light_sampler;
 pub mod material;
 pub mod medium;
+pub mod participating;
 pub mod surface;
 pub mod texture;
 
@@ -19,7 +20,8 @@ pub use interaction::{EmitterHit, Interaction, SurfaceHit};
 pub use light::{EmissionSample, Light, LightSample};
 pub use light_sampler::LightSampler;
 pub use material::{Shading, ShadingPoint, SurfaceMaterial};
-pub use medium::Medium;
+pub use medium::{Interior, Medium};
+pub use participating::HomogeneousMedium;
 pub use surface::{SurfaceParams, SurfacePoint};
 pub use texture::Texture;
 
@@ -136,6 +138,14 @@ pub struct RenderScene {
     pub objects: Vec<ObjectInfo>,
     /// Primitives and their BVH.
     pub geometry: Geometry,
+    /// Participating media, indexed by [`Interior::medium`] and `camera_medium`.
+    pub media: Vec<HomogeneousMedium>,
+    /// The medium around every object (fog), where cameras and lights are.
+    pub camera_medium: Option<u32>,
+    /// Some material states a medium, a priority or an interface, or the scene a medium:
+    /// paths carry the volume stack and sample media ([`Medium`]); false keeps every
+    /// integrator on its path without media (the same bytes as before media existed).
+    pub volumetric: bool,
 }
 
 impl RenderScene {

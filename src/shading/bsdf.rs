@@ -236,6 +236,29 @@ impl Bsdf {
         Self::with_parts(self.tint, parts)
     }
 
+    /// The same BSDF with the dielectric part's relative index of refraction (inside over
+    /// outside) replaced by `ior`: the interface between two dielectrics that touch (water
+    /// against glass, 1.33/1.5), whose inside and outside indices come from the volumes a path
+    /// is in (`render_scene::Medium`, Schmidt & Budge 2002). Smooth and rough dielectrics keep
+    /// their microfacets; other parts are unchanged.
+    #[must_use]
+    pub fn with_ior(self, ior: f32) -> Self {
+        let mut parts = self.parts;
+        for lobe in parts[2].lobes.iter_mut().flatten() {
+            match lobe {
+                Lobe::Dielectric(d) => d.ior = ior,
+                Lobe::RoughDielectric(d) => d.ior = ior,
+                Lobe::Lambert(_)
+                | Lobe::Phong(_)
+                | Lobe::SpecularReflection(_)
+                | Lobe::SpecularConductor(_)
+                | Lobe::RoughConductor(_)
+                | Lobe::Coated(_) => {}
+            }
+        }
+        Self::with_parts(self.tint, parts)
+    }
+
     /// The clear coat of a coated material, if it is one.
     #[must_use]
     pub fn coat(&self) -> Option<Coated> {

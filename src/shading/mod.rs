@@ -14,6 +14,7 @@ pub mod microfacet;
 pub mod normals;
 pub mod optics;
 mod part;
+pub mod phase;
 pub mod phong;
 pub mod rough_conductor;
 pub mod rough_dielectric;

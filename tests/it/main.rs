@@ -29,6 +29,7 @@ mod light_guide;
 mod light_transport;
 mod lights;
 mod materials_scene;
+mod media;
 mod models;
 mod mutated_scenes;
 mod normal_maps;

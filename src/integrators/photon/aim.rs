@@ -89,9 +89,13 @@ impl CausticTargets {
             .iter()
             .map(|o| {
                 o.material.map_or(0.0, |m| {
-                    scene.materials[m as usize]
-                        .bsdf
-                        .focusing_share(near_specular)
+                    let m = &scene.materials[m as usize];
+                    // An interface (no surface, docs/media.md) focuses nothing.
+                    if m.interior.interface {
+                        0.0
+                    } else {
+                        m.bsdf.focusing_share(near_specular)
+                    }
                 })
             })
             .collect();

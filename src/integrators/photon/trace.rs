@@ -13,6 +13,7 @@ use glam::Vec3;
 
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
+use crate::render_scene::participating::FreeFlight;
 use crate::render_scene::{Interaction, Medium, RenderScene};
 use crate::sampling::Sampler;
 use crate::shading::TransportMode;
@@ -22,6 +23,10 @@ use crate::spatial::Photon;
 /// factor can exceed 1 at grazing angles on bumped surfaces; Veach 1997 §5.3). Bounds the
 /// worst photon's flux so one grazing photon cannot leave a bright spot.
 pub const MAX_FLUX_GROWTH: f32 = 10.0;
+
+/// Most surfaces a photon may cross straight on (interfaces, false hits of nested volumes)
+/// before it is dropped: a guard against a ray caught on one surface by rounding.
+const MAX_SKIPPED: u32 = 1024;
 
 /// Which map a photon path feeds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -116,14 +121,84 @@ pub fn trace_photon(
     let max_flux = power.max_element() * MAX_FLUX_GROWTH;
     let mut diffuse_bounces = 0u32;
     let mut bounces = 0u32;
-    let mut medium = Medium::OUTSIDE;
+    let mut medium = Medium::outside(scene);
     // Past `max_bounces`: the path is only followed to account for what it would have stored.
     let mut cut = false;
+    let mut skipped = 0u32;
     loop {
         let mut textured = None;
-        let it = scene.interact(&ray, |_| 0.0, &mut textured);
-        // Beer–Lambert absorption along the segment just travelled (1 outside media).
-        power *= medium.transmittance(&ray, &it);
+        let mut nested = None;
+        let mut it = scene.interact(&ray, |_| 0.0, &mut textured);
+        if scene.volumetric {
+            if let Some(m) = medium.participating(scene) {
+                let len = ray.dir.length();
+                let t_hit = match &it {
+                    Interaction::Escaped => f32::INFINITY,
+                    Interaction::Emitter(e) => e.hit.t * len,
+                    Interaction::Surface(v) => v.hit.t * len,
+                };
+                if settings.kind == MapKind::Caustic {
+                    // Caustic photons are the light that crosses media without scattering
+                    // (a scattered photon is no longer on a specular path): their expected
+                    // share, exp(−σt d), instead of sampling events and dropping the scattered.
+                    power *= m.transmittance(t_hit);
+                } else {
+                    match m.sample_distance(t_hit, sampler.next_2d()) {
+                        FreeFlight::Pass { weight } => power *= weight,
+                        FreeFlight::Scatter { t, weight } => {
+                            // A bounce in the medium: a diffuse one for the maps (nothing is
+                            // stored there), continued by the phase function.
+                            let p = ray.origin + ray.dir * (t / len);
+                            let s = m.phase.sample(ray.dir / len, sampler.next_2d());
+                            let u_rr = sampler.next_1d();
+                            diffuse_bounces += 1;
+                            bounces += 1;
+                            let q = weight.max_element().min(1.0);
+                            if !(q > 0.0) || u_rr >= q {
+                                return;
+                            }
+                            power *= weight / q;
+                            if !power.is_finite() {
+                                return;
+                            }
+                            let m = power.max_element();
+                            if m > max_flux {
+                                power *= max_flux / m;
+                            }
+                            if bounces > settings.max_bounces && !cut {
+                                cut = true;
+                                counts.lost_at_depth += 1;
+                            }
+                            if bounces > settings.max_bounces.saturating_mul(2) {
+                                return;
+                            }
+                            ray = Ray::new(p, s.wi);
+                            continue;
+                        }
+                    }
+                }
+            } else {
+                power *= medium.transmittance(&ray, &it);
+            }
+            if let Interaction::Surface(v) = &mut it {
+                // Interfaces and surfaces inside a volume of higher priority are not there.
+                if medium.skips(scene, v.material) {
+                    skipped += 1;
+                    if skipped > MAX_SKIPPED {
+                        return;
+                    }
+                    (ray, medium) = medium.pass_through(scene, &ray, v);
+                    continue;
+                }
+                // Two dielectrics touching: the index ratio of the volumes they separate.
+                if let Some(eta) = medium.interface_ior(scene, v.material) {
+                    v.bsdf = nested.insert(v.bsdf.with_ior(eta));
+                }
+            }
+        } else {
+            // Beer–Lambert absorption along the segment just travelled (1 outside media).
+            power *= medium.transmittance(&ray, &it);
+        }
         let v = match it {
             Interaction::Surface(v) => v,
             // Escaped, or an emitter: it absorbs what reaches it.

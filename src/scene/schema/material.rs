@@ -67,6 +67,23 @@ pub struct MaterialSpec {
     /// implemented.
     #[serde(default)]
     pub coat: Option<CoatSpec>,
+    /// The participating medium inside the material's closed surfaces (murky water, smoke):
+    /// the name of one of the scene's `media` (docs/media.md). Not with `absorption` (give
+    /// the medium's `sigma_a` instead).
+    #[serde(default)]
+    pub medium: Option<String>,
+    /// The volume's rank where volumes overlap or touch (Schmidt & Budge 2002, docs/media.md):
+    /// inside two volumes the higher priority's index and medium hold, and the lower one's
+    /// surfaces there are not surfaces at all, so a glass of water is modelled with the water
+    /// reaching into the glass wall and refracts 1.5 | 1.33 where they meet. Materials that
+    /// state a priority take part in this nesting; others are interfaces against air as before.
+    #[serde(default)]
+    pub priority: Option<i32>,
+    /// The surface is no surface: only the boundary of its `medium` (smoke in air, pbrt-v4's
+    /// `interface` material). Rays cross it unbent and unreflected. Requires `medium`; takes
+    /// no colour, weights, roughness, coat or textures.
+    #[serde(default)]
+    pub interface: bool,
 }
 
 /// A smooth dielectric clear coat over a diffuse base.

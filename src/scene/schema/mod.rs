@@ -13,6 +13,7 @@ pub use crate::settings::{IntegratorKind, SamplerKind, TextureFilter, Tonemap};
 
 mod light;
 mod material;
+mod medium;
 mod node;
 mod values;
 
@@ -21,6 +22,7 @@ pub use material::{
     AbsorptionSpec, CONDUCTOR_PRESETS, CoatSpec, ColorAtDepth, ColorSpec, ConductorSpec,
     ConductorTint, Mapping, MaterialSpec, RoughnessSpec, TextureSpec,
 };
+pub use medium::MediumSpec;
 pub use node::{NodeSpec, TransformStep};
 pub use values::ScaleSpec;
 use values::{exact_floats, unique_keys};
@@ -53,6 +55,14 @@ pub struct SceneFile {
     pub lights: Vec<LightSpec>,
     /// The scene graph: a list of nodes forming an implicit root group.
     pub nodes: Vec<NodeSpec>,
+    /// Named participating media (docs/media.md), referenced by name from a material's
+    /// `medium` (inside its closed surfaces) and from the scene's `medium`.
+    #[serde(default, deserialize_with = "unique_keys")]
+    pub media: BTreeMap<String, MediumSpec>,
+    /// The medium around every object, where the camera and the lights are (fog, steam):
+    /// the name of one of `media`. Unset: clear air.
+    #[serde(default)]
+    pub medium: Option<String>,
 }
 
 /// Image and sampling settings (the report's Settings.hpp constants that concern rendering).

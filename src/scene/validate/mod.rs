@@ -2,6 +2,7 @@
 
 mod light;
 mod material;
+mod media;
 mod node;
 mod photons;
 mod render;
@@ -74,7 +75,9 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
     }
     for (name, m) in &scene.materials {
         v.material(&format!("materials.{name}"), m);
+        v.material_volume(&format!("materials.{name}"), m);
     }
+    v.media(scene);
     if scene.lights.is_empty() && !scene.nodes.iter().any(has_emission) {
         v.out.push(
             Diagnostic::warning(
