@@ -130,8 +130,8 @@ impl Settings {
             return Err(usage("--threads must be at least 1".into()));
         }
         let mut overrides = args.scene.overrides();
-        if args.time.is_some() && overrides.samples_per_pixel.is_none() {
-            overrides.samples_per_pixel = Some(BUDGET_SPP_CAP);
+        if args.time.is_some() && overrides.render.samples_per_pixel.is_none() {
+            overrides.render.samples_per_pixel = Some(BUDGET_SPP_CAP);
         }
         Ok(Self {
             scene: args.scene.scene.clone(),

@@ -78,10 +78,8 @@ fn the_command_lines_integrator_wins_over_the_scene_and_the_default() {
     for file in ["benches/scenes/pool.ron", "scenes/refraction.ron"] {
         let path = root().join(file);
         for &kind in IntegratorKind::ALL {
-            let overrides = SceneOverrides {
-                integrator: Some(kind),
-                ..SceneOverrides::default()
-            };
+            let mut overrides = SceneOverrides::default();
+            overrides.render.integrator = Some(kind);
             let p = prepare(&path, &overrides).expect("prepares");
             assert_eq!(p.render_scene.params.integrator, kind, "{file}");
             assert!(p.render_scene.params.default_estimator.is_none(), "{file}");
@@ -123,11 +121,14 @@ fn brightest(f: &Film) -> f32 {
 /// `None`) and `seed`.
 fn pool(integrator: Option<IntegratorKind>, spp: u32, seed: u64) -> Film {
     let overrides = SceneOverrides {
-        width: Some(64),
-        height: Some(48),
-        samples_per_pixel: Some(spp),
-        seed: Some(seed),
-        integrator,
+        render: caustic::scene::schema::RenderSettings {
+            width: Some(64),
+            height: Some(48),
+            samples_per_pixel: Some(spp),
+            seed: Some(seed),
+            integrator,
+            ..Default::default()
+        },
         ..SceneOverrides::default()
     };
     let p =
