@@ -224,6 +224,24 @@ fn is_exr(path: &Path) -> bool {
     matches!(OutputFormat::for_path(path), Ok(OutputFormat::Exr))
 }
 
+/// The shard of `--shard` (`None` without it), after checking that the output is one caustic
+/// writes and that a shard writes a `.part` film (`render` and `preview` share the rule).
+pub(super) fn output_shard(output: &Path, shard: Option<&str>) -> Result<Option<Shard>, Error> {
+    if !is_part(output) {
+        if shard.is_some() {
+            return Err(Error::Usage(format!(
+                "--shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
+                output.display()
+            )));
+        }
+        OutputFormat::for_path(output)?;
+    }
+    shard
+        .map(Shard::parse)
+        .transpose()
+        .map_err(|e| Error::Usage(e.to_string()))
+}
+
 /// Whether `path` asks for the mergeable film (`.part`).
 pub(super) fn is_part(path: &Path) -> bool {
     path.extension()
@@ -279,21 +297,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         .clone()
         .unwrap_or_else(|| default_output(&args.scene.scene));
     // Refuse a bad output name before doing any work.
-    if !is_part(&output) {
-        if args.shard.is_some() {
-            return Err(Error::Usage(format!(
-                "--shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
-                output.display()
-            )));
-        }
-        OutputFormat::for_path(&output)?;
-    }
-    let shard = args
-        .shard
-        .as_deref()
-        .map(Shard::parse)
-        .transpose()
-        .map_err(|e| Error::Usage(e.to_string()))?;
+    let shard = output_shard(&output, args.shard.as_deref())?;
     if let Some(cp) = &args.checkpoint {
         if OutputFormat::for_path(cp).is_err() {
             return Err(Error::Usage(format!(
