@@ -7,7 +7,10 @@
 //! use caustic::pipeline::{SceneOverrides, prepare};
 //! use caustic::render::{RenderOptions, render};
 //!
-//! let small = SceneOverrides { width: Some(8), height: Some(6), samples_per_pixel: Some(1), ..Default::default() };
+//! use caustic::scene::schema::RenderSettings;
+//!
+//! let size = RenderSettings { width: Some(8), height: Some(6), samples_per_pixel: Some(1), ..Default::default() };
+//! let small = SceneOverrides { render: size, ..Default::default() };
 //! let prepared = prepare(std::path::Path::new("scenes/cornell.ron"), &small)?;
 //! let out = render(&prepared.render_scene, &RenderOptions::default())?;
 //! assert_eq!((out.film.width, out.film.height), (8, 6));

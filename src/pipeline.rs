@@ -3,53 +3,37 @@
 
 use std::path::Path;
 
-use crate::compile::{CompileStats, compile};
+use crate::compile::{CompileStats, compile_with};
 use crate::error::Error;
 use crate::render_scene::RenderScene;
 use crate::scene::load::SourceFile;
 use crate::scene::overrides::apply_overrides;
+use crate::scene::schema::{PhotonSettings, RenderSettings};
 use crate::scene::validate::validate;
 use crate::scene::{Diagnostic, SceneError, SceneFile};
-use crate::settings::{IntegratorKind, SamplerKind};
 
-/// Command-line changes to a scene: `--set` assignments and the dedicated render flags.
+/// Command-line changes to a scene: `--set` assignments and the dedicated render flags, the
+/// latter as layers of the scene's own settings structs (only the fields the command line
+/// states are `Some`).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SceneOverrides {
     /// `path=value` assignments, applied first.
     pub sets: Vec<String>,
-    /// `render.width`.
-    pub width: Option<u32>,
-    /// `render.height`.
-    pub height: Option<u32>,
-    /// `render.samples_per_pixel`.
-    pub samples_per_pixel: Option<u32>,
-    /// `render.max_depth`.
-    pub max_depth: Option<u32>,
-    /// `render.seed`.
-    pub seed: Option<u64>,
-    /// `render.integrator`.
-    pub integrator: Option<IntegratorKind>,
-    /// `render.sampler`.
-    pub sampler: Option<SamplerKind>,
-    /// `photons.caustic`, shared by power among all lights (their own `caustic_photons` are
-    /// dropped).
-    pub caustic_photons: Option<u32>,
+    /// `render` fields the flags state (`--width`, `--spp`, `--integrator`, …).
+    pub render: RenderSettings,
+    /// `photons` fields the flags state. A stated `caustic` (`--caustic-photons`) is shared by
+    /// power among all lights: their own `caustic_photons` are dropped.
+    pub photons: PhotonSettings,
 }
 
 impl SceneOverrides {
-    /// Applies the overrides to a parsed scene.
+    /// Applies the overrides to a parsed scene: the assignments, then the flags' layers over
+    /// the file's settings.
     pub fn apply(&self, scene: &SceneFile) -> Result<SceneFile, SceneError> {
         let mut s = apply_overrides(scene, &self.sets)?;
-        let r = &mut s.render;
-        r.width = self.width.unwrap_or(r.width);
-        r.height = self.height.unwrap_or(r.height);
-        r.samples_per_pixel = self.samples_per_pixel.unwrap_or(r.samples_per_pixel);
-        r.max_depth = self.max_depth.unwrap_or(r.max_depth);
-        r.seed = self.seed.unwrap_or(r.seed);
-        r.integrator = self.integrator.or(r.integrator);
-        r.sampler = self.sampler.unwrap_or(r.sampler);
-        if let Some(n) = self.caustic_photons {
-            s.photons.caustic = n;
+        s.render = self.render.or(&s.render);
+        s.photons = self.photons.or(&s.photons);
+        if self.photons.caustic.is_some() {
             for l in &mut s.lights {
                 *l.caustic_photons_mut() = None;
             }
@@ -66,21 +50,18 @@ impl SceneOverrides {
             .filter_map(|s| s.split_once('='))
             .map(|(k, _)| k.trim().to_string())
             .collect();
-        for (flag, set) in [
-            ("render.width", self.width.is_some()),
-            ("render.height", self.height.is_some()),
-            ("render.samples_per_pixel", self.samples_per_pixel.is_some()),
-            ("render.max_depth", self.max_depth.is_some()),
-            ("render.seed", self.seed.is_some()),
-            ("render.integrator", self.integrator.is_some()),
-            ("render.sampler", self.sampler.is_some()),
-            ("photons.caustic", self.caustic_photons.is_some()),
-        ] {
-            if set {
-                p.push(flag.to_string());
-            }
-        }
+        p.extend(self.render.stated().iter().map(|f| format!("render.{f}")));
+        p.extend(self.photons.stated().iter().map(|f| format!("photons.{f}")));
         p
+    }
+
+    /// The photon settings the command line stated, read from `applied` (the scene's photon
+    /// settings after [`SceneOverrides::apply`]): the fields named by a flag or a
+    /// `--set photons.FIELD=…`.
+    #[must_use]
+    pub fn stated_photons(&self, applied: &PhotonSettings) -> PhotonSettings {
+        let paths = self.paths();
+        applied.only(|field| paths.iter().any(|p| *p == format!("photons.{field}")))
     }
 }
 
@@ -117,9 +98,9 @@ pub fn check(
 /// Reads, overrides, validates and compiles a scene file.
 pub fn prepare(path: &Path, overrides: &SceneOverrides) -> Result<Prepared, Error> {
     let (source, scene, warnings) = check(path, overrides)?;
-    let (mut render_scene, mut stats) = compile(&scene, &source.base_dir())
+    let command_line = overrides.stated_photons(&scene.photons);
+    let (render_scene, mut stats) = compile_with(&scene, &command_line, &source.base_dir())
         .map_err(|errs| SceneError::Invalid(locate(&source, errs, overrides)))?;
-    keep_stated_photons(&mut render_scene, &scene, overrides);
     let mut warnings = warnings;
     warnings.extend(locate(
         &source,
@@ -133,40 +114,6 @@ pub fn prepare(path: &Path, overrides: &SceneOverrides) -> Result<Prepared, Erro
         stats,
         warnings,
     })
-}
-
-/// The default estimator chooses its per-pass photon counts itself, but counts stated on the
-/// command line (`--set photons.caustic=…`, `--caustic-photons`, `--photons`, `--gather`) are
-/// per pass and win: they replace the chosen ones, and the summary says so.
-fn keep_stated_photons(rs: &mut RenderScene, scene: &SceneFile, overrides: &SceneOverrides) {
-    let Some(choice) = rs.params.default_estimator.as_mut() else {
-        return;
-    };
-    if choice.photons.is_none() {
-        return;
-    }
-    let stated = overrides.paths();
-    let is_stated = |field: &str| stated.iter().any(|p| p == &format!("photons.{field}"));
-    let p = &mut rs.params.photons;
-    let mut any = false;
-    for (field, value, from) in [
-        ("caustic", &mut p.caustic, scene.photons.caustic),
-        ("global", &mut p.global, scene.photons.global),
-        (
-            "caustic_gather",
-            &mut p.caustic_gather,
-            scene.photons.caustic_gather,
-        ),
-        ("gather", &mut p.gather, scene.photons.gather),
-    ] {
-        if is_stated(field) {
-            *value = from;
-            any = true;
-        }
-    }
-    if any {
-        choice.photons = None;
-    }
 }
 
 fn locate(

@@ -6,9 +6,11 @@
 pub mod atomic;
 pub mod fnv;
 pub mod key;
+pub mod meta_text;
 pub mod reader;
 
 pub use atomic::{AtomicWrite, parent_dir};
 pub use fnv::{Fnv, fnv1a};
 pub use key::KeyHash;
+pub use meta_text::MetaText;
 pub use reader::{Reader, Truncated};

@@ -12,8 +12,8 @@ use caustic::analysis::metrics::{
 };
 use caustic::render::Region;
 
-use super::error_image::{self, ErrorScale};
 use super::render::parse_region;
+use caustic::analysis::error_image::{self, ErrorScale};
 
 /// Arguments of `caustic compare`.
 #[derive(Args)]

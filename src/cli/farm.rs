@@ -126,25 +126,25 @@ fn shard_budget(limit: Duration) -> Option<Duration> {
 fn override_record(o: &SceneOverrides) -> Vec<String> {
     let mut out = o.sets.clone();
     let flags = [
-        ("render.width", o.width.map(u64::from)),
-        ("render.height", o.height.map(u64::from)),
+        ("render.width", o.render.width.map(u64::from)),
+        ("render.height", o.render.height.map(u64::from)),
         (
             "render.samples_per_pixel",
-            o.samples_per_pixel.map(u64::from),
+            o.render.samples_per_pixel.map(u64::from),
         ),
-        ("render.max_depth", o.max_depth.map(u64::from)),
-        ("render.seed", o.seed),
-        ("photons.caustic", o.caustic_photons.map(u64::from)),
+        ("render.max_depth", o.render.max_depth.map(u64::from)),
+        ("render.seed", o.render.seed),
+        ("photons.caustic", o.photons.caustic.map(u64::from)),
     ];
     for (path, v) in flags {
         if let Some(v) = v {
             out.push(format!("{path}={v}"));
         }
     }
-    if let Some(i) = o.integrator {
+    if let Some(i) = o.render.integrator {
         out.push(format!("render.integrator={}", i.name()));
     }
-    if let Some(s) = o.sampler {
+    if let Some(s) = o.render.sampler {
         out.push(format!("render.sampler={}", s.name()));
     }
     out
@@ -181,7 +181,9 @@ fn resolved_scene(
             from.display()
         ))
     };
-    let mut tree = serde_json::to_value(scene).map_err(|e| fail(e.to_string()))?;
+    // Every setting pinned to the value in effect (the stated ones over their defaults).
+    let mut tree =
+        serde_json::to_value(scene.with_default_settings()).map_err(|e| fail(e.to_string()))?;
     absolute_assets(&mut tree, base);
     pin_default_estimator(&mut tree, params);
     let scene: SceneFile = serde_json::from_value(tree).map_err(|e| fail(e.to_string()))?;
@@ -244,7 +246,7 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
     let mut overrides = a.scene.overrides();
     let time = a.time.unwrap_or(DEFAULT_TIME);
     // `--time` without `--spp`: a plan in time, every shard renders until its budget.
-    let in_time = a.time.is_some() && overrides.samples_per_pixel.is_none();
+    let in_time = a.time.is_some() && overrides.render.samples_per_pixel.is_none();
     if in_time {
         if shard_budget(time).is_none() {
             return Err(usage(format!(
@@ -262,7 +264,7 @@ fn plan(a: &PlanArgs) -> Result<(), Error> {
                     u32::MAX / TIME_PLAN_SPP_PER_SHARD
                 ))
             })?;
-        overrides.samples_per_pixel = Some(total);
+        overrides.render.samples_per_pixel = Some(total);
     }
     let source_path = &a.scene.scene;
     let prepared = prepare(source_path, &overrides)?;

@@ -16,7 +16,8 @@ use caustic::pipeline::{SceneOverrides, prepare};
 use caustic::render::RenderOptions;
 use caustic::render::golden::floor::{self, DetectSearch, DetectStep, DetectionFloor};
 use caustic::render::golden::{
-    BatchBlocks, BatchTest, GoldenImage, GoldenMeta, PixelEstimates, render_batches, report,
+    BatchBlocks, BatchTest, GoldenImage, GoldenMeta, PixelEstimates, golden_file_name,
+    render_batches, report, scene_files,
 };
 use caustic::settings::{IntegratorKind, SamplerKind};
 
@@ -135,75 +136,24 @@ fn usage(text: String) -> Error {
     Error::Usage(text)
 }
 
-/// The scene files named: files as given, folders replaced by their `.ron` and `.toml` files
-/// (sorted); refuses two scenes whose golden files would have the same name.
-fn scene_list(first: &Path, more: &[PathBuf]) -> Result<Vec<PathBuf>, Error> {
-    let mut out = Vec::new();
-    for path in std::iter::once(first).chain(more.iter().map(PathBuf::as_path)) {
-        if path.is_dir() {
-            let entries = std::fs::read_dir(path)
-                .map_err(|e| usage(format!("cannot read the folder `{}`: {e}", path.display())))?;
-            let mut found: Vec<PathBuf> = entries
-                .filter_map(Result::ok)
-                .map(|e| e.path())
-                .filter(|p| {
-                    p.is_file()
-                        && matches!(p.extension().and_then(|e| e.to_str()), Some("ron" | "toml"))
-                })
-                .collect();
-            if found.is_empty() {
-                return Err(usage(format!(
-                    "the folder `{}` holds no scene (.ron or .toml) files",
-                    path.display()
-                )));
-            }
-            found.sort();
-            out.extend(found);
-        } else {
-            out.push(path.to_path_buf());
-        }
-    }
-    let mut names: Vec<(String, &PathBuf)> = out.iter().map(|p| (golden_name(p), p)).collect();
-    names.sort();
-    for w in names.windows(2) {
-        if w[0].0 == w[1].0 {
-            return Err(usage(format!(
-                "`{}` and `{}` would share the golden file `{}`; check them with separate --golden folders",
-                w[0].1.display(),
-                w[1].1.display(),
-                w[0].0
-            )));
-        }
-    }
-    Ok(out)
-}
-
-/// The golden file's name for a scene: its file name and `.golden` (`cornell.ron.golden`).
-fn golden_name(scene: &Path) -> String {
-    let name = scene
-        .file_name()
-        .map_or_else(|| "scene".into(), |n| n.to_string_lossy().into_owned());
-    format!("{name}.golden")
-}
-
 /// The overrides that `update` records for `check` to apply again (all but the seed).
 fn record(o: &SceneOverrides) -> Vec<(String, String)> {
     let mut out: Vec<(String, String)> = o.sets.iter().map(|s| ("set".into(), s.clone())).collect();
     for (key, v) in [
-        ("width", o.width),
-        ("height", o.height),
-        ("spp", o.samples_per_pixel),
-        ("max_depth", o.max_depth),
-        ("caustic_photons", o.caustic_photons),
+        ("width", o.render.width),
+        ("height", o.render.height),
+        ("spp", o.render.samples_per_pixel),
+        ("max_depth", o.render.max_depth),
+        ("caustic_photons", o.photons.caustic),
     ] {
         if let Some(v) = v {
             out.push((key.into(), v.to_string()));
         }
     }
-    if let Some(i) = o.integrator {
+    if let Some(i) = o.render.integrator {
         out.push(("integrator".into(), i.cli_name().into()));
     }
-    if let Some(s) = o.sampler {
+    if let Some(s) = o.render.sampler {
         out.push(("sampler".into(), s.cli_name().into()));
     }
     out
@@ -235,15 +185,17 @@ fn combined(
         };
         match key.as_str() {
             "set" => o.sets.push(value.clone()),
-            "width" => o.width = Some(num()?),
-            "height" => o.height = Some(num()?),
-            "spp" => o.samples_per_pixel = Some(num()?),
-            "max_depth" => o.max_depth = Some(num()?),
-            "caustic_photons" => o.caustic_photons = Some(num()?),
+            "width" => o.render.width = Some(num()?),
+            "height" => o.render.height = Some(num()?),
+            "spp" => o.render.samples_per_pixel = Some(num()?),
+            "max_depth" => o.render.max_depth = Some(num()?),
+            "caustic_photons" => o.photons.caustic = Some(num()?),
             "integrator" => {
-                o.integrator = Some(IntegratorKind::from_name(value).ok_or_else(unknown)?)
+                o.render.integrator = Some(IntegratorKind::from_name(value).ok_or_else(unknown)?)
             }
-            "sampler" => o.sampler = Some(SamplerKind::from_name(value).ok_or_else(unknown)?),
+            "sampler" => {
+                o.render.sampler = Some(SamplerKind::from_name(value).ok_or_else(unknown)?)
+            }
             _ => {
                 return Err(usage(format!(
                     "`{}`: unknown recorded flag `{key}` (written by a newer caustic?); run `caustic golden update` again",
@@ -253,14 +205,9 @@ fn combined(
         }
     }
     o.sets.extend(own.sets.iter().cloned());
-    o.width = own.width.or(o.width);
-    o.height = own.height.or(o.height);
-    o.samples_per_pixel = own.samples_per_pixel.or(o.samples_per_pixel);
-    o.max_depth = own.max_depth.or(o.max_depth);
-    o.caustic_photons = own.caustic_photons.or(o.caustic_photons);
-    o.integrator = own.integrator.or(o.integrator);
-    o.sampler = own.sampler.or(o.sampler);
-    o.seed = Some(own.seed.unwrap_or(golden.seed.wrapping_add(1)));
+    o.render = own.render.or(&o.render);
+    o.photons = own.photons.or(&o.photons);
+    o.render.seed = Some(own.render.seed.unwrap_or(golden.seed.wrapping_add(1)));
     Ok(o)
 }
 
@@ -318,18 +265,14 @@ fn render_scene(
             out.output.stats.nan_samples
         );
     }
-    let p = &prepared.render_scene.params;
-    let scene_value = serde_json::to_value(&prepared.scene).unwrap_or_default();
+    // The settings in effect: the stated ones over their defaults.
+    let scene_value =
+        serde_json::to_value(prepared.scene.with_default_settings()).unwrap_or_default();
     let meta = GoldenMeta {
-        hash,
-        seed,
-        spp: p.samples_per_pixel,
-        integrator: format!("{:?}", p.integrator),
-        sampler: format!("{:?}", p.sampler),
-        exposure: p.exposure,
         scene: path.display().to_string(),
         overrides: record(overrides),
         settings: report::settings(&scene_value),
+        ..GoldenMeta::of(&prepared.render_scene, hash)
     };
     Ok(Rendered {
         estimates: PixelEstimates::from_sums(&out.output.sums),
@@ -340,7 +283,7 @@ fn render_scene(
 }
 
 fn update(a: &UpdateArgs) -> Result<(), Error> {
-    let scenes = scene_list(&a.scene.scene, &a.more)?;
+    let scenes = scene_files(&a.scene.scene, &a.more).map_err(|e| usage(e.to_string()))?;
     if a.block == 0 {
         return Err(usage("--block must be at least 1 pixel".into()));
     }
@@ -364,7 +307,7 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
                     side = scale.side
                 );
                 let mut more = overrides.clone();
-                more.samples_per_pixel = Some(spp);
+                more.render.samples_per_pixel = Some(spp);
                 let next = render_scene(path, &more, a.block, a.threads, a.quiet, None)?;
                 let next_floor = DetectionFloor::of(&next.batches, a.alpha);
                 let (was, now) = (
@@ -391,7 +334,7 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
                 );
             }
         }
-        let target = a.output.join(golden_name(path));
+        let target = a.output.join(golden_file_name(path));
         let (w, h) = (r.estimates.width, r.estimates.height);
         let (spp, integrator) = (r.meta.spp, r.meta.integrator.clone());
         GoldenImage {
@@ -411,7 +354,7 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
 }
 
 fn check(a: &CheckArgs) -> Result<(), Error> {
-    let scenes = scene_list(&a.scene.scene, &a.more)?;
+    let scenes = scene_files(&a.scene.scene, &a.more).map_err(|e| usage(e.to_string()))?;
     let test = BatchTest { alpha: a.alpha };
     let own = a.scene.overrides();
     let error_dir = a.error_dir.clone().unwrap_or_else(|| a.golden.clone());
@@ -453,7 +396,7 @@ fn check_one(
     test: &BatchTest,
     error_dir: &Path,
 ) -> Result<Outcome, Error> {
-    let golden_path = a.golden.join(golden_name(path));
+    let golden_path = a.golden.join(golden_file_name(path));
     let golden = GoldenImage::read(&golden_path).map_err(|e| {
         usage(format!(
             "{}: {e}; write it with `caustic golden update {} -o {}`",

@@ -13,7 +13,7 @@ use caustic::render::golden::{
     BatchBlocks, BatchTest, BatchVerdict, GoldenImage, GoldenMeta, PixelEstimates,
 };
 
-use super::error_image::{self, ErrorScale};
+use caustic::analysis::error_image::{self, ErrorScale};
 
 /// A scene's verdict.
 pub enum Outcome {

@@ -4,7 +4,6 @@ mod check;
 mod compare;
 mod converge;
 mod debug_pixel;
-mod error_image;
 mod farm;
 mod golden;
 mod golden_report;
@@ -12,10 +11,7 @@ mod layers_flag;
 mod max_rmse;
 mod merge;
 mod photons;
-mod pixel_font;
 mod plot;
-mod plot_backend;
-mod plot_csv;
 mod preview;
 mod render;
 mod same_file;
@@ -27,6 +23,7 @@ use clap::{Args, Parser, Subcommand};
 use caustic::Error;
 use caustic::pipeline::SceneOverrides;
 use caustic::scene::Diagnostic;
+use caustic::scene::schema::{PhotonSettings, RenderSettings};
 use caustic::settings::{IntegratorKind, SamplerKind, Tonemap};
 
 /// caustic: a ray tracer driven by RON/TOML scene files.
@@ -61,7 +58,7 @@ enum Command {
     Converge(converge::ConvergeArgs),
     /// Draw `converge`'s log-log plot of RMSE against time, with fitted slopes, for curves read
     /// from CSV files (`seconds,rmse` columns): another renderer's beside caustic's.
-    Plot(plot_csv::PlotArgs),
+    Plot(plot::PlotArgs),
     /// Draw the photon maps over a dim render of the scene (caustic photons orange, global
     /// blue, brighter where more power landed).
     Photons(photons::PhotonsArgs),
@@ -93,7 +90,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::DebugPixel(args) => debug_pixel::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Converge(args) => converge::run(&args),
-        Command::Plot(args) => plot_csv::run(&args),
+        Command::Plot(args) => plot::run(&args),
         Command::Photons(args) => photons::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::Farm(args) => farm::run(&args),
@@ -172,15 +169,21 @@ impl SceneArgs {
             sets.push(format!("photons.max_radius={r:?}"));
         }
         SceneOverrides {
-            caustic_photons: self.caustic_photons,
             sets,
-            width: self.width,
-            height: self.height,
-            samples_per_pixel: self.spp,
-            max_depth: self.max_depth,
-            seed: self.seed,
-            integrator: self.integrator,
-            sampler: self.sampler,
+            render: RenderSettings {
+                width: self.width,
+                height: self.height,
+                samples_per_pixel: self.spp,
+                max_depth: self.max_depth,
+                seed: self.seed,
+                integrator: self.integrator,
+                sampler: self.sampler,
+                ..RenderSettings::default()
+            },
+            photons: PhotonSettings {
+                caustic: self.caustic_photons,
+                ..PhotonSettings::default()
+            },
         }
     }
 }

@@ -1,167 +1,151 @@
-//! Log-log plots of error against time for `caustic converge`, drawn with `plotters` once as
-//! SVG (text as `<text>`, so no font is needed) and once into an RGB buffer saved as PNG, whose
-//! text is drawn with the 8×8 bitmap font ([`super::pixel_font`]) by a thin backend wrapper:
-//! plotters is built without its font features (font-kit and system fonts). Every text is 18 px:
-//! plotters lays text out with its font-less estimate of 0.7 em per character (em = size / 1.24²),
-//! which at 18 px is the bitmap font's 8 px advance, so boxes fit the PNG's text.
+//! `caustic plot`: the log-log plot and slopes of `caustic converge`, for curves read from CSV
+//! files — another renderer's (Mitsuba 3's, in `scripts/convergence_slopes.sh`) beside ours.
 
-use std::path::Path;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
-use plotters::coord::Shift;
-use plotters::prelude::*;
+use clap::Args;
+use serde_json::json;
 
-use caustic::render::output::{OutputError, write_atomic};
+use caustic::Error;
+use caustic::render::output::write_atomic;
 
-use super::error_image::write_png;
-use super::plot_backend::PixelFontBackend;
+use caustic::analysis::convergence_plot::{Curve, Plot};
+use caustic::analysis::slope::{fmt_slope, log_log_slope};
 
-/// Size of both plots, in pixels.
-pub const SIZE: (u32, u32) = (800, 560);
-
-/// One curve: an integrator's points.
-#[derive(Debug, Clone)]
-pub struct Curve {
-    /// The legend's text (name and fitted slope).
-    pub label: String,
-    /// (wall time in seconds, RMSE), both positive.
-    pub points: Vec<(f64, f64)>,
-}
-
-/// A plot: title, axis names and curves.
-#[derive(Debug, Clone)]
-pub struct Plot {
+/// `caustic plot` arguments.
+#[derive(Args, Debug)]
+pub struct PlotArgs {
+    /// Curves as `LABEL=FILE.csv`: each CSV has a header row naming at least the columns
+    /// `seconds` and `rmse`, then one point per row.
+    #[arg(required = true, value_name = "LABEL=CSV")]
+    curves: Vec<String>,
+    /// Writes OUT.svg and OUT.png (and OUT.json: the points and slopes).
+    #[arg(long, short, value_name = "OUT")]
+    output: PathBuf,
     /// Caption above the chart.
-    pub title: String,
-    /// X axis name.
-    pub x_desc: String,
-    /// Y axis name.
-    pub y_desc: String,
-    /// The curves; points that are not positive and finite are left out.
-    pub curves: Vec<Curve>,
+    #[arg(long, default_value = "RMSE against render time")]
+    title: String,
+    /// RMSE of the reference's own noise σ: also fits the slope of √(RMSE² − σ²), the error
+    /// against the exact image (a reference's noise adds σ² to every point's expected MSE and
+    /// flattens a curve's far end).
+    #[arg(long, value_name = "SIGMA", default_value_t = 0.0)]
+    ref_noise: f64,
 }
 
-/// Writes the plot as `<stem>.svg` and `<stem>.png` (each atomically).
-pub fn write(plot: &Plot, svg: &Path, png: &Path) -> Result<(), OutputError> {
-    let fail = |path: &Path, e: String| OutputError::Io {
-        path: path.to_path_buf(),
-        source: std::io::Error::other(e),
+/// The `(seconds, rmse)` points of the CSV file `path` (`text` its contents), sorted by time.
+fn points(path: &Path, text: &str) -> Result<Vec<(f64, f64)>, Error> {
+    let bad =
+        |line: usize, what: String| Error::Usage(format!("{}:{line}: {what}", path.display()));
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let Some((_, header)) = lines.next() else {
+        return Err(bad(
+            1,
+            "empty: want a header row with `seconds` and `rmse`".into(),
+        ));
     };
-    let mut text = String::new();
-    {
-        let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
-        draw(&root, plot).map_err(|e| fail(svg, e.to_string()))?;
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    let column = |name: &str| {
+        names.iter().position(|n| *n == name).ok_or_else(|| {
+            bad(
+                1,
+                format!(
+                    "no `{name}` column in the header (it has {})",
+                    names.join(", ")
+                ),
+            )
+        })
+    };
+    let (s, r) = (column("seconds")?, column("rmse")?);
+    let mut out = Vec::new();
+    for (i, line) in lines {
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let number = |c: usize, name: &str| {
+            cells
+                .get(c)
+                .and_then(|v| v.parse::<f64>().ok())
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| bad(i + 1, format!("`{name}` must be a positive number")))
+        };
+        out.push((number(s, "seconds")?, number(r, "rmse")?));
     }
-    write_atomic(svg, text.as_bytes())?;
-    let mut buffer = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
-    {
-        let inner = BitMapBackend::with_buffer(&mut buffer, SIZE);
-        let root = PixelFontBackend { inner }.into_drawing_area();
-        draw(&root, plot).map_err(|e| fail(png, e.to_string()))?;
+    if out.is_empty() {
+        return Err(bad(2, "no points below the header".into()));
     }
-    let img = image::RgbImage::from_raw(SIZE.0, SIZE.1, buffer)
-        .ok_or_else(|| fail(png, "plot buffer has the wrong size".into()))?;
-    write_png(&img, png)
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(out)
 }
 
-/// The range of positive finite values of `v`, widened to whole decades (plotters labels a log
-/// axis from its first power of ten on).
-fn log_range(v: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
-    let (lo, hi) = v
-        .filter(|x| x.is_finite() && *x > 0.0)
-        .fold((f64::MAX, f64::MIN_POSITIVE), |(lo, hi), x| {
-            (lo.min(x), hi.max(x))
+/// Runs `caustic plot`.
+pub fn run(args: &PlotArgs) -> Result<(), Error> {
+    let sigma = args.ref_noise;
+    if !(sigma.is_finite() && sigma >= 0.0) {
+        return Err(Error::Usage(format!(
+            "--ref-noise {sigma}: want a number ≥ 0"
+        )));
+    }
+    let mut curves = Vec::new();
+    let mut doc = Vec::new();
+    for spec in &args.curves {
+        let Some((label, file)) = spec.split_once('=') else {
+            return Err(Error::Usage(format!("`{spec}`: want LABEL=FILE.csv")));
+        };
+        let path = Path::new(file);
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::Usage(format!("{}: {e}", path.display())))?;
+        let pts = points(path, &text)?;
+        let slope = log_log_slope(pts.iter().copied());
+        let net = (sigma > 0.0).then(|| {
+            log_log_slope(
+                pts.iter()
+                    .filter(|p| p.1 > sigma)
+                    .map(|&(x, y)| (x, (y * y - sigma * sigma).sqrt())),
+            )
         });
-    if lo > hi {
-        return 0.1..1.0;
+        let mut line = format!(
+            "{label}: {} points, {:.2}–{:.2} s, RMSE {:.5} → {:.5}; slope {}",
+            pts.len(),
+            pts[0].0,
+            pts[pts.len() - 1].0,
+            pts[0].1,
+            pts[pts.len() - 1].1,
+            fmt_slope(slope)
+        );
+        let mut legend = format!("{label} (slope {}", fmt_slope(slope));
+        if let Some(net) = net {
+            let _ = write!(
+                line,
+                ", {} with the reference's noise ({sigma:.5}) taken out",
+                fmt_slope(net)
+            );
+            let _ = write!(legend, "; net {}", fmt_slope(net));
+        }
+        legend.push(')');
+        println!("{line}");
+        doc.push(
+            json!({"label": label, "csv": file, "points": pts, "slope": slope,
+            "ref_noise": (sigma > 0.0).then_some(sigma), "slope_without_ref_noise": net.flatten()}),
+        );
+        curves.push(Curve {
+            label: legend,
+            points: pts,
+        });
     }
-    let (a, b) = (lo.log10().floor(), hi.log10().ceil());
-    // Just below the lower decade, so that plotters' own rounding of log10 still starts there.
-    10f64.powf(a) * 0.999..10f64.powf(b.max(a + 1.0))
-}
-
-/// A log axis' tick label: 1, 2 and 5 times a power of ten are labelled (only powers of ten on
-/// an axis of more than four decades), the other grid lines (3, 4, 6, …) are left blank so
-/// labels do not crowd near the top of each decade. Shortest decimal form: `0.002`, `50`.
-fn tick(v: f64, decades: f64) -> String {
-    let exponent = v.log10().floor();
-    let mantissa = v / 10f64.powf(exponent);
-    let marks: &[f64] = if decades > 4.5 {
-        &[1.0, 10.0]
-    } else {
-        &[1.0, 2.0, 5.0, 10.0]
+    let plot = Plot {
+        title: args.title.clone(),
+        x_desc: "render time (s)".into(),
+        y_desc: "RMSE".into(),
+        curves,
     };
-    if !marks.iter().any(|m| (mantissa - m).abs() < 1e-6 * m) {
-        return String::new();
-    }
-    let digits = (-exponent).max(0.0) as usize;
-    if digits > 6 || exponent > 6.0 {
-        format!("{v:.0e}")
-    } else {
-        format!("{v:.digits$}")
-    }
-}
-
-/// Decades a log range spans.
-fn decades(r: &std::ops::Range<f64>) -> f64 {
-    (r.end / r.start).log10()
-}
-
-fn draw<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    plot: &Plot,
-) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-    let ok = |p: &&(f64, f64)| p.0.is_finite() && p.0 > 0.0 && p.1.is_finite() && p.1 > 0.0;
-    let all = || plot.curves.iter().flat_map(|c| c.points.iter().filter(ok));
-    let xs = log_range(all().map(|p| p.0));
-    let ys = log_range(all().map(|p| p.1));
-    let (x_decades, y_decades) = (decades(&xs), decades(&ys));
-    root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(root)
-        .caption(&plot.title, ("sans-serif", 18))
-        .margin(16)
-        .x_label_area_size(44)
-        .y_label_area_size(80)
-        .build_cartesian_2d(xs.clone().log_scale(), ys.log_scale())?;
-    chart
-        .configure_mesh()
-        .x_desc(&plot.x_desc)
-        .y_desc(&plot.y_desc)
-        .label_style(("sans-serif", 18))
-        .x_labels(40)
-        .y_labels(40)
-        .bold_line_style(BLACK.mix(0.12))
-        .light_line_style(BLACK.mix(0.04))
-        .axis_desc_style(("sans-serif", 18))
-        .x_label_formatter(&|v| tick(*v, x_decades))
-        .y_label_formatter(&|v| tick(*v, y_decades))
-        .draw()?;
-    for (i, curve) in plot.curves.iter().enumerate() {
-        let colour = Palette99::pick(i).to_rgba();
-        let points: Vec<(f64, f64)> = curve.points.iter().filter(ok).copied().collect();
-        chart
-            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
-            .label(curve.label.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
-        chart.draw_series(points.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
-    }
-    // A guide of slope −1/2 (Monte Carlo's rate) through the first curve's first point.
-    if let Some(&(t0, e0)) = plot.curves.first().and_then(|c| c.points.iter().find(ok)) {
-        let t1 = xs.end;
-        let guide = vec![(t0, e0), (t1, e0 * (t1 / t0).powf(-0.5))];
-        let grey = RGBColor(150, 150, 150);
-        chart
-            .draw_series(LineSeries::new(guide, grey.stroke_width(1)))?
-            .label("slope -1/2")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
-    }
-    chart
-        .configure_series_labels()
-        .label_font(("sans-serif", 18))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()?;
-    root.present()
+    let with = |ext: &str| args.output.with_extension(ext);
+    caustic::analysis::convergence_plot::write(&plot, &with("svg"), &with("png"))?;
+    let doc = json!({"title": args.title, "curves": doc});
+    write_atomic(&with("json"), format!("{doc:#}\n").as_bytes())?;
+    println!("wrote {}.{{svg,png,json}}", args.output.display());
+    Ok(())
 }
 
 #[cfg(test)]
@@ -169,38 +153,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn ticks_label_one_two_five_in_short_form() {
-        assert_eq!(tick(0.001, 3.0), "0.001");
-        assert_eq!(tick(0.002, 3.0), "0.002");
-        assert_eq!(tick(0.003, 3.0), "");
-        assert_eq!(tick(50.0, 3.0), "50");
-        assert_eq!(tick(50.0, 6.0), "");
-        assert_eq!(tick(100.0, 6.0), "100");
-        assert_eq!(tick(1e-9, 12.0), "1e-9");
-    }
-
-    #[test]
-    fn both_plots_are_written_and_the_png_has_text_and_curves() {
-        let dir = tempfile::tempdir().expect("tmp");
-        let plot = Plot {
-            title: "test".into(),
-            x_desc: "time (s)".into(),
-            y_desc: "RMSE".into(),
-            curves: vec![Curve {
-                label: "path".into(),
-                points: vec![(0.1, 1.0), (0.4, 0.5), (1.6, 0.25), (0.0, 9.0)],
-            }],
-        };
-        let (svg, png) = (dir.path().join("p.svg"), dir.path().join("p.png"));
-        write(&plot, &svg, &png).expect("written");
-        let text = std::fs::read_to_string(&svg).expect("svg");
-        assert!(text.starts_with("<svg") && text.contains("\npath\n") && text.contains("\nRMSE\n"));
-        let img = image::open(&png).expect("png").into_rgb8();
-        assert_eq!((img.width(), img.height()), SIZE);
-        // The first curve is drawn in Palette99's first colour; black text is somewhere.
-        let first = Palette99::pick(0).to_rgba();
-        let has = |c: [u8; 3]| img.pixels().any(|p| p.0 == c);
-        assert!(has([first.0, first.1, first.2]));
-        assert!(has([0, 0, 0]));
+    fn csv_points_are_read_by_column_name_and_bad_rows_name_their_line() {
+        let p = Path::new("m.csv");
+        let pts = points(p, "rmse,seconds,spp\n0.02,8,512\n0.04,2,128\n").expect("points");
+        assert_eq!(pts, vec![(2.0, 0.04), (8.0, 0.02)]);
+        let e = points(p, "seconds,rmse\n1,0.1\n2,oops\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("m.csv:3") && e.contains("rmse"), "{e}");
+        let e = points(p, "time,rmse\n1,0.1\n").unwrap_err().to_string();
+        assert!(e.contains("m.csv:1") && e.contains("seconds"), "{e}");
+        assert!(points(p, "seconds,rmse\n").is_err());
     }
 }

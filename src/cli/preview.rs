@@ -92,21 +92,7 @@ impl Settings {
             .clone()
             .unwrap_or_else(|| default_output(&args.scene.scene));
         let part = is_part(&output);
-        if !part {
-            if args.shard.is_some() {
-                return Err(usage(format!(
-                    "--shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
-                    output.display()
-                )));
-            }
-            OutputFormat::for_path(&output)?;
-        }
-        let shard = args
-            .shard
-            .as_deref()
-            .map(Shard::parse)
-            .transpose()
-            .map_err(|e| usage(e.to_string()))?;
+        let shard = super::render::output_shard(&output, args.shard.as_deref())?;
         if let Some(cp) = &args.checkpoint {
             if OutputFormat::for_path(cp).is_err() {
                 return Err(usage(format!(
@@ -130,8 +116,8 @@ impl Settings {
             return Err(usage("--threads must be at least 1".into()));
         }
         let mut overrides = args.scene.overrides();
-        if args.time.is_some() && overrides.samples_per_pixel.is_none() {
-            overrides.samples_per_pixel = Some(BUDGET_SPP_CAP);
+        if args.time.is_some() && overrides.render.samples_per_pixel.is_none() {
+            overrides.render.samples_per_pixel = Some(BUDGET_SPP_CAP);
         }
         Ok(Self {
             scene: args.scene.scene.clone(),

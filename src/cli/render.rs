@@ -224,6 +224,24 @@ fn is_exr(path: &Path) -> bool {
     matches!(OutputFormat::for_path(path), Ok(OutputFormat::Exr))
 }
 
+/// The shard of `--shard` (`None` without it), after checking that the output is one caustic
+/// writes and that a shard writes a `.part` film (`render` and `preview` share the rule).
+pub(super) fn output_shard(output: &Path, shard: Option<&str>) -> Result<Option<Shard>, Error> {
+    if !is_part(output) {
+        if shard.is_some() {
+            return Err(Error::Usage(format!(
+                "--shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
+                output.display()
+            )));
+        }
+        OutputFormat::for_path(output)?;
+    }
+    shard
+        .map(Shard::parse)
+        .transpose()
+        .map_err(|e| Error::Usage(e.to_string()))
+}
+
 /// Whether `path` asks for the mergeable film (`.part`).
 pub(super) fn is_part(path: &Path) -> bool {
     path.extension()
@@ -279,21 +297,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         .clone()
         .unwrap_or_else(|| default_output(&args.scene.scene));
     // Refuse a bad output name before doing any work.
-    if !is_part(&output) {
-        if args.shard.is_some() {
-            return Err(Error::Usage(format!(
-                "--shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
-                output.display()
-            )));
-        }
-        OutputFormat::for_path(&output)?;
-    }
-    let shard = args
-        .shard
-        .as_deref()
-        .map(Shard::parse)
-        .transpose()
-        .map_err(|e| Error::Usage(e.to_string()))?;
+    let shard = output_shard(&output, args.shard.as_deref())?;
     if let Some(cp) = &args.checkpoint {
         if OutputFormat::for_path(cp).is_err() {
             return Err(Error::Usage(format!(
@@ -334,15 +338,16 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         overrides.sets.push(format!("render.target_error={x:?}"));
     }
     // A budget or a target decides when to stop; the sample count only caps it.
-    if (args.time.is_some() || args.target_error.is_some()) && overrides.samples_per_pixel.is_none()
+    if (args.time.is_some() || args.target_error.is_some())
+        && overrides.render.samples_per_pixel.is_none()
     {
-        overrides.samples_per_pixel = Some(BUDGET_SPP_CAP);
+        overrides.render.samples_per_pixel = Some(BUDGET_SPP_CAP);
     }
     let mut prepared = prepare(&args.scene.scene, &overrides)?;
     let target_error = prepared.scene.render.target_error;
-    if target_error.is_some() && overrides.samples_per_pixel.is_none() {
+    if target_error.is_some() && overrides.render.samples_per_pixel.is_none() {
         // The scene's own `render.target_error`: compiled again with the cap (rare).
-        overrides.samples_per_pixel = Some(BUDGET_SPP_CAP);
+        overrides.render.samples_per_pixel = Some(BUDGET_SPP_CAP);
         prepared = prepare(&args.scene.scene, &overrides)?;
     }
     if !args.quiet {
@@ -526,27 +531,16 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     );
     let auto = auto.filter(|_| hash.is_none() && !is_exr(&output));
     if let Some(hash) = hash {
-        let p = &prepared.render_scene.params;
         let taken =
             out.stats.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1);
         let end = first_sample + taken as u32;
         let meta = PartMeta {
-            hash,
-            samples: if end > first_sample {
-                std::iter::once(first_sample..end).collect()
-            } else {
-                Vec::new()
-            },
-            spp,
-            width: p.width,
-            height: p.height,
-            region,
-            integrator: format!("{:?}", p.integrator),
             // NaN: automatic (`merge` then chooses it from the merged film).
             exposure: stated_exposure.unwrap_or(f32::NAN),
             scene: args.scene.scene.display().to_string(),
             shard: shard.map(|s| s.to_string()),
             seconds: out.stats.elapsed.as_secs_f64(),
+            ..PartMeta::of(&prepared.render_scene, hash, first_sample..end, spp, region)
         };
         out.sums.write(&output, &meta.to_text())?;
     } else if features.is_some() || denoised.is_some() {

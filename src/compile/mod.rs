@@ -2,6 +2,7 @@
 //! flat [`RenderScene`] (world-space primitives, resolved indices, BVH), keeping only what the
 //! scene uses.
 
+pub mod default_estimator;
 pub mod gltf;
 mod gltf_node;
 pub mod lights;
@@ -14,14 +15,14 @@ pub mod mtl;
 mod nodes;
 pub mod ply;
 pub mod polygon;
+pub mod settings;
 
 use std::path::Path;
 use std::time::{Duration, Instant};
 
 use crate::accel::BvhStats;
-use crate::render_scene::PhotonParams;
 use crate::render_scene::geometry::GeometryBuilder;
-use crate::render_scene::{Camera, DefaultEstimator, RenderParams, RenderScene};
+use crate::render_scene::{Camera, DefaultEstimator, RenderScene};
 use crate::scene::Diagnostic;
 use crate::scene::schema::{self, LightSpec, SceneFile};
 
@@ -57,29 +58,22 @@ pub struct CompileStats {
     pub warnings: Vec<Diagnostic>,
 }
 
-/// The photon settings as the renderer reads them.
-fn photon_params(p: &schema::PhotonSettings, lights: &[LightSpec]) -> PhotonParams {
-    PhotonParams {
-        global: p.global,
-        caustic: p.caustic,
-        caustic_per_light: lights.iter().map(LightSpec::caustic_photons).collect(),
-        gather: p.gather,
-        caustic_gather: p.caustic_gather,
-        max_radius: p.max_radius,
-        alpha: p.alpha,
-        caustic_cone: match p.caustic_filter {
-            schema::PhotonFilter::Box => None,
-            schema::PhotonFilter::Cone { k } => Some(k),
-        },
-        min_bounces: p.min_bounces,
-        final_gather: p.final_gather,
-        max_bounces: p.max_bounces,
-    }
-}
-
 /// Compiles a validated scene. Asset paths resolve against `base_dir`. Returns all asset errors.
+/// The scene's settings are taken as stated in the file ([`compile_with`] for settings stated on
+/// the command line).
 pub fn compile(
     scene: &SceneFile,
+    base_dir: &Path,
+) -> Result<(RenderScene, CompileStats), Vec<Diagnostic>> {
+    compile_with(scene, &schema::PhotonSettings::default(), base_dir)
+}
+
+/// [`compile`], where `command_line` is the photon settings the command line stated (already
+/// applied to `scene`): they win over the default estimator's own per-pass counts, which the
+/// file's do not ([`settings::resolve`]).
+pub fn compile_with(
+    scene: &SceneFile,
+    command_line: &schema::PhotonSettings,
     base_dir: &Path,
 ) -> Result<(RenderScene, CompileStats), Vec<Diagnostic>> {
     let t0 = Instant::now();
@@ -154,55 +148,27 @@ pub fn compile(
     stats.bvh_time = t1.elapsed();
     stats.bvh = geometry.bvh.stats();
 
-    let r = &scene.render;
-    let (integrator, default_estimator) = match r.integrator {
-        Some(kind) => (kind, None),
-        None => {
-            let (kind, why) = DefaultEstimator::choose(
+    let params = settings::resolve(
+        scene,
+        command_line,
+        &all_lights,
+        lights.len(),
+        |width, height| {
+            DefaultEstimator::choose(
                 &objects,
                 |m| materials.list.get(m).map(|(_, m)| m),
-                r.width,
-                r.height,
-            );
-            (kind, Some(why))
-        }
-    };
-    let mut photons = photon_params(&scene.photons, &all_lights);
-    if let Some(p) = default_estimator.and_then(|d| d.photons) {
-        // The default estimator's own per-pass budget (the scene's counts are per render).
-        photons.caustic = p.caustic;
-        photons.caustic_gather = p.caustic_gather;
-        photons.global = p.global;
-        photons.caustic_per_light.iter_mut().for_each(|c| *c = None);
-    }
-    let params = RenderParams {
-        width: r.width,
-        height: r.height,
-        samples_per_pixel: r.samples_per_pixel,
-        max_depth: r.max_depth,
-        min_contribution: r.min_contribution,
-        light_samples: r.light_samples,
-        seed: r.seed,
-        background: r.background.into(),
-        exposure: r.exposure.unwrap_or(1.0),
-        tonemap: r.tonemap.unwrap_or(schema::Tonemap::Linear),
-        integrator,
-        default_estimator,
-        sampler: r.sampler,
-        diffuse_depth: r.diffuse_depth.unwrap_or(u32::MAX),
-        texture_filter: r.texture_filter,
-        photons,
-    };
-    let mut params = params;
-    // Emissive shapes have no budget of their own: they share `photons.caustic` by power.
-    params.photons.caustic_per_light.resize(lights.len(), None);
+                width,
+                height,
+            )
+        },
+    );
     let (eye, look_at, up, fov_y) = camera_spec.view();
     let camera = Camera::pinhole(
         eye.into(),
         look_at.into(),
         up.into(),
         fov_y,
-        r.width as f32 / r.height as f32,
+        params.width as f32 / params.height as f32,
     );
     let camera = match camera_spec.lens() {
         Some((radius, focus_distance)) => camera.with_thin_lens(radius, focus_distance),

@@ -1,8 +1,10 @@
 //! Render farms, above the renderer: what a `.part` film records about the render it holds
 //! ([`PartMeta`], the settings hash that tells whether parts belong together) and how a render
-//! is split into shards of sample indices ([`Shard`]). The commands that plan, run and merge
-//! farm jobs are in the binary (`caustic farm`, `caustic merge`).
+//! is split into shards of sample indices ([`Shard`]), and how parts merge back into one film
+//! ([`merge::merge_parts`]). The commands that plan, run and merge farm jobs are thin files in
+//! the binary (`caustic farm`, `caustic merge`).
 
+pub mod merge;
 pub mod part_meta;
 pub mod shard;
 

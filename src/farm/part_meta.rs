@@ -6,6 +6,7 @@
 
 use std::ops::Range;
 
+use crate::binfile::meta_text::{MetaText, malformed};
 use crate::render::Region;
 use crate::render_scene::RenderScene;
 use crate::render_scene::hash::pixel_key;
@@ -111,6 +112,38 @@ impl PartMeta {
         )
     }
 
+    /// The metadata of a film of `scene` (whose [`settings_hash`] is `hash`) holding samples
+    /// `samples` of `spp` per pixel over `region` (`None`: the whole image). The exposure is the
+    /// resolved one and the informational fields are empty; a caller that knows them (the scene
+    /// path, the shard, the render time, a stated or automatic exposure) sets them over this.
+    #[must_use]
+    pub fn of(
+        scene: &RenderScene,
+        hash: u64,
+        samples: Range<u32>,
+        spp: u32,
+        region: Option<Region>,
+    ) -> Self {
+        let p = &scene.params;
+        Self {
+            hash,
+            samples: if samples.is_empty() {
+                Vec::new()
+            } else {
+                vec![samples]
+            },
+            spp,
+            width: p.width,
+            height: p.height,
+            region,
+            integrator: format!("{:?}", p.integrator),
+            exposure: p.exposure,
+            scene: String::new(),
+            shard: None,
+            seconds: 0.0,
+        }
+    }
+
     /// Reads [`PartMeta::to_text`]'s output; `path` names the file in errors.
     ///
     /// # Errors
@@ -120,25 +153,14 @@ impl PartMeta {
             path: path.to_string(),
             reason,
         };
-        let mut lines = text.lines();
-        if lines.next() != Some(HEADER) {
-            return Err(err(format!(
+        let m = MetaText::parse(text, HEADER).ok_or_else(|| {
+            err(format!(
                 "its metadata is not `{HEADER}` (written by an older caustic, or not by `caustic render --shard`/`-o FILE.part`); render it again"
-            )));
-        }
-        let fields: Vec<(&str, &str)> = lines.filter_map(|l| l.split_once('=')).collect();
-        let get = |key: &str| {
-            fields
-                .iter()
-                .find(|(k, _)| *k == key)
-                .map(|(_, v)| *v)
-                .ok_or_else(|| err(format!("its metadata has no `{key}` field")))
-        };
-        let bad = |key: &str, v: &str| err(format!("its metadata field `{key}={v}` is malformed"));
-        let num = |key: &str| -> Result<u32, PartMetaError> {
-            let v = get(key)?;
-            v.parse().map_err(|_| bad(key, v))
-        };
+            ))
+        })?;
+        let get = |key: &str| m.get(key).map_err(&err);
+        let bad = |key: &str, v: &str| err(malformed(key, v));
+        let num = |key: &str| m.parsed::<u32>(key).map_err(&err);
         let hash_text = get("hash")?;
         let hash = u64::from_str_radix(hash_text, 16).map_err(|_| bad("hash", hash_text))?;
         let samples_text = get("samples")?;
@@ -162,8 +184,6 @@ impl PartMeta {
                 _ => return Err(bad("region", region_text)),
             }
         };
-        let exposure_text = get("exposure")?;
-        let seconds_text = get("seconds")?;
         let shard = get("shard")?;
         Ok(Self {
             hash,
@@ -173,14 +193,10 @@ impl PartMeta {
             height: num("height")?,
             region,
             integrator: get("integrator")?.to_string(),
-            exposure: exposure_text
-                .parse()
-                .map_err(|_| bad("exposure", exposure_text))?,
+            exposure: m.parsed("exposure").map_err(&err)?,
             scene: get("scene")?.to_string(),
             shard: (shard != "none").then(|| shard.to_string()),
-            seconds: seconds_text
-                .parse()
-                .map_err(|_| bad("seconds", seconds_text))?,
+            seconds: m.parsed("seconds").map_err(&err)?,
         })
     }
 

@@ -1,7 +1,6 @@
 //! The flat, world-space, immutable scene that integrators render: produced only by `compile`.
 
 pub mod camera;
-pub mod default_estimator;
 pub mod geometry;
 pub mod hash;
 pub mod interaction;
@@ -14,7 +13,6 @@ pub mod surface;
 pub mod texture;
 
 pub use camera::Camera;
-pub use default_estimator::{DefaultEstimator, PassPhotons};
 pub use geometry::{Geometry, Hit, PrimRef};
 pub use interaction::{EmitterHit, Interaction, SurfaceHit};
 pub use light::{EmissionSample, Light, LightSample};
@@ -72,6 +70,32 @@ pub struct RenderParams {
     pub texture_filter: TextureFilter,
     /// Photon-map settings (the `photon` integrator).
     pub photons: PhotonParams,
+}
+
+/// The photon budget of one pass of the default estimator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PassPhotons {
+    /// Caustic photons emitted per pass.
+    pub caustic: u32,
+    /// Nearest photons that set the initial radius `R(x)` (about that many photons per disc at
+    /// the first pass, where the pilot map's density holds; later passes shrink the disc).
+    pub caustic_gather: u32,
+    /// Photons emitted per pass for the global map: 0, no global map. The path tracer carries
+    /// all diffuse interreflection itself, without the global map's blur (the local bias of the
+    /// issue's `ppm` row); only the caustic paths, which it finds by chance, come from photons.
+    pub global: u32,
+}
+
+/// How the default estimator was chosen for a scene that names no integrator (kept in
+/// `RenderParams::default_estimator` for the summary line; chosen by
+/// `compile::default_estimator`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DefaultEstimator {
+    /// Objects whose material has a mirror or glass part or is near-specular.
+    pub specular_casters: usize,
+    /// The per-pass photon budget chosen (`None` when the choice is `path`, or when the command
+    /// line stated the counts, which then stand as given).
+    pub photons: Option<PassPhotons>,
 }
 
 /// Photon-map settings after command-line overrides (see the scene schema's `photons`).

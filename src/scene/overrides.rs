@@ -13,7 +13,10 @@ pub fn apply_overrides(scene: &SceneFile, sets: &[String]) -> Result<SceneFile, 
     if sets.is_empty() {
         return Ok(scene.clone());
     }
-    let mut tree = serde_json::to_value(scene).map_err(|e| invalid("--set", e.to_string()))?;
+    // Over the defaults, so that a path into an unset setting (`photons.caustic_filter.k`)
+    // exists to be set.
+    let mut tree = serde_json::to_value(scene.with_default_settings())
+        .map_err(|e| invalid("--set", e.to_string()))?;
     let mut errors = Vec::new();
     for set in sets {
         if let Err(d) = apply_one(&mut tree, set) {

@@ -150,10 +150,8 @@ fn caustic_figures(width: u32, height: u32, spp: u32) -> CausticFigures {
     use caustic::integrators::LightPath;
     let path = common::root().join("scenes/bath.ron");
     let layers = |seed: Option<u64>| {
-        let overrides = caustic::pipeline::SceneOverrides {
-            seed,
-            ..common::small(width, height, spp)
-        };
+        let mut overrides = common::small(width, height, spp);
+        overrides.render.seed = seed;
         let p = prepare(&path, &overrides).expect("bath.ron");
         let options = RenderOptions {
             threads: Some(2),

@@ -78,10 +78,8 @@ fn the_command_lines_integrator_wins_over_the_scene_and_the_default() {
     for file in ["benches/scenes/pool.ron", "scenes/refraction.ron"] {
         let path = root().join(file);
         for &kind in IntegratorKind::ALL {
-            let overrides = SceneOverrides {
-                integrator: Some(kind),
-                ..SceneOverrides::default()
-            };
+            let mut overrides = SceneOverrides::default();
+            overrides.render.integrator = Some(kind);
             let p = prepare(&path, &overrides).expect("prepares");
             assert_eq!(p.render_scene.params.integrator, kind, "{file}");
             assert!(p.render_scene.params.default_estimator.is_none(), "{file}");
@@ -123,11 +121,14 @@ fn brightest(f: &Film) -> f32 {
 /// `None`) and `seed`.
 fn pool(integrator: Option<IntegratorKind>, spp: u32, seed: u64) -> Film {
     let overrides = SceneOverrides {
-        width: Some(64),
-        height: Some(48),
-        samples_per_pixel: Some(spp),
-        seed: Some(seed),
-        integrator,
+        render: caustic::scene::schema::RenderSettings {
+            width: Some(64),
+            height: Some(48),
+            samples_per_pixel: Some(spp),
+            seed: Some(seed),
+            integrator,
+            ..Default::default()
+        },
         ..SceneOverrides::default()
     };
     let p =
@@ -168,4 +169,60 @@ fn the_lights_image_in_rippled_water_has_no_single_sample_glints_at_any_seed() {
         path_worst > 1.5,
         "path's worst brightest pixel is only {path_worst} × the reference"
     );
+}
+
+/// Settings resolved once (issue #41): the default estimator's per-pass budget beats the
+/// file's photon counts, but counts stated on the command line (`--set`, `--caustic-photons`)
+/// beat it; a named integrator reads the file's; `--set` reaches a setting the file leaves
+/// unset (`photons.caustic_filter.k` over the default cone).
+#[test]
+fn photon_counts_resolve_command_line_then_default_estimator_then_file() {
+    let text = scene(true, None).replace(
+        "lights: [",
+        "photons: (caustic: 123456, gather: 77),\n    lights: [",
+    );
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("stated.ron");
+    std::fs::write(&path, text).expect("writes the scene");
+    let params = |o: &SceneOverrides| prepare(&path, o).expect("prepares").render_scene.params;
+
+    let file = params(&SceneOverrides::default());
+    assert_eq!(file.integrator, IntegratorKind::PathPpm);
+    // 16 × 12 pixels: the per-pass budget's lower bound and its k, no global map.
+    let p = &file.photons;
+    assert_eq!((p.caustic, p.caustic_gather, p.global), (1000, 10, 0));
+    assert_eq!(
+        p.gather, 77,
+        "the file's gather stands: the default does not choose it"
+    );
+    assert!(file.default_estimator.is_some_and(|d| d.photons.is_some()));
+
+    let set = params(&SceneOverrides {
+        sets: vec!["photons.caustic=5000".into()],
+        ..SceneOverrides::default()
+    });
+    assert_eq!(
+        (set.photons.caustic, set.photons.caustic_gather),
+        (5000, 10)
+    );
+    assert!(set.default_estimator.is_some_and(|d| d.photons.is_none()));
+
+    let mut flag = SceneOverrides::default();
+    flag.photons.caustic = Some(4000);
+    assert_eq!(params(&flag).photons.caustic, 4000);
+
+    let mut named = SceneOverrides::default();
+    named.render.integrator = Some(IntegratorKind::Photon);
+    let named = params(&named);
+    assert_eq!(
+        (named.photons.caustic, named.photons.global),
+        (123_456, 200_000)
+    );
+    assert!(named.default_estimator.is_none());
+
+    let k = params(&SceneOverrides {
+        sets: vec!["photons.caustic_filter.k=2".into()],
+        ..SceneOverrides::default()
+    });
+    assert_eq!(k.photons.caustic_cone, Some(2.0));
 }

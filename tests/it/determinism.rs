@@ -48,7 +48,7 @@ fn thread_count_does_not_change_a_single_bit() {
 fn a_different_seed_changes_the_noise() {
     let mut o = common::small(32, 32, 1);
     let (a, _) = common::render_file(&cornell(), &o, &RenderOptions::default());
-    o.seed = Some(99);
+    o.render.seed = Some(99);
     let (b, _) = common::render_file(&cornell(), &o, &RenderOptions::default());
     assert_ne!(a.to_bytes(), b.to_bytes());
 }
@@ -162,7 +162,7 @@ fn regions_rendered_together_equal_each_rendered_alone() {
     ];
     for integrator in [IntegratorKind::PathPpm, IntegratorKind::Path] {
         let mut o = common::small(40, 32, 3);
-        o.integrator = Some(integrator);
+        o.render.integrator = Some(integrator);
         let p = prepare(&common::root().join("scenes/refraction.ron"), &o).expect("scene");
         let options = RenderOptions {
             light_paths: true,

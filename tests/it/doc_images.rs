@@ -108,11 +108,11 @@ fn parse_call(e: &Entry) -> RenderCall {
                     .unwrap_or_else(|| panic!("{at}: --set needs a value"))
                     .clone(),
             ),
-            "--width" => o.width = Some(num(flag, it.next()) as u32),
-            "--height" => o.height = Some(num(flag, it.next()) as u32),
-            "--spp" => o.samples_per_pixel = Some(num(flag, it.next()) as u32),
-            "--max-depth" => o.max_depth = Some(num(flag, it.next()) as u32),
-            "--seed" => o.seed = Some(num(flag, it.next())),
+            "--width" => o.render.width = Some(num(flag, it.next()) as u32),
+            "--height" => o.render.height = Some(num(flag, it.next()) as u32),
+            "--spp" => o.render.samples_per_pixel = Some(num(flag, it.next()) as u32),
+            "--max-depth" => o.render.max_depth = Some(num(flag, it.next()) as u32),
+            "--seed" => o.render.seed = Some(num(flag, it.next())),
             "--region" => {
                 let v = it
                     .next()
@@ -226,7 +226,7 @@ fn compare_rows(e: &Entry, images: &[RgbImage]) -> Vec<Comparison> {
     );
     let prepared =
         prepare(&call.scene, &call.overrides).unwrap_or_else(|err| panic!("{at}: {err}"));
-    let r = &prepared.scene.render;
+    let r = &prepared.render_scene.params;
     let crop = call.region.unwrap_or(Region {
         x: 0,
         y: 0,

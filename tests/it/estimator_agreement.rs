@@ -54,19 +54,22 @@ fn path_ppm_and_path_agree_within_noise_on_every_scene() {
     for file in scene_files() {
         let estimates = |integrator: IntegratorKind, spp: u32, seed: u64| {
             let overrides = SceneOverrides {
-                width: Some(64),
-                height: Some(64),
-                samples_per_pixel: Some(spp),
-                seed: Some(seed),
-                integrator: Some(integrator),
+                render: caustic::scene::schema::RenderSettings {
+                    width: Some(64),
+                    height: Some(64),
+                    samples_per_pixel: Some(spp),
+                    seed: Some(seed),
+                    integrator: Some(integrator),
+                    ..Default::default()
+                },
                 ..SceneOverrides::default()
             };
             let p =
                 prepare(&file, &overrides).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
             let mut scene = p.scene.clone();
-            scene.photons.caustic = 1000;
-            scene.photons.caustic_gather = 10;
-            scene.photons.global = 0;
+            scene.photons.caustic = Some(1000);
+            scene.photons.caustic_gather = Some(10);
+            scene.photons.global = Some(0);
             for light in &mut scene.lights {
                 match light {
                     LightSpec::Point {

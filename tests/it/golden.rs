@@ -27,11 +27,11 @@ fn render(
     sets: &[&str],
 ) -> (BatchBlocks, PixelEstimates) {
     let path = common::root().join(scene);
-    let o = SceneOverrides {
-        seed: Some(seed),
+    let mut o = SceneOverrides {
         sets: sets.iter().map(|s| (*s).to_string()).collect(),
         ..overrides.clone()
     };
+    o.render.seed = Some(seed);
     let mut prepared = prepare(&path, &o).unwrap_or_else(|e| panic!("{e}"));
     let options = RenderOptions {
         threads: Some(2),
@@ -131,10 +131,8 @@ fn unchanged_cornell_passes_and_three_small_changes_fail_at_every_seed() {
     // Whitted (named), 64×64, 32 spp: 32 batches of one sample index each.
     let start = Instant::now();
     let test = BatchTest::default();
-    let o = SceneOverrides {
-        integrator: Some(IntegratorKind::Whitted),
-        ..common::small(64, 64, 32)
-    };
+    let mut o = common::small(64, 64, 32);
+    o.render.integrator = Some(IntegratorKind::Whitted);
     let cornell = "scenes/cornell.ron";
     let (golden, _) = render(cornell, &o, 1, &[]);
     let changes: [(&str, &str); 3] = [

@@ -220,7 +220,7 @@ fn path_converges_to_the_committed_reference() {
         .iter()
         .map(|&s| {
             let mut o = cornell_path(32, 32, 16, "Sobol");
-            o.seed = Some(s);
+            o.render.seed = Some(s);
             common::render_file(&file, &o, &RenderOptions::default()).0
         })
         .collect();
@@ -245,7 +245,7 @@ fn path_converges_to_the_committed_reference() {
         let mut total = 0.0;
         for seed in 1..=6 {
             let mut o = cornell_path(32, 32, spp, "Independent");
-            o.seed = Some(seed);
+            o.render.seed = Some(seed);
             let (f, _) = common::render_file(&file, &o, &RenderOptions::default());
             total += caustic::analysis::metrics::compare(&f, &reference)
                 .expect("same size")

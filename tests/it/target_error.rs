@@ -47,7 +47,7 @@ fn a_target_error_render_stops_and_its_true_error_is_near_the_target() {
 
     // The reference: 4096 samples per pixel of the same scene, another seed.
     let mut overrides = common::small(w, h, 4096);
-    overrides.seed = Some(99);
+    overrides.render.seed = Some(99);
     let prepared =
         caustic::pipeline::prepare(&common::root().join("scenes/lights.ron"), &overrides)
             .expect("lights prepares");

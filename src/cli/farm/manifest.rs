@@ -100,6 +100,6 @@ impl Manifest {
     /// # Errors
     /// When the manifest's `hash` is not hexadecimal.
     pub fn hash_value(&self) -> Result<u64, Error> {
-        super::super::merge::parse_hash(&self.hash)
+        caustic::farm::merge::parse_hash(&self.hash).map_err(super::super::merge::usage)
     }
 }

@@ -25,8 +25,9 @@ fn shard_state(m: &Manifest, hash: u64, dir: &Path, index: u32) -> ShardState {
         return ShardState::Missing;
     }
     let [start, end] = m.ranges[index as usize - 1];
-    match super::super::merge::read_part(&path) {
-        Err(e) => ShardState::Invalid(e.to_string()),
+    match caustic::farm::merge::read_part(&path) {
+        // Worded as `caustic merge` would refuse it.
+        Err(e) => ShardState::Invalid(super::super::merge::usage(e).to_string()),
         Ok((_, meta)) if meta.hash != hash => ShardState::Invalid(format!(
             "settings hash {:016x}, not the job's {}",
             meta.hash, m.hash

@@ -158,10 +158,13 @@ mod tests {
         let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
         let run = |seed| {
             let overrides = SceneOverrides {
-                width: Some(32),
-                height: Some(32),
-                samples_per_pixel: Some(32),
-                seed: Some(seed),
+                render: caustic::scene::schema::RenderSettings {
+                    width: Some(32),
+                    height: Some(32),
+                    samples_per_pixel: Some(32),
+                    seed: Some(seed),
+                    ..Default::default()
+                },
                 sets: vec![
                     "render.integrator=Path".into(),
                     format!("render.sampler={sampler}"),

@@ -38,18 +38,18 @@ pub fn save(
         tonemap: p.tonemap,
     };
     let written = if s.part {
+        let scene = &prepared.render_scene;
         let meta = PartMeta {
-            hash: settings_hash(&prepared.render_scene),
-            samples: std::iter::once(first..end).collect(),
-            spp: p.samples_per_pixel,
-            width: p.width,
-            height: p.height,
-            region: settings.region,
-            integrator: format!("{:?}", p.integrator),
-            exposure: p.exposure,
             scene: settings.scene.display().to_string(),
             shard: settings.shard.map(|s| s.to_string()),
             seconds: start.elapsed().as_secs_f64(),
+            ..PartMeta::of(
+                scene,
+                settings_hash(scene),
+                first..end,
+                p.samples_per_pixel,
+                settings.region,
+            )
         };
         sums.write(output, &meta.to_text())
     } else if !s.layers.is_empty() {

@@ -188,10 +188,13 @@ impl Session<'_> {
         s.started = Instant::now();
         s.stopped = None;
         s.preparing = if traces {
-            let ph = &prepared.scene.photons;
+            // The counts the scene states (over the defaults), as before the settings were
+            // resolved once; the default estimator's per-pass counts are in `params`.
+            let ph = prepared.scene.photons.with_defaults();
             format!(
                 "tracing photons ({} global, {} caustic asked for)",
-                ph.global, ph.caustic
+                ph.global.unwrap_or_default(),
+                ph.caustic.unwrap_or_default()
             )
         } else {
             "preparing the integrator".into()

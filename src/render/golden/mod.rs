@@ -25,13 +25,15 @@ pub mod quantile;
 pub mod record;
 pub mod report;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
 use super::PixelSums;
 use super::output::{OutputError, write_atomic};
 use crate::binfile::fnv1a;
+use crate::binfile::meta_text::{MetaText, malformed};
+use crate::render_scene::RenderScene;
 
 pub use batch_means::{BatchBlocks, BatchTest, BatchVerdict};
 pub use floor::DetectionFloor;
@@ -64,6 +66,66 @@ pub enum GoldenError {
         /// What is wrong.
         reason: String,
     },
+    /// The scenes named for a golden run cannot be listed (the message says why).
+    #[error("{0}")]
+    Scenes(String),
+}
+
+/// The scene files named: files as given, folders replaced by their `.ron` and `.toml` files
+/// (sorted); refuses two scenes whose golden files would have the same name.
+///
+/// # Errors
+/// [`GoldenError::Scenes`] for an unreadable folder, a folder without scenes, or two scenes
+/// whose golden files would have the same name.
+pub fn scene_files(first: &Path, more: &[PathBuf]) -> Result<Vec<PathBuf>, GoldenError> {
+    let mut out = Vec::new();
+    for path in std::iter::once(first).chain(more.iter().map(PathBuf::as_path)) {
+        if path.is_dir() {
+            let entries = std::fs::read_dir(path).map_err(|e| {
+                GoldenError::Scenes(format!("cannot read the folder `{}`: {e}", path.display()))
+            })?;
+            let mut found: Vec<PathBuf> = entries
+                .filter_map(Result::ok)
+                .map(|e| e.path())
+                .filter(|p| {
+                    p.is_file()
+                        && matches!(p.extension().and_then(|e| e.to_str()), Some("ron" | "toml"))
+                })
+                .collect();
+            if found.is_empty() {
+                return Err(GoldenError::Scenes(format!(
+                    "the folder `{}` holds no scene (.ron or .toml) files",
+                    path.display()
+                )));
+            }
+            found.sort();
+            out.extend(found);
+        } else {
+            out.push(path.to_path_buf());
+        }
+    }
+    let mut names: Vec<(String, &PathBuf)> = out.iter().map(|p| (golden_file_name(p), p)).collect();
+    names.sort();
+    for w in names.windows(2) {
+        if w[0].0 == w[1].0 {
+            return Err(GoldenError::Scenes(format!(
+                "`{}` and `{}` would share the golden file `{}`; check them with separate --golden folders",
+                w[0].1.display(),
+                w[1].1.display(),
+                w[0].0
+            )));
+        }
+    }
+    Ok(out)
+}
+
+/// The golden file's name for a scene: its file name and `.golden` (`cornell.ron.golden`).
+#[must_use]
+pub fn golden_file_name(scene: &Path) -> String {
+    let name = scene
+        .file_name()
+        .map_or_else(|| "scene".into(), |n| n.to_string_lossy().into_owned());
+    format!("{name}.golden")
 }
 
 /// Per-pixel estimates of an image: each pixel's mean radiance and the variance of that mean
@@ -132,6 +194,25 @@ pub struct GoldenMeta {
 }
 
 impl GoldenMeta {
+    /// What a golden of `scene` (whose settings hash is `hash`) records: its seed, samples per
+    /// pixel, integrator, sampler and exposure from the render parameters; the informational
+    /// scene path, the recorded overrides and the settings are empty, for the caller to set.
+    #[must_use]
+    pub fn of(scene: &RenderScene, hash: u64) -> Self {
+        let p = &scene.params;
+        Self {
+            hash,
+            seed: p.seed,
+            spp: p.samples_per_pixel,
+            integrator: format!("{:?}", p.integrator),
+            sampler: format!("{:?}", p.sampler),
+            exposure: p.exposure,
+            scene: String::new(),
+            overrides: Vec::new(),
+            settings: Vec::new(),
+        }
+    }
+
     /// The metadata text stored in the file: one `key=value` per line.
     #[must_use]
     pub fn to_text(&self) -> String {
@@ -165,41 +246,21 @@ impl GoldenMeta {
             path: path.to_string(),
             reason,
         };
-        let mut lines = text.lines();
-        if lines.next() != Some(HEADER) {
-            return Err(err(format!("its metadata does not start with `{HEADER}`")));
-        }
-        let fields: Vec<(&str, &str)> = lines.filter_map(|l| l.split_once('=')).collect();
-        let get = |key: &str| {
-            fields
-                .iter()
-                .find(|(k, _)| *k == key)
-                .map(|(_, v)| *v)
-                .ok_or_else(|| err(format!("its metadata has no `{key}` field")))
-        };
-        let bad = |key: &str, v: &str| err(format!("its metadata field `{key}={v}` is malformed"));
+        let m = MetaText::parse(text, HEADER)
+            .ok_or_else(|| err(format!("its metadata does not start with `{HEADER}`")))?;
+        let get = |key: &str| m.get(key).map_err(&err);
         let hash_text = get("hash")?;
-        let seed_text = get("seed")?;
-        let spp_text = get("spp")?;
-        let exposure_text = get("exposure")?;
-        let prefixed = |prefix: &str| -> Vec<(String, String)> {
-            fields
-                .iter()
-                .filter_map(|(k, v)| Some((k.strip_prefix(prefix)?.to_string(), v.to_string())))
-                .collect()
-        };
         Ok(Self {
-            hash: u64::from_str_radix(hash_text, 16).map_err(|_| bad("hash", hash_text))?,
-            seed: seed_text.parse().map_err(|_| bad("seed", seed_text))?,
-            spp: spp_text.parse().map_err(|_| bad("spp", spp_text))?,
+            hash: u64::from_str_radix(hash_text, 16)
+                .map_err(|_| err(malformed("hash", hash_text)))?,
+            seed: m.parsed("seed").map_err(&err)?,
+            spp: m.parsed("spp").map_err(&err)?,
             integrator: get("integrator")?.to_string(),
             sampler: get("sampler")?.to_string(),
-            exposure: exposure_text
-                .parse()
-                .map_err(|_| bad("exposure", exposure_text))?,
+            exposure: m.parsed("exposure").map_err(&err)?,
             scene: get("scene")?.to_string(),
-            overrides: prefixed("override."),
-            settings: prefixed("setting."),
+            overrides: m.prefixed("override."),
+            settings: m.prefixed("setting."),
         })
     }
 }

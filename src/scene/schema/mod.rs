@@ -15,6 +15,7 @@ mod light;
 mod material;
 mod medium;
 mod node;
+mod settings;
 mod values;
 
 pub use light::*;
@@ -24,6 +25,7 @@ pub use material::{
 };
 pub use medium::MediumSpec;
 pub use node::{NodeSpec, TransformStep};
+pub use settings::{PhotonFilter, PhotonSettings, RenderSettings};
 pub use values::ScaleSpec;
 use values::{exact_floats, unique_keys};
 
@@ -63,155 +65,6 @@ pub struct SceneFile {
     /// the name of one of `media`. Unset: clear air.
     #[serde(default)]
     pub medium: Option<String>,
-}
-
-/// Image and sampling settings (the report's Settings.hpp constants that concern rendering).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields, default)]
-pub struct RenderSettings {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Camera samples per pixel, stratified over the pixel area.
-    pub samples_per_pixel: u32,
-    /// Maximum number of specular bounces (reflection/refraction recursion depth).
-    pub max_depth: u32,
-    /// A path whose weight (max RGB component) falls below this is not continued.
-    pub min_contribution: f32,
-    /// Shadow-ray samples per sphere light at each shaded point (soft shadows).
-    pub light_samples: u32,
-    /// Seed of every random stream; same seed and scene give the same image.
-    pub seed: u64,
-    /// Radiance seen by rays that leave the scene.
-    #[serde(deserialize_with = "exact_floats::<_, 3>")]
-    pub background: Rgb,
-    /// Linear scale applied to radiance before writing 8-bit images. Unset: chosen per image
-    /// from the rendered film (Reinhard et al. 2002's key: the log-average luminance mapped to
-    /// 0.18, lowered so at most 1 % of the pixels clip; the render summary prints it). EXR
-    /// output stays linear either way.
-    #[serde(default)]
-    pub exposure: Option<f32>,
-    /// Tone-mapping curve for 8-bit images, applied after `exposure`: `Linear` (clip) or `Aces`
-    /// (a filmic curve). Unset: `Aces` when the exposure is automatic (unset too), `Linear`
-    /// when the scene states an exposure (today's images, byte for byte). EXR output stays
-    /// linear.
-    #[serde(default)]
-    pub tonemap: Option<Tonemap>,
-    /// Light-transport algorithm. Unset: the default estimator, chosen per scene — `PathPpm`
-    /// (path tracing with a progressive caustic photon map, per-pass photon counts and gather
-    /// sizes chosen from the image size; see docs/progressive.md) when some object's material
-    /// has a mirror or glass part that could focus light onto a diffuse surface, else `Path`
-    /// (no photon pass at all). Naming an integrator here or with `--integrator` picks it.
-    #[serde(default)]
-    pub integrator: Option<IntegratorKind>,
-    /// Where the integrators' random numbers come from.
-    pub sampler: SamplerKind,
-    /// Path tracing: most diffuse or glossy bounces a path may make (unset: up to `max_depth`);
-    /// 0 keeps only direct light and mirror/glass chains (Whitted's light transport).
-    #[serde(default)]
-    pub diffuse_depth: Option<u32>,
-    /// How image textures are filtered.
-    pub texture_filter: TextureFilter,
-    /// Render pass after pass until the estimated relative mean squared error of the image
-    /// (from each pixel's sample variance; docs/convergence.md) is at most this, e.g. 0.01;
-    /// `--time` and `--spp` still stop it first (without `--spp` the scene's
-    /// `samples_per_pixel` gives way to the target). Unset: render every sample.
-    #[serde(default)]
-    pub target_error: Option<f32>,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            width: 640,
-            height: 480,
-            samples_per_pixel: 4,
-            max_depth: 8,
-            min_contribution: 0.001,
-            light_samples: 1,
-            seed: 0,
-            background: [0.0; 3],
-            exposure: None,
-            tonemap: None,
-            integrator: None,
-            sampler: SamplerKind::Sobol,
-            diffuse_depth: None,
-            texture_filter: TextureFilter::Anisotropic,
-            target_error: None,
-        }
-    }
-}
-
-/// Photon-map settings: the report's Settings.hpp photon constants, made explicit. Counts are
-/// photons *emitted*; each light gets a share in proportion to its power (equal-flux photons).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields, default)]
-pub struct PhotonSettings {
-    /// Photons emitted for the global map (diffuse interreflection); 0 builds no global map.
-    pub global: u32,
-    /// Caustic photons, aimed at objects that reflect or transmit (Jensen's projection maps)
-    /// and stored where they land on a diffuse surface after specular bounces only; 0 builds no
-    /// caustic map. Shared among the lights in proportion to power, except lights that set
-    /// their own `caustic_photons`.
-    pub caustic: u32,
-    /// Nearest photons per global-map estimate (k).
-    pub gather: u32,
-    /// Nearest photons per caustic-map estimate (k).
-    pub caustic_gather: u32,
-    /// Largest radius (scene units) of an estimate's disc; unset: chosen from the scene's size
-    /// and the photon count (reported in the summary). For the progressive integrators (`Ppm`,
-    /// `PathPpm`): the radius of the first pass.
-    #[serde(default)]
-    pub max_radius: Option<f32>,
-    /// Progressive integrators: the radius shrink of Knaus & Zwicker's schedule,
-    /// `r²ᵢ₊₁ = r²ᵢ (i + α)/(i + 1)`, in (0, 1); smaller shrinks faster (less bias, more noise).
-    pub alpha: f32,
-    /// The kernel of caustic estimates.
-    pub caustic_filter: PhotonFilter,
-    /// Diffuse bounces a photon must have made before the global map stores it (the report's
-    /// MIN_PHOTON_BOUNCE). At least 1: direct light always comes from shadow rays; more than 1
-    /// drops the first bounces of indirect light.
-    pub min_bounces: u32,
-    /// Final-gather rays per camera hit on a diffuse surface (indirect light sampled from the
-    /// BSDF and read from the maps where those rays land); 0 reads the global map directly.
-    pub final_gather: u32,
-    /// Most bounces a photon path makes before it is dropped: a safety net (Russian roulette
-    /// ends paths without bias); the summary says what a cut path would have stored.
-    pub max_bounces: u32,
-}
-
-impl Default for PhotonSettings {
-    fn default() -> Self {
-        Self {
-            global: 200_000,
-            caustic: 200_000,
-            gather: 100,
-            caustic_gather: 60,
-            max_radius: None,
-            alpha: 2.0 / 3.0,
-            caustic_filter: PhotonFilter::Cone { k: 1.1 },
-            min_bounces: 1,
-            final_gather: 16,
-            max_bounces: 256,
-        }
-    }
-}
-
-/// The kernel that weighs photons in a density estimate by their distance `d` from the query
-/// point, within the disc of radius `r`; each is normalised so a uniform photon density reads
-/// its true value (the report's CAUSTIC_SHARPNESS made explicit and energy-preserving).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub enum PhotonFilter {
-    /// Every photon counts equally.
-    Box,
-    /// Jensen's cone filter: weight `1 − d/(k·r)`, normalised by `1 − 2/(3k)`; `k ≥ 1`, smaller
-    /// is sharper (1 reaches 0 at the rim).
-    Cone {
-        /// Cone slope constant (≥ 1).
-        k: f32,
-    },
 }
 
 /// Camera models.

@@ -276,13 +276,16 @@ impl<'a> Validator<'a> {
                 .with_help("merge them into one map"),
             );
         }
-        if !envs.is_empty() && scene.render.background.iter().any(|c| *c != 0.0) {
+        if !envs.is_empty()
+            && let Some(background) = scene.render.background
+            && background.iter().any(|c| *c != 0.0)
+        {
             self.out.push(
                 Diagnostic::error(
                     "render.background",
                     format!(
                         "must be black with an environment or sky light (which is what escaping rays see), found {}",
-                        fmt3(scene.render.background)
+                        fmt3(background)
                     ),
                 )
                 .with_help("remove `background`, or add it to the environment's `radiance`"),

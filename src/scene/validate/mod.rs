@@ -67,8 +67,8 @@ pub fn validate(scene: &SceneFile) -> Vec<Diagnostic> {
         used_textures: BTreeSet::new(),
         scene,
     };
-    v.render(&scene.render);
-    v.photons(&scene.photons);
+    v.render(&scene.render.with_defaults());
+    v.photons(&scene.photons.with_defaults());
     v.camera(&scene.camera);
     for (name, t) in &scene.textures {
         v.texture(&format!("textures.{name}"), t);

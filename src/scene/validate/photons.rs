@@ -30,7 +30,8 @@ impl<'a> Validator<'a> {
             .map(|&(i, n)| (format!("lights[{i}].caustic_photons"), n))
             .collect();
         if own.len() < scene.lights.len() {
-            parts.push(("photons.caustic".into(), scene.photons.caustic));
+            let shared = scene.photons.with_defaults().caustic.unwrap_or(0);
+            parts.push(("photons.caustic".into(), shared));
         }
         let total: u64 = parts.iter().map(|p| u64::from(p.1)).sum();
         // One field over the limit is reported by `photon_count`.
@@ -47,11 +48,17 @@ impl<'a> Validator<'a> {
             list.join(" + "), total as f64 * 24.0 * 4.0 / 1e9)).with_help("every light's caustic photons go into one map: lower the counts, or use `ppm` passes for more"));
     }
 
+    /// `p`: the stated settings over their defaults (only `max_radius` may be `None`).
     pub(super) fn photons(&mut self, p: &PhotonSettings) {
-        self.photon_count("photons.global", p.global);
-        self.photon_count("photons.caustic", p.caustic);
+        for (path, n) in [("photons.global", p.global), ("photons.caustic", p.caustic)] {
+            if let Some(n) = n {
+                self.photon_count(path, n);
+            }
+        }
         for (field, k) in [("gather", p.gather), ("caustic_gather", p.caustic_gather)] {
-            if k == 0 || k > MAX_GATHER {
+            if let Some(k) = k
+                && (k == 0 || k > MAX_GATHER)
+            {
                 self.err(
                     &format!("photons.{field}"),
                     format!("must be within [1, {MAX_GATHER}] photons, found {k}"),
@@ -61,16 +68,19 @@ impl<'a> Validator<'a> {
         if let Some(r) = p.max_radius {
             self.positive("photons.max_radius", r, "the radius");
         }
-        if self.finite("photons.alpha", p.alpha) && !(p.alpha > 0.0 && p.alpha < 1.0) {
+        if let Some(alpha) = p.alpha
+            && self.finite("photons.alpha", alpha)
+            && !(alpha > 0.0 && alpha < 1.0)
+        {
             self.out.push(
                 Diagnostic::error(
                     "photons.alpha",
-                    format!("must be within (0, 1), found {}", p.alpha),
+                    format!("must be within (0, 1), found {alpha}"),
                 )
                 .with_help("Knaus and Zwicker suggest 2/3: each pass keeps (i + α)/(i + 1) of the previous radius²"),
             );
         }
-        if let PhotonFilter::Cone { k } = p.caustic_filter
+        if let Some(PhotonFilter::Cone { k }) = p.caustic_filter
             && self.finite("photons.caustic_filter.k", k)
             && !(1.0..=1e6).contains(&k)
         {
@@ -84,31 +94,28 @@ impl<'a> Validator<'a> {
                 ),
             );
         }
-        if p.min_bounces == 0 || p.min_bounces > p.max_bounces {
+        let (min, max) = (p.min_bounces.unwrap_or(1), p.max_bounces.unwrap_or(0));
+        if p.min_bounces.is_some() && (min == 0 || min > max) {
             self.out.push(
                 Diagnostic::error(
                     "photons.min_bounces",
-                    format!(
-                        "must be within [1, photons.max_bounces = {}], found {}",
-                        p.max_bounces, p.min_bounces
-                    ),
+                    format!("must be within [1, photons.max_bounces = {max}], found {min}"),
                 )
                 .with_help("direct light always comes from shadow rays, so the global map starts after at least one diffuse bounce"),
             );
         }
-        if p.max_bounces > MAX_DEPTH {
+        if max > MAX_DEPTH {
             self.err(
                 "photons.max_bounces",
-                format!("must be at most {MAX_DEPTH}, found {}", p.max_bounces),
+                format!("must be at most {MAX_DEPTH}, found {max}"),
             );
         }
-        if p.final_gather > MAX_FINAL_GATHER {
+        if let Some(n) = p.final_gather
+            && n > MAX_FINAL_GATHER
+        {
             self.err(
                 "photons.final_gather",
-                format!(
-                    "must be at most {MAX_FINAL_GATHER} rays per hit, found {}",
-                    p.final_gather
-                ),
+                format!("must be at most {MAX_FINAL_GATHER} rays per hit, found {n}"),
             );
         }
     }

@@ -3,8 +3,11 @@
 use super::*;
 
 impl<'a> Validator<'a> {
+    /// `r`: the stated settings over their defaults (only the fields without a default may be
+    /// `None`).
     pub(super) fn render(&mut self, r: &RenderSettings) {
-        for (field, v) in [("width", r.width), ("height", r.height)] {
+        let (width, height) = (r.width.unwrap_or(1), r.height.unwrap_or(1));
+        for (field, v) in [("width", width), ("height", height)] {
             let path = format!("render.{field}");
             if v == 0 {
                 self.err(&path, "must be at least 1 pixel, found 0".into());
@@ -15,45 +18,52 @@ impl<'a> Validator<'a> {
                 );
             }
         }
-        let pixels = u64::from(r.width) * u64::from(r.height);
-        if r.width <= MAX_IMAGE_SIDE && r.height <= MAX_IMAGE_SIDE && pixels > MAX_IMAGE_PIXELS {
+        let pixels = u64::from(width) * u64::from(height);
+        if width <= MAX_IMAGE_SIDE && height <= MAX_IMAGE_SIDE && pixels > MAX_IMAGE_PIXELS {
             self.err(
                 "render.width",
                 format!(
                     "{}×{} = {pixels} pixels exceeds the limit of {MAX_IMAGE_PIXELS} pixels (the film alone would need {:.1} GB)",
-                    r.width,
-                    r.height,
+                    width,
+                    height,
                     pixels as f64 * 12.0 / 1e9
                 ),
             );
         }
-        if r.samples_per_pixel == 0 || r.samples_per_pixel > MAX_SAMPLES_PER_PIXEL {
+        if let Some(spp) = r.samples_per_pixel
+            && (spp == 0 || spp > MAX_SAMPLES_PER_PIXEL)
+        {
             self.err(
                 "render.samples_per_pixel",
-                format!(
-                    "must be within [1, {MAX_SAMPLES_PER_PIXEL}], found {}",
-                    r.samples_per_pixel
-                ),
+                format!("must be within [1, {MAX_SAMPLES_PER_PIXEL}], found {spp}"),
             );
         }
-        if r.max_depth > MAX_DEPTH {
+        if let Some(depth) = r.max_depth
+            && depth > MAX_DEPTH
+        {
             self.err(
                 "render.max_depth",
-                format!("must be at most {MAX_DEPTH}, found {}", r.max_depth),
+                format!("must be at most {MAX_DEPTH}, found {depth}"),
             );
         }
-        if r.light_samples == 0 || r.light_samples > 1024 {
+        if let Some(n) = r.light_samples
+            && (n == 0 || n > 1024)
+        {
             self.err(
                 "render.light_samples",
-                format!("must be within [1, 1024], found {}", r.light_samples),
+                format!("must be within [1, 1024], found {n}"),
             );
         }
-        self.range("render.min_contribution", r.min_contribution, 0.0, 1.0);
-        if self.finite3("render.background", r.background) && r.background.iter().any(|c| *c < 0.0)
+        if let Some(m) = r.min_contribution {
+            self.range("render.min_contribution", m, 0.0, 1.0);
+        }
+        if let Some(bg) = r.background
+            && self.finite3("render.background", bg)
+            && bg.iter().any(|c| *c < 0.0)
         {
             self.err(
                 "render.background",
-                format!("must not be negative, found {}", fmt3(r.background)),
+                format!("must not be negative, found {}", fmt3(bg)),
             );
         }
         if let Some(exposure) = r.exposure {

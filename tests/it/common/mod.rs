@@ -33,9 +33,12 @@ pub fn scene_files() -> Vec<PathBuf> {
 /// Overrides for a small test render.
 pub fn small(width: u32, height: u32, spp: u32) -> SceneOverrides {
     SceneOverrides {
-        width: Some(width),
-        height: Some(height),
-        samples_per_pixel: Some(spp),
+        render: caustic::scene::schema::RenderSettings {
+            width: Some(width),
+            height: Some(height),
+            samples_per_pixel: Some(spp),
+            ..Default::default()
+        },
         ..SceneOverrides::default()
     }
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 use image::{ImageFormat, Rgb, RgbImage};
 use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 
-use caustic::render::output::{OutputError, write_atomic};
+use crate::render::output::{OutputError, write_atomic};
 
 use super::pixel_font::{GLYPH, draw_text, text_width};
 

@@ -1,5 +1,8 @@
 //! The default estimator: what renders a scene that names no integrator (issue #24), and the
-//! per-pass photon budget it chooses for itself.
+//! per-pass photon budget it chooses for itself. The choice is part of resolving the settings
+//! ([`super::settings::resolve`], where the integrator is chosen); the record of it,
+//! [`DefaultEstimator`] with its [`PassPhotons`], is kept in the render parameters for the
+//! summary.
 //!
 //! The choice is made once, when the scene is compiled, from what the scene can do:
 //!
@@ -22,7 +25,9 @@
 //! the default chooses its per-pass counts itself ([`PassPhotons::for_image`]) unless the command
 //! line states them (`--set photons.caustic=…`, `--caustic-photons`, …), which then win.
 
-use super::{IntegratorKind, ObjectInfo, SurfaceMaterial};
+use crate::render_scene::{
+    DefaultEstimator, IntegratorKind, ObjectInfo, PassPhotons, SurfaceMaterial,
+};
 use crate::shading::NEAR_SPECULAR_ALPHA;
 
 /// Caustic photons emitted per pass per image pixel. The issue's measurement on the caustic
@@ -45,20 +50,6 @@ pub const MAX_PASS_PHOTONS: u32 = 100_000;
 /// (10), 0.00455 (7), RMSE within 3 %, z8 1.15 for all three. A smaller disc also blurs less.
 pub const PASS_CAUSTIC_GATHER: u32 = 10;
 
-/// The photon budget of one pass of the default estimator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PassPhotons {
-    /// Caustic photons emitted per pass.
-    pub caustic: u32,
-    /// Nearest photons that set the initial radius `R(x)` (about that many photons per disc at
-    /// the first pass, where the pilot map's density holds; later passes shrink the disc).
-    pub caustic_gather: u32,
-    /// Photons emitted per pass for the global map: 0, no global map. The path tracer carries
-    /// all diffuse interreflection itself, without the global map's blur (the local bias of the
-    /// issue's `ppm` row); only the caustic paths, which it finds by chance, come from photons.
-    pub global: u32,
-}
-
 impl PassPhotons {
     /// The per-pass budget for an image of `width` × `height` pixels:
     /// [`CAUSTIC_PHOTONS_PER_PIXEL`] per pixel, rounded to a thousand and clamped to
@@ -76,17 +67,6 @@ impl PassPhotons {
             global: 0,
         }
     }
-}
-
-/// How the default estimator was chosen for a scene that names no integrator (kept in
-/// `RenderParams::default_estimator` for the summary line).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct DefaultEstimator {
-    /// Objects whose material has a mirror or glass part or is near-specular.
-    pub specular_casters: usize,
-    /// The per-pass photon budget chosen (`None` when the choice is `path`, or when the command
-    /// line stated the counts, which then stand as given).
-    pub photons: Option<PassPhotons>,
 }
 
 impl DefaultEstimator {
