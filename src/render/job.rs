@@ -15,7 +15,9 @@ use super::options::{
     ProgressiveStats, Region, RenderError, RenderOptions, RenderOutput, RenderStats, check_region,
 };
 use super::pixel_sums::PixelSums;
-use super::tiles::{Sweep, TileResult, new_parts, pixel_index, render_tile, tile_grid};
+use super::tiles::{
+    SampleRanges, Sweep, TileResult, new_parts, pixel_index, render_tile, tile_grid,
+};
 use crate::integrators::Integrator;
 use crate::integrators::splat::FilmSplats;
 use crate::render_scene::RenderScene;
@@ -49,8 +51,16 @@ pub struct RenderJob<'a> {
     parts: Option<Vec<PixelSums>>,
     /// First sample index this job takes.
     first: u32,
-    /// Samples `first..done` are in `sums`.
+    /// Samples `first..done` are in `sums` (of every pixel).
     done: u32,
+    /// Once adaptive rounds ([`RenderJob::render_counts`]) have begun: one past the last sample
+    /// index each pixel has taken (at least `done`), row-major over the region.
+    taken: Option<Vec<u32>>,
+    /// Samples taken by adaptive rounds beyond `done` per pixel, summed over the pixels.
+    extra: u64,
+    /// One past the last pass (photon maps, one per sample index) a progressive integrator
+    /// has begun, for the summary's radius.
+    next_pass: u32,
     /// One past the last sample index this job takes.
     end: u32,
     stats: RenderStats,
@@ -141,6 +151,9 @@ impl<'a> RenderJob<'a> {
                 .then(|| new_parts(region.width, region.height)),
             first: range.start,
             done: range.start,
+            taken: None,
+            extra: 0,
+            next_pass: range.start,
             end: range.end,
             stats: RenderStats {
                 threads,
@@ -177,6 +190,11 @@ impl<'a> RenderJob<'a> {
     /// [`RenderError::Cancelled`] when the cancel flag is raised before the pass ends; the job
     /// then still holds the image of the samples it completed before (whole sample indices).
     pub fn render_pass(&mut self, n: u32) -> Result<(), RenderError> {
+        if let Some(taken) = &self.taken {
+            // After adaptive rounds: `n` more of each pixel's own samples.
+            let counts: Vec<u32> = taken.iter().map(|&t| n.min(self.end - t)).collect();
+            return self.render_counts(&counts);
+        }
         let end = self.done + n.min(self.samples_per_pixel() - self.done);
         if self.is_cancelled() {
             return Err(RenderError::Cancelled);
@@ -193,12 +211,147 @@ impl<'a> RenderJob<'a> {
         Ok(())
     }
 
+    /// An adaptive round: pixel `i` (row-major over the region) takes its next `counts[i]`
+    /// sample indices (fewer if the samples per pixel run out), continuing from the last one
+    /// it took, so a pixel's `s`-th sample is the same whichever round it falls in. A
+    /// progressive integrator takes the round pass by pass over the sample indices some pixel
+    /// takes: sample `s` of any pixel reads the photon maps of pass `s`, as in a uniform render
+    /// (see [`super::adaptive`]).
+    ///
+    /// # Errors
+    /// [`RenderError::Cancelled`] as [`RenderJob::render_pass`] (a progressive round keeps its
+    /// completed passes); [`RenderError::Counts`] when `counts` is not one per pixel.
+    pub fn render_counts(&mut self, counts: &[u32]) -> Result<(), RenderError> {
+        let n = self.region.width as usize * self.region.height as usize;
+        if counts.len() != n {
+            return Err(RenderError::Counts(counts.len(), n));
+        }
+        if self.is_cancelled() {
+            return Err(RenderError::Cancelled);
+        }
+        let (done, end) = (self.done, self.end);
+        let taken = self.taken.get_or_insert_with(|| vec![done; n]);
+        let to: Vec<u32> = taken
+            .iter()
+            .zip(counts)
+            .map(|(&t, &c)| t.saturating_add(c).min(end))
+            .collect();
+        if !self.integrator.is_progressive() {
+            return self.sweep_to(to);
+        }
+        // Sample `s` of every pixel reads pass `s`'s photon maps, as in a uniform render: the
+        // passes of the indices some pixel takes this round, in increasing order.
+        let lo = taken
+            .iter()
+            .zip(&to)
+            .filter(|(t, e)| t < e)
+            .map(|(&t, _)| t)
+            .min();
+        let hi = to.iter().copied().max().unwrap_or(0);
+        let Some(lo) = lo else {
+            return Ok(());
+        };
+        for pass in lo..hi {
+            let Some(taken) = self.taken.as_ref() else {
+                return Ok(());
+            };
+            let slot: Vec<u32> = taken
+                .iter()
+                .zip(&to)
+                .map(|(&t, &e)| if t == pass && pass < e { pass + 1 } else { t })
+                .collect();
+            if slot.iter().zip(taken).all(|(s, t)| s == t) {
+                continue;
+            }
+            let integrator = &mut self.integrator;
+            self.pool.install(|| integrator.begin_pass(pass));
+            self.sweep_to(slot)?;
+            self.next_pass = self.next_pass.max(pass + 1);
+        }
+        Ok(())
+    }
+
+    /// Takes each pixel's samples from its `taken` index to `to` (adaptive rounds).
+    fn sweep_to(&mut self, to: Vec<u32>) -> Result<(), RenderError> {
+        let Some(from) = self.taken.take() else {
+            return Ok(());
+        };
+        let samples = SampleRanges::PerPixel {
+            region: self.region,
+            from: &from,
+            to: &to,
+        };
+        let swept = self.sweep_ranges(samples);
+        if swept.is_ok() {
+            self.extra += from
+                .iter()
+                .zip(&to)
+                .map(|(&f, &t)| u64::from(t - f))
+                .sum::<u64>();
+            self.taken = Some(to);
+        } else {
+            self.taken = Some(from);
+        }
+        swept
+    }
+
+    /// What an adaptive render has taken so far, to be continued by another job
+    /// ([`RenderJob::resume`]): the same bytes as if it had never stopped.
+    #[must_use]
+    pub fn state(&self) -> JobState {
+        let n = self.region.width as usize * self.region.height as usize;
+        JobState {
+            sums: self.sums.clone(),
+            taken: self.taken.clone().unwrap_or_else(|| vec![self.done; n]),
+            next_pass: self.next_pass.max(self.done),
+        }
+    }
+
+    /// Continues the render `state` was taken from ([`RenderJob::state`]) in this new job of the
+    /// same scene, options and region (the light-path layers start empty).
+    ///
+    /// # Errors
+    /// [`RenderError::Counts`] when `state` is not of this job's region's size.
+    pub fn resume(&mut self, state: JobState) -> Result<(), RenderError> {
+        let n = self.region.width as usize * self.region.height as usize;
+        let size = state.sums.width as usize * state.sums.height as usize;
+        if state.taken.len() != n || size != n {
+            return Err(RenderError::Counts(state.taken.len(), n));
+        }
+        let done = self.done;
+        self.extra = state
+            .taken
+            .iter()
+            .map(|&t| u64::from(t - done.min(t)))
+            .sum();
+        self.sums = state.sums;
+        self.taken = Some(state.taken);
+        self.next_pass = state.next_pass;
+        Ok(())
+    }
+
+    /// One past the last sample index pixel `i` (row-major over the region) has taken.
+    #[must_use]
+    pub fn pixel_samples(&self, i: usize) -> u32 {
+        self.taken.as_ref().map_or(self.done, |t| t[i])
+    }
+
     /// Takes samples `done..end` of every pixel in one sweep over the tiles.
     fn sweep(&mut self, end: u32) -> Result<(), RenderError> {
         if end == self.done {
             return Ok(());
         }
-        let (region, samples) = (self.region, self.done..end);
+        self.sweep_ranges(SampleRanges::All(self.done..end))?;
+        self.done = end;
+        if self.next_pass < end {
+            self.next_pass = end;
+        }
+        Ok(())
+    }
+
+    /// Takes `samples` of every pixel in one sweep over the tiles.
+    fn sweep_ranges(&mut self, samples: SampleRanges<'_>) -> Result<(), RenderError> {
+        let region = self.region;
         let sweep = Sweep {
             scene: self.scene,
             integrator: &self.integrator,
@@ -210,7 +363,7 @@ impl<'a> RenderJob<'a> {
         let results: Option<Vec<TileResult>> = self.pool.install(|| {
             self.tiles
                 .par_iter()
-                .map(|t| render_tile(&sweep, t, samples.clone()))
+                .map(|t| render_tile(&sweep, t, &samples))
                 .collect()
         });
         let Some(results) = results else {
@@ -235,7 +388,6 @@ impl<'a> RenderJob<'a> {
             // Exact fixed-point sums: the order of splats and tiles never shows in the bytes.
             merge_splats(splats, &mut self.sums, self.parts.as_mut());
         }
-        self.done = end;
         Ok(())
     }
 
@@ -338,6 +490,9 @@ impl<'a> RenderJob<'a> {
             self.parts = Some(new_parts(region.width, region.height));
         }
         self.done = self.first;
+        self.taken = None;
+        self.extra = 0;
+        self.next_pass = self.first;
         self.stats = RenderStats {
             threads: self.stats.threads,
             ..Default::default()
@@ -398,11 +553,12 @@ impl<'a> RenderJob<'a> {
         let mut stats = self.stats;
         stats.samples = u64::from(self.region.width)
             * u64::from(self.region.height)
-            * u64::from(self.done - self.first);
+            * u64::from(self.done - self.first)
+            + self.extra;
         stats.elapsed = self.start.elapsed();
         stats.progressive = self.integrator.progressive().map(|p| ProgressiveStats {
             totals: p.totals(),
-            last_shrink: p.shrink(self.done.saturating_sub(1)),
+            last_shrink: p.shrink(self.next_pass.max(self.done).saturating_sub(1)),
             caustic_radius: p
                 .fields()
                 .and_then(|f| f.caustic.as_ref())
@@ -426,6 +582,17 @@ impl<'a> RenderJob<'a> {
             .as_deref()
             .is_some_and(|c| c.load(Ordering::Relaxed))
     }
+}
+
+/// The state of an adaptive render between rounds ([`RenderJob::state`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct JobState {
+    /// The film's sums, squares and counts.
+    pub sums: PixelSums,
+    /// One past the last sample index each pixel has taken, row-major over the region.
+    pub taken: Vec<u32>,
+    /// One past the last pass a progressive integrator began (for its summary).
+    pub next_pass: u32,
 }
 
 /// One region's part of a [`RenderJob::render_regions`] call: what the job holds per region.

@@ -109,6 +109,11 @@ pub struct RenderSettings {
     /// `samples_per_pixel` gives way to the target). Unset: render every sample.
     #[serde(default)]
     pub target_error: Option<f32>,
+    /// Adaptive sampling (docs/convergence.md): after 8 uniform samples per pixel, each pixel
+    /// takes more only while its own estimated relative error is above `target_error` (unset:
+    /// 0.002); `samples_per_pixel` caps every pixel. Not with farm shards or `.part` outputs.
+    #[serde(default)]
+    pub adaptive: bool,
 }
 
 impl Default for RenderSettings {
@@ -129,6 +134,7 @@ impl Default for RenderSettings {
             diffuse_depth: None,
             texture_filter: TextureFilter::Anisotropic,
             target_error: None,
+            adaptive: false,
         }
     }
 }
