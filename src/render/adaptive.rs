@@ -11,10 +11,13 @@
 //! Rounds:
 //! 1. **Warm-up**: every pixel takes samples `0..W` (the bytes of a uniform render at that
 //!    many samples per pixel), `W` a quarter of the samples per pixel within 8..=64.
-//! 2. **Each later round** gives pixel `i` `clamp(⌈n · e / τ⌉ − n, 1, taken)` more samples if
-//!    `e > τ`, none otherwise: at most as many as it has (the estimate from few samples is
-//!    itself noisy, so a pixel at most doubles before it is looked at again), never past the
-//!    samples per pixel. The render ends when a round gives no pixel a sample.
+//! 2. **Each later round** covers the sample indices `start..2·start` (so rounds double, up to
+//!    the samples per pixel, the same for every pixel and crop), and pixel `i` takes the
+//!    first `clamp(⌈n · e / τ⌉ − n, 1, start)` of them if `e > τ`, none otherwise (the
+//!    estimate from few samples is itself noisy, so a pixel at most doubles before it is
+//!    looked at again). The indices a pixel skips in a round are never taken: its samples are
+//!    the warm-up and a prefix of each round it took part in. The render ends when a round
+//!    gives no pixel a sample.
 //!
 //! The decision for a pixel reads only that pixel's statistics after the previous round, in
 //! fixed-point sums that are the same for any thread count, and a pixel's `s`-th sample is the
@@ -25,15 +28,14 @@
 //!
 //! **Progressive photon passes** (`path-ppm`, `ppm`, and so the default estimator): a pixel's
 //! sample `s` reads the photon maps of pass `s` (fresh maps, radius shrunk by Knaus & Zwicker's
-//! schedule for pass `s`), exactly as in a uniform render. A round traces the passes of the
-//! sample indices some pixel takes in it, in increasing order, each once per round, and in
-//! pass `s` the pixels whose next sample is `s` take it. A pixel that skips passes simply has
-//! fewer samples: with `n` of them it is, bit for bit, the pixel of the uniform render at `n`
-//! samples per pixel, with that render's bias and variance, and consistent like it. (The
-//! alternative, a sample reading the maps of the round's pass whatever its index, would number
-//! passes by how many the *other* pixels needed, and a crop would differ.) The cost: passes are
-//! traced up to the most samples any pixel takes, and a pass index taken in two rounds by
-//! different pixels is traced twice (`--integrator path` has no passes).
+//! schedule for pass `s`), as in a uniform render; a round traces each of its passes once, for
+//! every pixel whose prefix of the round reaches it, so passes are traced up to the most
+//! samples any pixel reached, never twice. A pixel that skipped the end of a round has samples
+//! of later passes than its count: their radii shrank further than a uniform render's at
+//! that count (less bias, more variance per sample), and every radius still goes to zero, so
+//! it stays consistent. Each sample reads its own maps: a pixel's samples are independent and
+//! its variance estimate holds. (Numbering passes by how many a round needed instead would
+//! depend on the other pixels, and a crop would differ.)
 //!
 //! **The mean**: the film keeps each pixel's count, so every pixel is the mean of its own
 //! samples. Stopping on a pixel's own samples is not exactly unbiased (Kirk & Arvo 1991: a
@@ -48,6 +50,8 @@
 //! **Shards and merge**: a shard's samples would depend on every earlier shard's film, so an
 //! adaptive render cannot be split into sample ranges: `--shard`, `--samples` and a `.part`
 //! output refuse `--adaptive` (docs/farm.md).
+
+use std::ops::Range;
 
 use super::PixelSums;
 use super::error_estimate::pixel_rel_mse;
@@ -85,24 +89,33 @@ impl AdaptivePlan {
         }
     }
 
-    /// The next round's samples for each pixel of `sums` (row-major), given the sample
-    /// indices each has taken (`taken(i)`) and the samples per pixel `cap`.
+    /// The sample indices of the round that starts at `start` (the first index no pixel has
+    /// taken) in a render of `cap` samples per pixel: the warm-up `0..warmup`, then rounds
+    /// that double, `start..2·start`; empty at the cap. The same for every pixel and region.
     #[must_use]
-    pub fn counts(&self, sums: &PixelSums, taken: impl Fn(usize) -> u32, cap: u32) -> Vec<u32> {
-        let n = sums.width as usize * sums.height as usize;
-        (0..n)
-            .map(|i| self.pixel_count(sums, i, taken(i), cap))
-            .collect()
+    pub fn round(&self, start: u32, cap: u32) -> Range<u32> {
+        let end = if start < self.warmup {
+            self.warmup
+        } else {
+            start.saturating_mul(2)
+        };
+        start.min(cap)..end.min(cap)
     }
 
-    /// The next round's samples for pixel `i` that has taken `taken` sample indices.
-    fn pixel_count(&self, sums: &PixelSums, i: usize, taken: u32, cap: u32) -> u32 {
-        if taken >= cap {
-            return 0;
-        }
-        let left = cap - taken;
-        if taken < self.warmup {
-            return (self.warmup - taken).min(left);
+    /// How many of `round`'s sample indices ([`AdaptivePlan::round`]) each pixel of `sums`
+    /// (row-major) takes.
+    #[must_use]
+    pub fn counts(&self, sums: &PixelSums, round: &Range<u32>) -> Vec<u32> {
+        let n = sums.width as usize * sums.height as usize;
+        (0..n).map(|i| self.pixel_count(sums, i, round)).collect()
+    }
+
+    /// How many of `round`'s sample indices pixel `i` takes: all of the warm-up; later, none
+    /// once its estimate is at most the threshold, else what the 1/n fall predicts it needs.
+    fn pixel_count(&self, sums: &PixelSums, i: usize, round: &Range<u32>) -> u32 {
+        let len = round.end.saturating_sub(round.start);
+        if round.start < self.warmup {
+            return len;
         }
         let n = f64::from(sums.count(i));
         let e = pixel_rel_mse(sums, i);
@@ -111,7 +124,7 @@ impl AdaptivePlan {
         }
         // The estimate falls as 1/n: n · e / τ samples in all reach τ. `as` saturates.
         let more = (n * e / self.pixel_target - n).ceil();
-        (more as u32).clamp(1, taken.max(1)).min(left)
+        (more as u32).clamp(1, len.max(1)).min(len)
     }
 }
 
@@ -134,18 +147,29 @@ mod tests {
             pixel_target: 0.01,
             warmup: 8,
         };
-        let taken = [8, 8, 1];
-        let c = plan.counts(&s, |i| taken[i], 64);
-        // Pixel 1 needs 8 · 0.14144 / 0.01 ≈ 113 in all, 105 more: capped at doubling (8).
-        assert_eq!(c, vec![0, 8, 7]);
+        // After the warm-up of 8 the round is 8..16.
+        assert_eq!(plan.round(8, 64), 8..16);
+        let c = plan.counts(&s, &(8..16));
+        // Pixel 1 needs 8 · 0.14144 / 0.01 ≈ 113 in all, 106 more: the round's 8. Pixel 2's
+        // single sample says nothing (estimate 1): the whole round.
+        assert_eq!(c, vec![0, 8, 8]);
         // A looser target: 8 · 0.14144 / 0.1 = 11.3 → 4 more.
         let loose = AdaptivePlan {
             pixel_target: 0.1,
             warmup: 8,
         };
-        assert_eq!(loose.counts(&s, |i| taken[i], 64), vec![0, 4, 7]);
-        // The cap: pixel 1 at 60 of 64 takes at most 4 more, at 64 none.
-        assert_eq!(plan.counts(&s, |i| [8, 60, 64][i], 64), vec![0, 4, 0]);
+        assert_eq!(loose.counts(&s, &(8..16)), vec![0, 4, 8]);
+        // The warm-up round gives every pixel all of it; rounds double up to the cap.
+        assert_eq!(plan.counts(&s, &(0..8)), vec![8, 8, 8]);
+        assert_eq!(
+            [
+                plan.round(0, 64),
+                plan.round(16, 64),
+                plan.round(32, 48),
+                plan.round(64, 64)
+            ],
+            [0..8, 16..32, 32..48, 64..64]
+        );
     }
 
     #[test]

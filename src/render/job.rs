@@ -3,6 +3,7 @@
 //! [`super::tiles`] does each sweep), so a render can be checkpointed, cancelled, budgeted or
 //! split into farm shards without changing its bytes. [`render`] is the one-pass shortcut.
 
+use std::ops::Range;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -53,9 +54,9 @@ pub struct RenderJob<'a> {
     first: u32,
     /// Samples `first..done` are in `sums` (of every pixel).
     done: u32,
-    /// Once adaptive rounds ([`RenderJob::render_counts`]) have begun: one past the last sample
-    /// index each pixel has taken (at least `done`), row-major over the region.
-    taken: Option<Vec<u32>>,
+    /// Once adaptive rounds ([`RenderJob::render_round`]) have begun: one past the last
+    /// sample index a round covered (the next round starts there).
+    rounds_end: Option<u32>,
     /// Samples taken by adaptive rounds beyond `done` per pixel, summed over the pixels.
     extra: u64,
     /// One past the last pass (photon maps, one per sample index) a progressive integrator
@@ -151,7 +152,7 @@ impl<'a> RenderJob<'a> {
                 .then(|| new_parts(region.width, region.height)),
             first: range.start,
             done: range.start,
-            taken: None,
+            rounds_end: None,
             extra: 0,
             next_pass: range.start,
             end: range.end,
@@ -190,10 +191,11 @@ impl<'a> RenderJob<'a> {
     /// [`RenderError::Cancelled`] when the cancel flag is raised before the pass ends; the job
     /// then still holds the image of the samples it completed before (whole sample indices).
     pub fn render_pass(&mut self, n: u32) -> Result<(), RenderError> {
-        if let Some(taken) = &self.taken {
-            // After adaptive rounds: `n` more of each pixel's own samples.
-            let counts: Vec<u32> = taken.iter().map(|&t| n.min(self.end - t)).collect();
-            return self.render_counts(&counts);
+        if let Some(start) = self.rounds_end {
+            // After adaptive rounds: the next `n` sample indices of every pixel.
+            let pixels = self.region.width as usize * self.region.height as usize;
+            let end = start.saturating_add(n).min(self.end);
+            return self.render_round(start..end, &vec![n; pixels]);
         }
         let end = self.done + n.min(self.samples_per_pixel() - self.done);
         if self.is_cancelled() {
@@ -211,98 +213,81 @@ impl<'a> RenderJob<'a> {
         Ok(())
     }
 
-    /// An adaptive round: pixel `i` (row-major over the region) takes its next `counts[i]`
-    /// sample indices (fewer if the samples per pixel run out), continuing from the last one
-    /// it took, so a pixel's `s`-th sample is the same whichever round it falls in. A
-    /// progressive integrator takes the round pass by pass over the sample indices some pixel
-    /// takes: sample `s` of any pixel reads the photon maps of pass `s`, as in a uniform render
-    /// (see [`super::adaptive`]).
+    /// An adaptive round over the sample indices `round` (starting at or after every index
+    /// taken so far, [`RenderJob::next_index`]): pixel `i` (row-major over the region) takes
+    /// the first `counts[i]` of them (all of them at most). Sample `s` of a pixel is the
+    /// sampler's sample `s` of that pixel whichever round takes it, and a progressive
+    /// integrator traces pass `s`'s photon maps for it, as in a uniform render: once, for every
+    /// pixel that takes sample `s` (see [`super::adaptive`]). The next round starts at
+    /// `round.end` whatever the counts, so the rounds do not depend on the region.
     ///
     /// # Errors
     /// [`RenderError::Cancelled`] as [`RenderJob::render_pass`] (a progressive round keeps its
-    /// completed passes); [`RenderError::Counts`] when `counts` is not one per pixel.
-    pub fn render_counts(&mut self, counts: &[u32]) -> Result<(), RenderError> {
+    /// completed passes); [`RenderError::Counts`] when `counts` is not one per pixel;
+    /// [`RenderError::SampleRange`] when `round` overlaps the indices taken or passes the
+    /// samples per pixel.
+    pub fn render_round(&mut self, round: Range<u32>, counts: &[u32]) -> Result<(), RenderError> {
         let n = self.region.width as usize * self.region.height as usize;
         if counts.len() != n {
             return Err(RenderError::Counts(counts.len(), n));
         }
+        if round.start < self.next_index() || round.end > self.end || round.start > round.end {
+            return Err(RenderError::SampleRange(round.start, round.end, self.end));
+        }
         if self.is_cancelled() {
             return Err(RenderError::Cancelled);
         }
-        let (done, end) = (self.done, self.end);
-        let taken = self.taken.get_or_insert_with(|| vec![done; n]);
-        let to: Vec<u32> = taken
-            .iter()
-            .zip(counts)
-            .map(|(&t, &c)| t.saturating_add(c).min(end))
-            .collect();
+        let len = round.end - round.start;
+        let to: Vec<u32> = counts.iter().map(|&c| round.start + c.min(len)).collect();
         if !self.integrator.is_progressive() {
-            return self.sweep_to(to);
-        }
-        // Sample `s` of every pixel reads pass `s`'s photon maps, as in a uniform render: the
-        // passes of the indices some pixel takes this round, in increasing order.
-        let lo = taken
-            .iter()
-            .zip(&to)
-            .filter(|(t, e)| t < e)
-            .map(|(&t, _)| t)
-            .min();
-        let hi = to.iter().copied().max().unwrap_or(0);
-        let Some(lo) = lo else {
-            return Ok(());
-        };
-        for pass in lo..hi {
-            let Some(taken) = self.taken.as_ref() else {
-                return Ok(());
-            };
-            let slot: Vec<u32> = taken
-                .iter()
-                .zip(&to)
-                .map(|(&t, &e)| if t == pass && pass < e { pass + 1 } else { t })
-                .collect();
-            if slot.iter().zip(taken).all(|(s, t)| s == t) {
-                continue;
+            let from = vec![round.start; n];
+            self.sweep_counted(&from, &to)?;
+        } else {
+            let most = to.iter().copied().max().unwrap_or(round.start);
+            for pass in round.start..most {
+                let from: Vec<u32> = to.iter().map(|&e| pass.min(e)).collect();
+                let next: Vec<u32> = to.iter().map(|&e| (pass + 1).min(e)).collect();
+                let integrator = &mut self.integrator;
+                self.pool.install(|| integrator.begin_pass(pass));
+                self.sweep_counted(&from, &next)?;
+                self.next_pass = self.next_pass.max(pass + 1);
+                // A cancel after this pass leaves the round's later passes untaken.
+                self.rounds_end = Some(pass + 1);
             }
-            let integrator = &mut self.integrator;
-            self.pool.install(|| integrator.begin_pass(pass));
-            self.sweep_to(slot)?;
-            self.next_pass = self.next_pass.max(pass + 1);
         }
+        self.rounds_end = Some(round.end);
         Ok(())
     }
 
-    /// Takes each pixel's samples from its `taken` index to `to` (adaptive rounds).
-    fn sweep_to(&mut self, to: Vec<u32>) -> Result<(), RenderError> {
-        let Some(from) = self.taken.take() else {
-            return Ok(());
-        };
+    /// Takes each pixel's samples `from[i]..to[i]` in one sweep (adaptive rounds).
+    fn sweep_counted(&mut self, from: &[u32], to: &[u32]) -> Result<(), RenderError> {
         let samples = SampleRanges::PerPixel {
             region: self.region,
-            from: &from,
-            to: &to,
+            from,
+            to,
         };
-        let swept = self.sweep_ranges(samples);
-        if swept.is_ok() {
-            self.extra += from
-                .iter()
-                .zip(&to)
-                .map(|(&f, &t)| u64::from(t - f))
-                .sum::<u64>();
-            self.taken = Some(to);
-        } else {
-            self.taken = Some(from);
-        }
-        swept
+        self.sweep_ranges(samples)?;
+        self.extra += from
+            .iter()
+            .zip(to)
+            .map(|(&f, &t)| u64::from(t - f))
+            .sum::<u64>();
+        Ok(())
+    }
+
+    /// The first sample index no pixel has taken yet: where the next adaptive round starts.
+    #[must_use]
+    pub fn next_index(&self) -> u32 {
+        self.rounds_end.unwrap_or(self.done)
     }
 
     /// What an adaptive render has taken so far, to be continued by another job
     /// ([`RenderJob::resume`]): the same bytes as if it had never stopped.
     #[must_use]
     pub fn state(&self) -> JobState {
-        let n = self.region.width as usize * self.region.height as usize;
         JobState {
             sums: self.sums.clone(),
-            taken: self.taken.clone().unwrap_or_else(|| vec![self.done; n]),
+            next_index: self.next_index(),
             next_pass: self.next_pass.max(self.done),
         }
     }
@@ -315,25 +300,14 @@ impl<'a> RenderJob<'a> {
     pub fn resume(&mut self, state: JobState) -> Result<(), RenderError> {
         let n = self.region.width as usize * self.region.height as usize;
         let size = state.sums.width as usize * state.sums.height as usize;
-        if state.taken.len() != n || size != n {
-            return Err(RenderError::Counts(state.taken.len(), n));
+        if (state.sums.width, state.sums.height) != (self.region.width, self.region.height) {
+            return Err(RenderError::Counts(size, n));
         }
-        let done = self.done;
-        self.extra = state
-            .taken
-            .iter()
-            .map(|&t| u64::from(t - done.min(t)))
-            .sum();
+        self.extra = (0..n).map(|i| u64::from(state.sums.count(i))).sum();
         self.sums = state.sums;
-        self.taken = Some(state.taken);
+        self.rounds_end = Some(state.next_index);
         self.next_pass = state.next_pass;
         Ok(())
-    }
-
-    /// One past the last sample index pixel `i` (row-major over the region) has taken.
-    #[must_use]
-    pub fn pixel_samples(&self, i: usize) -> u32 {
-        self.taken.as_ref().map_or(self.done, |t| t[i])
     }
 
     /// Takes samples `done..end` of every pixel in one sweep over the tiles.
@@ -490,7 +464,7 @@ impl<'a> RenderJob<'a> {
             self.parts = Some(new_parts(region.width, region.height));
         }
         self.done = self.first;
-        self.taken = None;
+        self.rounds_end = None;
         self.extra = 0;
         self.next_pass = self.first;
         self.stats = RenderStats {
@@ -589,8 +563,8 @@ impl<'a> RenderJob<'a> {
 pub struct JobState {
     /// The film's sums, squares and counts.
     pub sums: PixelSums,
-    /// One past the last sample index each pixel has taken, row-major over the region.
-    pub taken: Vec<u32>,
+    /// The first sample index no pixel has taken (where the next round starts).
+    pub next_index: u32,
     /// One past the last pass a progressive integrator began (for its summary).
     pub next_pass: u32,
 }

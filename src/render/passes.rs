@@ -167,9 +167,10 @@ fn save_checkpoint(job: &RenderJob<'_>, cp: &CheckpointPlan<'_>) -> bool {
 }
 
 /// [`render_in_passes`] for an adaptive render: round after round of
-/// [`AdaptivePlan::counts`], each decided from the film after the previous one (never from
-/// the time), so the image does not depend on when checkpoints are saved; a budget stops it
-/// between rounds, before a round its measured time per sample says would overrun.
+/// [`AdaptivePlan::round`] and [`AdaptivePlan::counts`], each decided from the film after the
+/// previous one (never from the time), so the image does not depend on when checkpoints are
+/// saved; a budget stops it between rounds, before a round its measured time per sample says
+/// would overrun.
 fn adaptive_rounds(
     mut job: RenderJob<'_>,
     plan: &PassPlan<'_>,
@@ -183,7 +184,8 @@ fn adaptive_rounds(
     let mut error = None;
     let pixels = (job.sums().width as usize * job.sums().height as usize).max(1);
     loop {
-        let counts = adaptive.counts(job.sums(), |i| job.pixel_samples(i), spp);
+        let indices = adaptive.round(job.next_index(), spp);
+        let counts = adaptive.counts(job.sums(), &indices);
         let round: u64 = counts.iter().map(|&c| u64::from(c)).sum();
         if round == 0 {
             break;
@@ -198,7 +200,7 @@ fn adaptive_rounds(
             }
         }
         let t = Instant::now();
-        if let Err(e) = job.render_counts(&counts) {
+        if let Err(e) = job.render_round(indices, &counts) {
             return PassesOutcome {
                 result: Err(e),
                 checkpoint_spp: saved,
