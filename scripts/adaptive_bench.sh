@@ -25,7 +25,7 @@ tau=${TAU:-0.02}
 ref_spp=${REF_SPP:-1024}
 w=${size%x*}
 h=${size#*x}
-field() { sed -n "s/.*$1 \([0-9.e+-]*\).*/\1/p" | head -1; }
+field() { sed -n "s/.*$1 \([0-9.e+-]*\).*/\1/p" | sed -n 1p; }
 echo "load before: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo
 echo "| scene | size | adaptive spp (mean) | uniform spp | relMSE adaptive | relMSE uniform | ratio | RMSE adaptive | RMSE uniform | mean bias adaptive | mean bias uniform | photon passes adaptive / uniform |"
@@ -41,15 +41,15 @@ run() {
   spp=$(awk -v m="$mean" 'BEGIN { s = int(m); if (s < m) s++; print s }')
   ulog=$("$caustic" render "$scene" "$@" --threads 2 --spp "$spp" -o "$u" 2>&1)
   echo "$ulog" >"$out/$name.uniform.log"
-  ac=$("$caustic" compare "$a" "$ref" | head -1)
-  uc=$("$caustic" compare "$u" "$ref" | head -1)
+  ac=$("$caustic" compare "$a" "$ref" | sed -n 1p)
+  uc=$("$caustic" compare "$u" "$ref" | sed -n 1p)
   local ar ur
   ar=$(echo "$ac" | field relMSE)
   ur=$(echo "$uc" | field relMSE)
   local ap up
   ap=$(echo "$alog" | sed -n 's/^photons: \([0-9]*\) passes.*/\1/p')
   up=$(echo "$ulog" | sed -n 's/^photons: \([0-9]*\) passes.*/\1/p')
-  echo "| $name | $(echo "$ulog" | sed -n 's/.*: \([0-9]*×[0-9]*\), .*/\1/p' | head -1) | $mean | $spp | $ar | $ur | $(awk -v a="$ar" -v u="$ur" 'BEGIN { printf "%.3f", a / u }') | $(echo "$ac" | field rmse) | $(echo "$uc" | field rmse) | $(echo "$ac" | sed -n 's/.*mean bias \([0-9.e+-]*\).*/\1/p') | $(echo "$uc" | sed -n 's/.*mean bias \([0-9.e+-]*\).*/\1/p') | ${ap:--} / ${up:--} |"
+  echo "| $name | $(echo "$ulog" | sed -n 's/.*: \([0-9]*×[0-9]*\), .*/\1/p' | sed -n 1p) | $mean | $spp | $ar | $ur | $(awk -v a="$ar" -v u="$ur" 'BEGIN { printf "%.3f", a / u }') | $(echo "$ac" | field rmse) | $(echo "$uc" | field rmse) | $(echo "$ac" | sed -n 's/.*mean bias \([0-9.e+-]*\).*/\1/p') | $(echo "$uc" | sed -n 's/.*mean bias \([0-9.e+-]*\).*/\1/p') | ${ap:--} / ${up:--} |"
 }
 run cbox_caustic ../shared/bench/cbox_caustic.ron ../shared/bench/mitsuba/cbox_caustic.ref.exr
 for f in benches/scenes/user/*.ron; do
