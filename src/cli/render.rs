@@ -120,6 +120,11 @@ pub struct RenderArgs {
     /// `--spp`, if given, still stop it first. The summary states the estimate reached.
     #[arg(long, value_name = "X", value_parser = parse_positive)]
     pub(super) target_error: Option<f32>,
+    /// Adaptive sampling (`render.adaptive`): after 8 uniform samples per pixel each pixel takes
+    /// more only while its estimated error is above `--target-error` (unset: 0.002); `--spp`
+    /// caps every pixel. Not with `--shard`, `--samples`, `--denoise` or a `.part` output.
+    #[arg(long)]
+    pub(super) adaptive: bool,
 }
 
 /// A positive finite number (`--exposure`, `--target-error`).
@@ -337,6 +342,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     if let Some(x) = args.target_error {
         overrides.sets.push(format!("render.target_error={x:?}"));
     }
+    if args.adaptive {
+        overrides.sets.push("render.adaptive=true".into());
+    }
     // A budget or a target decides when to stop; the sample count only caps it.
     if (args.time.is_some() || args.target_error.is_some())
         && overrides.render.samples_per_pixel.is_none()
@@ -349,6 +357,21 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         // The scene's own `render.target_error`: compiled again with the cap (rare).
         overrides.render.samples_per_pixel = Some(BUDGET_SPP_CAP);
         prepared = prepare(&args.scene.scene, &overrides)?;
+    }
+    let adaptive = prepared.scene.render.with_defaults().adaptive == Some(true);
+    if adaptive
+        && let Some(why) = [
+            (is_part(&output), "a `.part` output"),
+            (args.samples.is_some(), "--samples"),
+            (args.shard.is_some(), "--shard"),
+            (args.denoise, "--denoise"),
+        ]
+        .iter()
+        .find_map(|&(refused, name)| refused.then_some(name))
+    {
+        return Err(Error::Usage(format!(
+            "--adaptive (render.adaptive) cannot be used with {why}: an adaptive render decides each pixel's samples from all its earlier ones, so it cannot be split into sample ranges and merged; render without --adaptive, or render the whole image adaptively"
+        )));
     }
     if !args.quiet {
         print_warnings(&prepared.warnings);
@@ -443,6 +466,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         time_budget: args.time,
         progress: terminal,
         target_error: target_error.map(f64::from),
+        adaptive: adaptive.then(|| {
+            caustic::render::adaptive::AdaptivePlan::new(target_error.map(f64::from), spp)
+        }),
     };
     let first_half = if args.denoise {
         match job.render_pass(split - taken.start) {
@@ -618,6 +644,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             reached_spp = reached_spp(&out),
         );
     }
+    if adaptive && !args.quiet {
+        eprintln!("{}", adaptive_summary(&out.sums, target_error));
+    }
     if let Some(auto) = &auto
         && !args.quiet
     {
@@ -673,6 +702,26 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         )?;
     }
     Ok(())
+}
+
+/// What an adaptive render spent: samples per pixel (mean, fewest, most) and the estimated
+/// relMSE of the image and of its worst 1 % of pixels.
+fn adaptive_summary(sums: &caustic::render::PixelSums, target: Option<f32>) -> String {
+    use caustic::render::adaptive::AdaptivePlan;
+    use caustic::render::error_estimate::ErrorEstimate;
+    let n = sums.width as usize * sums.height as usize;
+    let counts = (0..n).map(|i| sums.count(i));
+    let total: u64 = counts.clone().map(u64::from).sum();
+    let e = ErrorEstimate::of_sums(sums);
+    format!(
+        "adaptive: {:.2} samples per pixel on average ({} to {}), each pixel until its estimated relMSE is at most {}; estimated relMSE {:.5}, worst 1 % of pixels {:.4}",
+        total as f64 / n.max(1) as f64,
+        counts.clone().min().unwrap_or(0),
+        counts.max().unwrap_or(0),
+        AdaptivePlan::new(target.map(f64::from), 1).pixel_target as f32,
+        e.image,
+        e.worst
+    )
 }
 
 /// Samples per pixel a render output holds.

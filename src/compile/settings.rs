@@ -99,8 +99,10 @@ pub fn resolve(
         sampler,
         diffuse_depth,
         texture_filter,
-        // Read by the render loop from the stated settings (it stops passes, not pixels).
+        // Read by the render loop from the stated settings (they decide which samples are
+        // taken, not what a sample computes).
         target_error: _,
+        adaptive: _,
     } = r;
     RenderParams {
         width,

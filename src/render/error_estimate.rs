@@ -76,11 +76,18 @@ impl ErrorEstimate {
     pub fn reached(&self, target: f64) -> bool {
         self.min_samples >= MIN_SAMPLES && self.image <= target
     }
+
+    /// Whether the estimate is trusted and both the image's and its worst 1 %'s are at most
+    /// `target` (what an adaptive render stops on: each pixel aims at the target itself).
+    #[must_use]
+    pub fn reached_everywhere(&self, target: f64) -> bool {
+        self.reached(target) && self.worst <= target
+    }
 }
 
 /// `(s² / n) / (m² + ε)` averaged over the channels of pixel `i`; a pixel with fewer than two
 /// samples counts as unconverged (1).
-fn pixel_rel_mse(sums: &PixelSums, i: usize) -> f64 {
+pub(super) fn pixel_rel_mse(sums: &PixelSums, i: usize) -> f64 {
     let n = sums.count(i);
     if n < 2 {
         return 1.0;

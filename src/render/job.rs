@@ -3,6 +3,7 @@
 //! [`super::tiles`] does each sweep), so a render can be checkpointed, cancelled, budgeted or
 //! split into farm shards without changing its bytes. [`render`] is the one-pass shortcut.
 
+use std::ops::Range;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -15,7 +16,9 @@ use super::options::{
     ProgressiveStats, Region, RenderError, RenderOptions, RenderOutput, RenderStats, check_region,
 };
 use super::pixel_sums::PixelSums;
-use super::tiles::{Sweep, TileResult, new_parts, pixel_index, render_tile, tile_grid};
+use super::tiles::{
+    SampleRanges, Sweep, TileResult, new_parts, pixel_index, render_tile, tile_grid,
+};
 use crate::integrators::Integrator;
 use crate::integrators::splat::FilmSplats;
 use crate::render_scene::RenderScene;
@@ -49,8 +52,16 @@ pub struct RenderJob<'a> {
     parts: Option<Vec<PixelSums>>,
     /// First sample index this job takes.
     first: u32,
-    /// Samples `first..done` are in `sums`.
+    /// Samples `first..done` are in `sums` (of every pixel).
     done: u32,
+    /// Once adaptive rounds ([`RenderJob::render_round`]) have begun: one past the last
+    /// sample index a round covered (the next round starts there).
+    rounds_end: Option<u32>,
+    /// Samples taken by adaptive rounds beyond `done` per pixel, summed over the pixels.
+    extra: u64,
+    /// One past the last pass (photon maps, one per sample index) a progressive integrator
+    /// has begun, for the summary's radius.
+    next_pass: u32,
     /// One past the last sample index this job takes.
     end: u32,
     stats: RenderStats,
@@ -141,6 +152,9 @@ impl<'a> RenderJob<'a> {
                 .then(|| new_parts(region.width, region.height)),
             first: range.start,
             done: range.start,
+            rounds_end: None,
+            extra: 0,
+            next_pass: range.start,
             end: range.end,
             stats: RenderStats {
                 threads,
@@ -177,6 +191,12 @@ impl<'a> RenderJob<'a> {
     /// [`RenderError::Cancelled`] when the cancel flag is raised before the pass ends; the job
     /// then still holds the image of the samples it completed before (whole sample indices).
     pub fn render_pass(&mut self, n: u32) -> Result<(), RenderError> {
+        if let Some(start) = self.rounds_end {
+            // After adaptive rounds: the next `n` sample indices of every pixel.
+            let pixels = self.region.width as usize * self.region.height as usize;
+            let end = start.saturating_add(n).min(self.end);
+            return self.render_round(start..end, &vec![n; pixels]);
+        }
         let end = self.done + n.min(self.samples_per_pixel() - self.done);
         if self.is_cancelled() {
             return Err(RenderError::Cancelled);
@@ -193,12 +213,119 @@ impl<'a> RenderJob<'a> {
         Ok(())
     }
 
+    /// An adaptive round over the sample indices `round` (starting at or after every index
+    /// taken so far, [`RenderJob::next_index`]): pixel `i` (row-major over the region) takes
+    /// the first `counts[i]` of them (all of them at most). Sample `s` of a pixel is the
+    /// sampler's sample `s` of that pixel whichever round takes it, and a progressive
+    /// integrator traces pass `s`'s photon maps for it, as in a uniform render: once, for every
+    /// pixel that takes sample `s` (see [`super::adaptive`]). The next round starts at
+    /// `round.end` whatever the counts, so the rounds do not depend on the region.
+    ///
+    /// # Errors
+    /// [`RenderError::Cancelled`] as [`RenderJob::render_pass`] (a progressive round keeps its
+    /// completed passes); [`RenderError::Counts`] when `counts` is not one per pixel;
+    /// [`RenderError::SampleRange`] when `round` overlaps the indices taken or passes the
+    /// samples per pixel.
+    pub fn render_round(&mut self, round: Range<u32>, counts: &[u32]) -> Result<(), RenderError> {
+        let n = self.region.width as usize * self.region.height as usize;
+        if counts.len() != n {
+            return Err(RenderError::Counts(counts.len(), n));
+        }
+        if round.start < self.next_index() || round.end > self.end || round.start > round.end {
+            return Err(RenderError::SampleRange(round.start, round.end, self.end));
+        }
+        if self.is_cancelled() {
+            return Err(RenderError::Cancelled);
+        }
+        let len = round.end - round.start;
+        let to: Vec<u32> = counts.iter().map(|&c| round.start + c.min(len)).collect();
+        if !self.integrator.is_progressive() {
+            let from = vec![round.start; n];
+            self.sweep_counted(&from, &to)?;
+        } else {
+            let most = to.iter().copied().max().unwrap_or(round.start);
+            for pass in round.start..most {
+                let from: Vec<u32> = to.iter().map(|&e| pass.min(e)).collect();
+                let next: Vec<u32> = to.iter().map(|&e| (pass + 1).min(e)).collect();
+                let integrator = &mut self.integrator;
+                self.pool.install(|| integrator.begin_pass(pass));
+                self.sweep_counted(&from, &next)?;
+                self.next_pass = self.next_pass.max(pass + 1);
+                // A cancel after this pass leaves the round's later passes untaken.
+                self.rounds_end = Some(pass + 1);
+            }
+        }
+        self.rounds_end = Some(round.end);
+        Ok(())
+    }
+
+    /// Takes each pixel's samples `from[i]..to[i]` in one sweep (adaptive rounds).
+    fn sweep_counted(&mut self, from: &[u32], to: &[u32]) -> Result<(), RenderError> {
+        let samples = SampleRanges::PerPixel {
+            region: self.region,
+            from,
+            to,
+        };
+        self.sweep_ranges(samples)?;
+        self.extra += from
+            .iter()
+            .zip(to)
+            .map(|(&f, &t)| u64::from(t - f))
+            .sum::<u64>();
+        Ok(())
+    }
+
+    /// The first sample index no pixel has taken yet: where the next adaptive round starts.
+    #[must_use]
+    pub fn next_index(&self) -> u32 {
+        self.rounds_end.unwrap_or(self.done)
+    }
+
+    /// What an adaptive render has taken so far, to be continued by another job
+    /// ([`RenderJob::resume`]): the same bytes as if it had never stopped.
+    #[must_use]
+    pub fn state(&self) -> JobState {
+        JobState {
+            sums: self.sums.clone(),
+            next_index: self.next_index(),
+            next_pass: self.next_pass.max(self.done),
+        }
+    }
+
+    /// Continues the render `state` was taken from ([`RenderJob::state`]) in this new job of the
+    /// same scene, options and region (the light-path layers start empty).
+    ///
+    /// # Errors
+    /// [`RenderError::Counts`] when `state` is not of this job's region's size.
+    pub fn resume(&mut self, state: JobState) -> Result<(), RenderError> {
+        let n = self.region.width as usize * self.region.height as usize;
+        let size = state.sums.width as usize * state.sums.height as usize;
+        if (state.sums.width, state.sums.height) != (self.region.width, self.region.height) {
+            return Err(RenderError::Counts(size, n));
+        }
+        self.extra = (0..n).map(|i| u64::from(state.sums.count(i))).sum();
+        self.sums = state.sums;
+        self.rounds_end = Some(state.next_index);
+        self.next_pass = state.next_pass;
+        Ok(())
+    }
+
     /// Takes samples `done..end` of every pixel in one sweep over the tiles.
     fn sweep(&mut self, end: u32) -> Result<(), RenderError> {
         if end == self.done {
             return Ok(());
         }
-        let (region, samples) = (self.region, self.done..end);
+        self.sweep_ranges(SampleRanges::All(self.done..end))?;
+        self.done = end;
+        if self.next_pass < end {
+            self.next_pass = end;
+        }
+        Ok(())
+    }
+
+    /// Takes `samples` of every pixel in one sweep over the tiles.
+    fn sweep_ranges(&mut self, samples: SampleRanges<'_>) -> Result<(), RenderError> {
+        let region = self.region;
         let sweep = Sweep {
             scene: self.scene,
             integrator: &self.integrator,
@@ -210,7 +337,7 @@ impl<'a> RenderJob<'a> {
         let results: Option<Vec<TileResult>> = self.pool.install(|| {
             self.tiles
                 .par_iter()
-                .map(|t| render_tile(&sweep, t, samples.clone()))
+                .map(|t| render_tile(&sweep, t, &samples))
                 .collect()
         });
         let Some(results) = results else {
@@ -235,7 +362,6 @@ impl<'a> RenderJob<'a> {
             // Exact fixed-point sums: the order of splats and tiles never shows in the bytes.
             merge_splats(splats, &mut self.sums, self.parts.as_mut());
         }
-        self.done = end;
         Ok(())
     }
 
@@ -338,6 +464,9 @@ impl<'a> RenderJob<'a> {
             self.parts = Some(new_parts(region.width, region.height));
         }
         self.done = self.first;
+        self.rounds_end = None;
+        self.extra = 0;
+        self.next_pass = self.first;
         self.stats = RenderStats {
             threads: self.stats.threads,
             ..Default::default()
@@ -398,11 +527,12 @@ impl<'a> RenderJob<'a> {
         let mut stats = self.stats;
         stats.samples = u64::from(self.region.width)
             * u64::from(self.region.height)
-            * u64::from(self.done - self.first);
+            * u64::from(self.done - self.first)
+            + self.extra;
         stats.elapsed = self.start.elapsed();
         stats.progressive = self.integrator.progressive().map(|p| ProgressiveStats {
             totals: p.totals(),
-            last_shrink: p.shrink(self.done.saturating_sub(1)),
+            last_shrink: p.shrink(self.next_pass.max(self.done).saturating_sub(1)),
             caustic_radius: p
                 .fields()
                 .and_then(|f| f.caustic.as_ref())
@@ -426,6 +556,17 @@ impl<'a> RenderJob<'a> {
             .as_deref()
             .is_some_and(|c| c.load(Ordering::Relaxed))
     }
+}
+
+/// The state of an adaptive render between rounds ([`RenderJob::state`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct JobState {
+    /// The film's sums, squares and counts.
+    pub sums: PixelSums,
+    /// The first sample index no pixel has taken (where the next round starts).
+    pub next_index: u32,
+    /// One past the last pass a progressive integrator began (for its summary).
+    pub next_pass: u32,
 }
 
 /// One region's part of a [`RenderJob::render_regions`] call: what the job holds per region.

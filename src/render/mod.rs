@@ -1,5 +1,6 @@
 //! Rendering: the render job and its tile loop, the film and its mergeable sums, image output.
 
+pub mod adaptive;
 pub mod auto_exposure;
 pub mod denoised;
 pub mod error_estimate;
@@ -21,7 +22,7 @@ pub mod wide_sum;
 
 pub use features::{FeatureSample, Features};
 pub use film::Film;
-pub use job::{RenderJob, render};
+pub use job::{JobState, RenderJob, render};
 pub use layer_pictures::{
     NotAPicture, layer_path, picture_layers, write_with_extras, write_with_layers,
 };

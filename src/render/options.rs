@@ -114,6 +114,9 @@ pub enum RenderError {
     /// The sample range is empty-ended or beyond the scene's samples per pixel.
     #[error("sample range {0}..{1} is not within the scene's {2} samples per pixel")]
     SampleRange(u32, u32, u32),
+    /// An adaptive round's sample counts are not one per pixel of the region.
+    #[error("an adaptive round gave {0} sample counts for a region of {1} pixels")]
+    Counts(usize, usize),
     /// The cancel flag of [`RenderOptions`] was raised; no image is returned.
     #[error("the render was cancelled")]
     Cancelled,

@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use super::adaptive::AdaptivePlan;
 use super::auto_exposure::resolve;
 use super::error_estimate::ErrorEstimate;
 use super::output::write_image;
@@ -42,6 +43,11 @@ pub struct PassPlan<'a> {
     /// Stop once the estimated relMSE of the image ([`ErrorEstimate`]) is at most this
     /// (`--target-error`), or when the time budget or the samples per pixel run out first.
     pub target_error: Option<f64>,
+    /// Adaptive sampling ([`super::adaptive`]): rounds in which each pixel takes samples while
+    /// its own estimated error is above the plan's threshold. The render then ends when no
+    /// pixel needs more (or at the samples per pixel, the budget, or — with a target error —
+    /// once both the image's and its worst 1 %'s estimates reach it).
+    pub adaptive: Option<AdaptivePlan>,
 }
 
 /// The result of a render in passes.
@@ -65,6 +71,9 @@ const MIN_PASS: Duration = Duration::from_millis(500);
 /// next sample per pixel would overrun the budget.
 #[must_use]
 pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOutcome {
+    if let Some(adaptive) = plan.adaptive {
+        return adaptive_rounds(job, plan, adaptive);
+    }
     let spp = job.samples_per_pixel();
     let first = job.samples_done();
     let start = Instant::now();
@@ -115,12 +124,8 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
         }
         if let Some(cp) = &plan.checkpoint {
             if last_save.elapsed() >= cp.every {
-                let snapshot = job.snapshot();
-                let stated = (!cp.auto_exposure).then_some(cp.display.exposure);
-                let (display, _) = resolve(&snapshot, stated, cp.display.tonemap);
-                match write_image(&snapshot, cp.path, display) {
-                    Ok(()) => saved = Some(done),
-                    Err(e) => eprintln!("warning: checkpoint not saved: {e}"),
+                if save_checkpoint(&job, cp) {
+                    saved = Some(done);
                 }
                 last_save = Instant::now();
             }
@@ -139,6 +144,107 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
     }
     if let Some(b) = bar {
         b.finish_and_clear();
+    }
+    PassesOutcome {
+        result: Ok(job.into_output()),
+        checkpoint_spp: saved,
+        error,
+    }
+}
+
+/// Writes the image so far to the checkpoint; false (with a warning) when it cannot.
+fn save_checkpoint(job: &RenderJob<'_>, cp: &CheckpointPlan<'_>) -> bool {
+    let snapshot = job.snapshot();
+    let stated = (!cp.auto_exposure).then_some(cp.display.exposure);
+    let (display, _) = resolve(&snapshot, stated, cp.display.tonemap);
+    match write_image(&snapshot, cp.path, display) {
+        Ok(()) => true,
+        Err(e) => {
+            eprintln!("warning: checkpoint not saved: {e}");
+            false
+        }
+    }
+}
+
+/// [`render_in_passes`] for an adaptive render: round after round of
+/// [`AdaptivePlan::round`] and [`AdaptivePlan::counts`], each decided from the film after the
+/// previous one (never from the time), so the image does not depend on when checkpoints are
+/// saved; a budget stops it between rounds, before a round its measured time per sample says
+/// would overrun.
+fn adaptive_rounds(
+    mut job: RenderJob<'_>,
+    plan: &PassPlan<'_>,
+    adaptive: AdaptivePlan,
+) -> PassesOutcome {
+    let spp = job.samples_per_pixel();
+    let start = Instant::now();
+    let bar = budget_bar(plan);
+    let (mut saved, mut last_save) = (None, Instant::now());
+    let (mut render_time, mut taken) = (Duration::ZERO, 0u64);
+    let mut error = None;
+    let pixels = (job.sums().width as usize * job.sums().height as usize).max(1);
+    loop {
+        let indices = adaptive.round(job.next_index(), spp);
+        let counts = adaptive.counts(job.sums(), &indices);
+        let round: u64 = counts.iter().map(|&c| u64::from(c)).sum();
+        if round == 0 {
+            break;
+        }
+        if let Some(budget) = plan.time_budget
+            && taken > 0
+        {
+            let per_sample = render_time.as_secs_f64() / taken as f64;
+            let left = budget.saturating_sub(start.elapsed()).as_secs_f64();
+            if per_sample * round as f64 > left {
+                break;
+            }
+        }
+        let t = Instant::now();
+        if let Err(e) = job.render_round(indices, &counts) {
+            return PassesOutcome {
+                result: Err(e),
+                checkpoint_spp: saved,
+                error: None,
+            };
+        }
+        render_time += t.elapsed();
+        taken += round;
+        let mean_spp = taken as f64 / pixels as f64;
+        let estimate = plan.target_error.map(|target| {
+            let e = ErrorEstimate::of_sums(job.sums());
+            (e, e.reached_everywhere(target))
+        });
+        error = estimate;
+        if let (Some(b), Some(budget)) = (&bar, plan.time_budget) {
+            b.set_position(start.elapsed().min(budget).as_millis() as u64);
+            b.set_message(match estimate {
+                Some((e, _)) => format!(
+                    "{mean_spp:.1} spp (mean), estimated relMSE {:.4}, worst 1 % {:.4}",
+                    e.image, e.worst
+                ),
+                None => format!("{mean_spp:.1} spp (mean)"),
+            });
+        }
+        if estimate.is_some_and(|(_, reached)| reached) {
+            break;
+        }
+        if let Some(cp) = &plan.checkpoint
+            && last_save.elapsed() >= cp.every
+        {
+            if save_checkpoint(&job, cp) {
+                saved = Some(mean_spp.round() as u32);
+            }
+            last_save = Instant::now();
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if error.is_none()
+        && let Some(target) = plan.target_error
+    {
+        let e = ErrorEstimate::of_sums(job.sums());
+        error = Some((e, e.reached_everywhere(target)));
     }
     PassesOutcome {
         result: Ok(job.into_output()),

@@ -77,12 +77,41 @@ pub(super) struct Sweep<'s, 'a> {
     pub(super) progress: &'s ProgressBar,
 }
 
+/// Which sample indices a sweep takes of each pixel.
+#[derive(Debug, Clone)]
+pub(super) enum SampleRanges<'s> {
+    /// The same indices of every pixel (uniform passes).
+    All(Range<u32>),
+    /// Pixel `i` of `region` (row-major) takes `from[i]..to[i]` (adaptive rounds).
+    PerPixel {
+        /// The job's region, which `from` and `to` cover.
+        region: Region,
+        /// First index per pixel.
+        from: &'s [u32],
+        /// One past the last index per pixel.
+        to: &'s [u32],
+    },
+}
+
+impl SampleRanges<'_> {
+    /// The indices pixel `i` (row-major) of `tile` takes.
+    fn of(&self, tile: &Region, i: usize) -> Range<u32> {
+        match self {
+            SampleRanges::All(r) => r.clone(),
+            SampleRanges::PerPixel { region, from, to } => {
+                let at = pixel_index(*region, tile, i);
+                from[at]..to[at]
+            }
+        }
+    }
+}
+
 /// Takes samples `samples` of each pixel of `tile`. `None` when `sweep.cancel` is raised: it
 /// is checked before each pixel, never per ray.
 pub(super) fn render_tile(
     sweep: &Sweep<'_, '_>,
     tile: &Region,
-    samples: Range<u32>,
+    samples: &SampleRanges<'_>,
 ) -> Option<TileResult> {
     let Sweep {
         scene,
@@ -101,6 +130,7 @@ pub(super) fn render_tile(
     let mut nan = 0u64;
     let mut out = PixelSums::new(tile.width, tile.height);
     let mut parts = keep_parts.then(|| new_parts(tile.width, tile.height));
+    let mut taken = 0u64;
     for i in 0..(tile.width * tile.height) as usize {
         if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
             return None;
@@ -109,7 +139,9 @@ pub(super) fn render_tile(
             tile.x + i as u32 % tile.width,
             tile.y + i as u32 / tile.width,
         );
-        for s in samples.clone() {
+        let range = samples.of(tile, i);
+        taken += u64::from(range.end.saturating_sub(range.start));
+        for s in range {
             let ray = camera_sample(scene, &mut sampler, x, y, s);
             let r = integrator.li_parts(
                 ray,
@@ -128,7 +160,9 @@ pub(super) fn render_tile(
             }
         }
     }
-    progress.inc(u64::from(samples.end - samples.start));
+    // Tile-samples: the samples per pixel of a uniform sweep, the mean over the tile's pixels
+    // of an adaptive one.
+    progress.inc(taken / u64::from(tile.width * tile.height).max(1));
     Some(TileResult {
         sums: out,
         parts,

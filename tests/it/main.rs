@@ -2,6 +2,7 @@
 
 mod absorption;
 mod absorption_integrators;
+mod adaptive;
 mod architecture;
 mod assets;
 mod auto_exposure;

@@ -100,6 +100,11 @@ pub struct RenderSettings {
     /// `--time` and `--spp` still stop it first (without `--spp` the scene's
     /// `samples_per_pixel` gives way to the target). Unset: render every sample.
     pub target_error: Option<f32>,
+    /// Adaptive sampling (docs/convergence.md; default false): after a warm-up of uniform
+    /// samples, each pixel takes more only while its own estimated relative error is above
+    /// `target_error` (unset: 0.002); `samples_per_pixel` caps every pixel. Not with farm shards,
+    /// sample ranges or `.part` outputs.
+    pub adaptive: Option<bool>,
 }
 
 layered!(RenderSettings {
@@ -118,6 +123,7 @@ layered!(RenderSettings {
     diffuse_depth,
     texture_filter,
     target_error,
+    adaptive,
 });
 
 impl RenderSettings {
@@ -140,6 +146,7 @@ impl RenderSettings {
         diffuse_depth: None,
         texture_filter: Some(TextureFilter::Anisotropic),
         target_error: None,
+        adaptive: Some(false),
     };
 
     /// This layer over the defaults: every field that has a default is `Some`.
