@@ -214,8 +214,8 @@ fn adaptive_sampling_lowers_the_error_at_equal_samples() {
     )
     .expect("uniform");
     let mut overrides = common::small(w, h, 1024);
-    overrides.seed = Some(7);
-    overrides.integrator = Some(caustic::settings::IntegratorKind::Path);
+    overrides.render.seed = Some(7);
+    overrides.render.integrator = Some(caustic::settings::IntegratorKind::Path);
     let reference = render(
         &prepare(&common::root().join("scenes/cornell.ron"), &overrides)
             .expect("reference prepares")

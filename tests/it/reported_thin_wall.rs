@@ -14,10 +14,8 @@ use crate::common::{render_file, root};
 /// (100 spp; 100 passes of 20 000 global photons for the progressive ones).
 fn brightest(integrator: IntegratorKind) -> f32 {
     let path = root().join("tests/reported/thin-wall-photon-leak/two_rooms.ron");
-    let overrides = SceneOverrides {
-        integrator: Some(integrator),
-        ..SceneOverrides::default()
-    };
+    let mut overrides = SceneOverrides::default();
+    overrides.render.integrator = Some(integrator);
     let (film, _) = render_file(&path, &overrides, &RenderOptions::default());
     let mut max = 0.0f32;
     for y in 0..film.height {

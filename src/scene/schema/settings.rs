@@ -335,9 +335,10 @@ mod tests {
             diffuse_depth: Some(1),
             texture_filter: Some(TextureFilter::Anisotropic),
             target_error: Some(0.1),
+            adaptive: Some(true),
         }
         .stated();
-        assert_eq!(render_all.len(), 15);
+        assert_eq!(render_all.len(), 16);
         assert_eq!(
             unset(RenderSettings::DEFAULTS.stated(), &render_all),
             [
