@@ -451,7 +451,7 @@ impl<'a> PathTracer<'a> {
                         ("global", global, LightPath::Indirect),
                     ] {
                         let Some(map) = map else { continue };
-                        let e = map.estimate(sp.p, wo, &fr, bsdf, &scene.geometry);
+                        let e = map.estimate(sp.p, wo, &fr, bsdf);
                         cx.counters.photon_estimates += 1;
                         l.add(kind, beta * e.radiance);
                         if O::ACTIVE {

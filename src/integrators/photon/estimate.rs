@@ -19,15 +19,7 @@
 //!   photons;
 //! - photons from the other side of the surface or from another surface are rejected: their
 //!   stored normal must face the query's normal (`nₚ·ng > 0.1`) and their direction must arrive
-//!   from the side of `ωo` (`ωₚ·ng > 0`), the tests of Mitsuba 0.6's photon map (hard case 12);
-//! - photons a surface hides from the query point are rejected ([`visibility`]): a wall thinner
-//!   than the disc (a single quad) on a floor that runs under it leaves the far side's photons
-//!   in the query's plane with its normal, where the tests above accept them (issue 47,
-//!   thin-wall-photon-leak: a dark room read up to 0.1). A shadow ray to each photon is traced
-//!   only where a surface rises above the query's tangent plane within reach (one BVH query
-//!   per estimate says so): on open floors and convex surfaces an estimate traces no ray and
-//!   reads exactly what it read without the test; near walls, corners and thin walls every
-//!   accepted photon is tested.
+//!   from the side of `ωo` (`ωₚ·ng > 0`), the tests of Mitsuba 0.6's photon map (hard case 12).
 //!
 //! Progressive passes ([`PhotonMap::set_shrink`], `integrators::photon::passes`) read
 //! only the photons strictly inside `s·r`, `s` ∈ (0, 1], over the area `π (s r)² c`. Given
@@ -49,13 +41,8 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::radius_field::RadiusField;
-use crate::render_scene::Geometry;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 use crate::spatial::{HasPosition, HashGrid, KdTree, KnnHeap, Photon};
-
-pub mod visibility;
-
-use visibility::Visibility;
 
 /// The radius given to an estimate whose k nearest photons all lie at one point (a zero radius),
 /// as a fraction of the map's largest radius.
@@ -167,11 +154,6 @@ pub struct Estimate {
     pub radius: f32,
     /// True when the largest radius cut the search short (fewer than k photons found).
     pub cut: bool,
-    /// Visibility rays traced ([`visibility`]): 0 unless a surface rises above the query's
-    /// tangent plane within reach of the disc, or a photon lies under it.
-    pub rays: u32,
-    /// Photons the normal and side tests accepted that a surface hid from the query point.
-    pub hidden: u32,
 }
 
 thread_local! {
@@ -315,45 +297,29 @@ impl PhotonMap {
     }
 
     /// Radiance leaving `p` towards `wo` through the non-delta part of `bsdf` in frame `fr` (as
-    /// the camera side sees it), estimated from the nearest photons that `geometry` does not
-    /// hide from `p`. See the module docs.
+    /// the camera side sees it), estimated from the nearest photons. See the module docs.
     #[must_use]
-    pub fn estimate(
-        &self,
-        p: Vec3,
-        wo: Vec3,
-        fr: &ShadingFrame,
-        bsdf: &Bsdf,
-        geometry: &Geometry,
-    ) -> Estimate {
+    pub fn estimate(&self, p: Vec3, wo: Vec3, fr: &ShadingFrame, bsdf: &Bsdf) -> Estimate {
         let at = bsdf.at(wo, fr);
-        self.gather(p, fr.ng, geometry, |power, wi, cos_p| {
+        self.gather(p, fr.ng, |power, wi, cos_p| {
             let cos_s = wi.dot(fr.ns).max(0.0);
             at.eval(wi, TransportMode::Radiance) * power * (cos_s / cos_p)
         })
     }
 
     /// Irradiance (W/m² per channel) arriving at `p` on the side of unit normal `n`, from the
-    /// nearest photons that `geometry` does not hide from `p` (the estimate's `radiance` field
-    /// holds it).
+    /// nearest photons (the estimate's `radiance` field holds it).
     #[must_use]
-    pub fn irradiance(&self, p: Vec3, n: Vec3, geometry: &Geometry) -> Estimate {
-        self.gather(p, n, geometry, |power, _, _| power)
+    pub fn irradiance(&self, p: Vec3, n: Vec3) -> Estimate {
+        self.gather(p, n, |power, _, _| power)
     }
 
     /// The density estimate at `p` (surface normal `ng`, on the query's side): the kernel-
     /// weighted sum of `value(photon, wi, cos θₚ)` over the accepted photons (`cos θₚ` the
-    /// landing cosine, [`accept`]; those `geometry` hides from `p` left out), over the disc's
-    /// normalised area.
-    fn gather(
-        &self,
-        p: Vec3,
-        ng: Vec3,
-        geometry: &Geometry,
-        value: impl Fn(Vec3, Vec3, f32) -> Vec3,
-    ) -> Estimate {
+    /// landing cosine, [`accept`]), over the disc's normalised area.
+    fn gather(&self, p: Vec3, ng: Vec3, value: impl Fn(Vec3, Vec3, f32) -> Vec3) -> Estimate {
         if let Some(pass) = &self.pass {
-            return self.gather_within(pass, p, ng, geometry, value);
+            return self.gather_within(pass, p, ng, value);
         }
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
@@ -383,20 +349,15 @@ impl PhotonMap {
             let r2 = r2 * self.shrink * self.shrink;
             let r = r2.sqrt();
             let photons = self.tree.items();
-            let mut sight = Visibility::new(geometry, p, ng, r);
             let mut sum = Vec3::ZERO;
             for n in heap.iter() {
                 if Some(n.index) == skip || (self.shrink < 1.0 && n.dist2 >= r2) {
                     continue;
                 }
                 let ph = &photons[n.index as usize];
-                let Some((wi, cos_g)) = accept(ph, ng) else {
-                    continue;
-                };
-                if sight.hides(ph.position(), ph.normal()) {
-                    continue;
+                if let Some((wi, cos_g)) = accept(ph, ng) {
+                    sum += value(ph.power(), wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r);
                 }
-                sum += value(ph.power(), wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r);
             }
             let area = std::f32::consts::PI * r2 * self.kernel.normalisation();
             Estimate {
@@ -404,70 +365,50 @@ impl PhotonMap {
                 found,
                 radius: r,
                 cut,
-                rays: sight.rays,
-                hidden: sight.hidden,
             }
         })
     }
 }
 
 impl PhotonMap {
-    /// A progressive pass's estimate at `p`: every accepted photon within `r = shrink · R(p)`
-    /// that `geometry` does not hide from `p`, kernel-weighted, over the disc's normalised area `π r² c`.
+    /// A progressive pass's estimate at `p`: every accepted photon within `r = shrink · R(p)`,
+    /// kernel-weighted, over the disc's normalised area `π r² c`.
     #[inline]
     fn gather_within(
         &self,
         pass: &PassLookup,
         p: Vec3,
         ng: Vec3,
-        geometry: &Geometry,
         value: impl Fn(Vec3, Vec3, f32) -> Vec3,
     ) -> Estimate {
         let r = self.shrink * pass.field.radius(p);
+        let q = p.to_array();
         let mut sum = Vec3::ZERO;
         let mut found = 0;
-        let mut sight = Visibility::new(geometry, p, ng, r);
-        self.visit_within(pass, p, r, |ph, dist2| {
+        let mut add = |ph: &Landing, dist2: f32| {
             found += 1;
-            if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, ng)
-                && !sight.hides(Vec3::from_array(ph.position), ph.normal)
-            {
+            if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, ng) {
                 sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), r);
             }
-        });
+        };
+        // The finest grid whose cells are at least the disc's diameter (at most 8 cells to
+        // visit); a disc wider than the widest grid's cells is found through the kd-tree. Both
+        // find exactly the photons within r.
+        if let Some(grid) = pass.grids.iter().find(|g| g.cell_size() >= 2.0 * r) {
+            let photons = grid.items();
+            grid.within(q, r, |n| add(&photons[n.index as usize], n.dist2));
+        } else {
+            let photons = self.tree.items();
+            self.tree.within(q, r * r, |n| {
+                add(&Landing::from(&photons[n.index as usize]), n.dist2);
+            });
+        }
         let area = std::f32::consts::PI * r * r * self.kernel.normalisation();
         Estimate {
             radiance: if found > 0 { sum / area } else { Vec3::ZERO },
             found,
             radius: r,
             cut: false,
-            rays: sight.rays,
-            hidden: sight.hidden,
-        }
-    }
-
-    /// Calls `visit(photon, squared distance)` for every photon of the pass within `r` of `p`,
-    /// in a fixed order.
-    #[inline]
-    fn visit_within(
-        &self,
-        pass: &PassLookup,
-        p: Vec3,
-        r: f32,
-        mut visit: impl FnMut(&Landing, f32),
-    ) {
-        let q = p.to_array();
-        // The finest grid whose cells are at least the disc's diameter (at most 8 cells to
-        // visit); a disc wider than the widest grid's cells is found through the kd-tree. Both
-        // find exactly the photons within r.
-        if let Some(grid) = pass.grids.iter().find(|g| g.cell_size() >= 2.0 * r) {
-            let photons = grid.items();
-            grid.within(q, r, |n| visit(&photons[n.index as usize], n.dist2));
-        } else {
-            let photons = self.tree.items();
-            self.tree.within(q, r * r, |n| {
-                visit(&Landing::from(&photons[n.index as usize]), n.dist2);
-            });
         }
     }
 }
@@ -497,10 +438,7 @@ fn landing_cosine(np: Vec3, wi: Vec3, ng: Vec3) -> Option<f32> {
 /// there is `f(ωo, n) · E`, exact for Lambert surfaces only: the photon integrator reads the
 /// maps themselves where a surface has a Phong lobe. Each point also keeps the radius of the
 /// estimate it came from, which tells final gathering when a gather ray is too short for the
-/// estimate at its end (`integrators::photon`'s short-gather rule), and whether a surface rises
-/// above its tangent plane within reach of a lookup: a lookup then reads the point only if no
-/// surface hides it ([`visibility`]), so a gather ray that lands beside a thin wall does not
-/// read the irradiance of the wall's other side.
+/// estimate at its end (`integrators::photon`'s short-gather rule).
 #[derive(Debug)]
 pub struct IrradianceCache {
     /// Points (photon records whose `power` field holds the irradiance E in W/m²) with their
@@ -511,14 +449,11 @@ pub struct IrradianceCache {
 }
 
 /// One point of an [`IrradianceCache`]: a photon record (position, normal, and the irradiance
-/// in its `power` field), the radius of the sites map's estimate there (scene units), and
-/// whether a surface rises above its tangent plane within reach of a lookup (then a lookup
-/// tests that the point is visible from the query).
+/// in its `power` field) and the radius of the sites map's estimate there (scene units).
 #[derive(Debug, Clone, Copy)]
 struct IrradiancePoint {
     photon: Photon,
     radius: f32,
-    near_surface: bool,
 }
 
 impl HasPosition for IrradiancePoint {
@@ -536,21 +471,18 @@ const LOOKUP_K: usize = 4;
 
 impl IrradianceCache {
     /// Estimates the irradiance of `maps` (summed) at every [`IRRADIANCE_STRIDE`]-th photon of
-    /// `sites` (in parallel, deterministic), leaving out photons `geometry` hides from the
-    /// point. `None` when there are no maps or sites, or when `cancel` is raised before the
-    /// points are done (the rest are skipped at once).
+    /// `sites` (in parallel, deterministic). `None` when there are no maps or sites, or when
+    /// `cancel` is raised before the points are done (the rest are skipped at once).
     #[must_use]
     pub fn build(
         sites: &PhotonMap,
         maps: &[&PhotonMap],
-        geometry: &Geometry,
         cancel: Option<&std::sync::atomic::AtomicBool>,
     ) -> Option<Self> {
         use rayon::prelude::*;
         if maps.is_empty() || sites.is_empty() {
             return None;
         }
-        let max_radius = maps.iter().map(|m| m.max_radius).fold(0.0, f32::max);
         let points: Vec<IrradiancePoint> = sites
             .photons()
             .par_iter()
@@ -560,12 +492,11 @@ impl IrradianceCache {
                     return IrradiancePoint {
                         photon: Photon::default(),
                         radius: 0.0,
-                        near_surface: false,
                     };
                 }
                 let (p, n) = (ph.position(), ph.normal());
                 let (e, radius) = maps.iter().fold((Vec3::ZERO, 0.0), |(e, r), m| {
-                    let est = m.irradiance(p, n, geometry);
+                    let est = m.irradiance(p, n);
                     let r = if std::ptr::eq(*m, sites) {
                         est.radius
                     } else {
@@ -573,17 +504,16 @@ impl IrradianceCache {
                     };
                     (e + est.radiance, r)
                 });
-                let near_surface = Visibility::new(geometry, p, n, max_radius).rising();
                 IrradiancePoint {
                     photon: Photon::new(p, -n, n, e),
                     radius,
-                    near_surface,
                 }
             })
             .collect();
         if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
             return None;
         }
+        let max_radius = maps.iter().map(|m| m.max_radius).fold(0.0, f32::max);
         let tree = KdTree::build(points).ok()?;
         Some(Self { tree, max_radius })
     }
@@ -607,22 +537,16 @@ impl IrradianceCache {
     }
 
     /// The irradiance at the nearest point on the same surface side as `ng` (normals within
-    /// ~25°) that `geometry` does not hide from `p` (tested only for points whose estimate
-    /// found another surface), or `None` when no such point lies within the largest radius.
+    /// ~25°), or `None` when no such point lies within the largest radius.
     #[must_use]
-    pub fn lookup(&self, p: Vec3, ng: Vec3, geometry: &Geometry) -> Option<Vec3> {
-        self.lookup_with_radius(p, ng, geometry).map(|(e, _)| e)
+    pub fn lookup(&self, p: Vec3, ng: Vec3) -> Option<Vec3> {
+        self.lookup_with_radius(p, ng).map(|(e, _)| e)
     }
 
     /// [`IrradianceCache::lookup`], with the radius (scene units) of the estimate the point's
     /// irradiance came from.
     #[must_use]
-    pub fn lookup_with_radius(
-        &self,
-        p: Vec3,
-        ng: Vec3,
-        geometry: &Geometry,
-    ) -> Option<(Vec3, f32)> {
+    pub fn lookup_with_radius(&self, p: Vec3, ng: Vec3) -> Option<(Vec3, f32)> {
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
             heap.set_k(LOOKUP_K);
@@ -632,19 +556,7 @@ impl IrradianceCache {
             let points = self.tree.items();
             heap.iter()
                 .map(|n| &points[n.index as usize])
-                .filter(|q| q.photon.normal().dot(ng) > 0.9)
-                .find(|q| {
-                    let mut sight = Visibility::new(
-                        geometry,
-                        q.photon.position(),
-                        q.photon.normal(),
-                        self.max_radius,
-                    );
-                    if !q.near_surface {
-                        sight.assume_flat();
-                    }
-                    !sight.hides(p, ng)
-                })
+                .find(|q| q.photon.normal().dot(ng) > 0.9)
                 .map(|q| (q.photon.power(), q.radius))
         })
     }
@@ -699,13 +611,7 @@ mod tests {
             for _ in 0..250 {
                 let (a, b) = rng.next_2d();
                 let p = Vec3::new(a - 0.5, b - 0.5, 0.0);
-                let e = map.estimate(
-                    p,
-                    Vec3::Z,
-                    &up_frame(),
-                    &white_lambert(),
-                    &Geometry::default(),
-                );
+                let e = map.estimate(p, Vec3::Z, &up_frame(), &white_lambert());
                 assert!(!e.cut);
                 sum += f64::from(e.radiance.x / exact);
                 count += 1;
@@ -737,13 +643,7 @@ mod tests {
             ng: -Vec3::Z,
             entering: false,
         };
-        let e = map.estimate(
-            Vec3::ZERO,
-            -Vec3::Z,
-            &down,
-            &white_lambert(),
-            &Geometry::default(),
-        );
+        let e = map.estimate(Vec3::ZERO, -Vec3::Z, &down, &white_lambert());
         assert_eq!(e.radiance, Vec3::ZERO);
         assert_eq!(e.found, 20);
     }
@@ -752,13 +652,7 @@ mod tests {
     fn coincident_photons_give_a_finite_estimate() {
         let photons = vec![Photon::new(Vec3::ZERO, -Vec3::Z, Vec3::Z, Vec3::ONE); 500];
         let map = PhotonMap::new(KdTree::build(photons).expect("tree"), 50, 1.0, Kernel::Box);
-        let e = map.estimate(
-            Vec3::ZERO,
-            Vec3::Z,
-            &up_frame(),
-            &white_lambert(),
-            &Geometry::default(),
-        );
+        let e = map.estimate(Vec3::ZERO, Vec3::Z, &up_frame(), &white_lambert());
         assert!(e.radiance.is_finite() && e.radiance.x > 0.0);
         assert_eq!(e.radius, MIN_RADIUS_FRACTION);
     }
@@ -787,7 +681,7 @@ mod tests {
             for _ in 0..200 {
                 let (a, b) = queries.next_2d();
                 let p = Vec3::new(side * 0.5 * (a - 0.5), side * 0.5 * (b - 0.5), 0.0);
-                let e = map.irradiance(p, Vec3::Z, &Geometry::default());
+                let e = map.irradiance(p, Vec3::Z);
                 assert!(!e.cut && e.radius < 1e-4, "{e:?}");
                 sum += f64::from(e.radiance.x / lambda);
             }
@@ -807,7 +701,6 @@ mod tests {
             Vec3::Z,
             &up_frame(),
             &white_lambert(),
-            &Geometry::default(),
         );
         assert_eq!(e.radiance, Vec3::ZERO);
         assert!(e.cut);

@@ -565,7 +565,7 @@ pub(super) fn precompute_irradiance(
         global
             .as_ref()
             .or(caustic.as_ref())
-            .and_then(|sites| IrradianceCache::build(sites, &maps, &scene.geometry, cancel))
+            .and_then(|sites| IrradianceCache::build(sites, &maps, cancel))
     } else {
         None
     };
