@@ -3,7 +3,7 @@
 use caustic::Error;
 use caustic::pipeline::prepare;
 
-use super::{SceneArgs, count, print_warnings};
+use super::{SceneArgs, count, print_warnings, quadric_counts};
 
 /// Reports every error of the scene, or a one-line summary of what it holds.
 pub fn run(args: &SceneArgs) -> Result<(), Error> {
@@ -11,11 +11,12 @@ pub fn run(args: &SceneArgs) -> Result<(), Error> {
     print_warnings(&prepared.warnings);
     let s = &prepared.stats;
     println!(
-        "{}: ok ({}, {}, {}, {}, {}; {})",
+        "{}: ok ({}, {}, {}{}, {}, {}; {})",
         args.scene.display(),
         count(s.triangles, "triangle"),
         count(s.spheres, "sphere"),
         count(s.ellipsoids, "ellipsoid"),
+        quadric_counts(s),
         count(s.materials, "material"),
         count(s.lights, "light"),
         count(prepared.warnings.len(), "warning"),

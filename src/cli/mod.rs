@@ -189,6 +189,18 @@ impl SceneArgs {
 }
 
 /// `n` and the noun, singular for 1: "1 light", "2 lights".
+/// ", N discs, M cylinders" for the analytic shapes a scene has (nothing when it has none, so
+/// the summaries of scenes without them read as before).
+fn quadric_counts(s: &caustic::compile::CompileStats) -> String {
+    let mut out = String::new();
+    for (n, noun) in [(s.discs, "disc"), (s.cylinders, "cylinder")] {
+        if n > 0 {
+            out.push_str(&format!(", {}", count(n, noun)));
+        }
+    }
+    out
+}
+
 fn count(n: usize, noun: &str) -> String {
     if n == 1 {
         format!("1 {noun}")

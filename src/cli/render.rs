@@ -731,11 +731,12 @@ fn reached_spp(out: &caustic::render::RenderOutput) -> u64 {
 
 pub(super) fn print_stats(s: &caustic::compile::CompileStats) {
     eprintln!(
-        "scene: {} ({} dropped), {}, {}, {}, {}, {}",
+        "scene: {} ({} dropped), {}, {}{}, {}, {}, {}",
         count(s.triangles, "triangle"),
         count(s.degenerate_triangles, "degenerate triangle"),
         count(s.spheres, "sphere"),
         count(s.ellipsoids, "ellipsoid"),
+        super::quadric_counts(s),
         count(s.materials, "material"),
         count(s.lights, "light"),
         count(s.meshes_loaded, "OBJ file"),

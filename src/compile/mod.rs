@@ -21,6 +21,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use crate::accel::BvhStats;
+use crate::geometry::quadric::QuadricShape;
 use crate::render_scene::geometry::GeometryBuilder;
 use crate::render_scene::{Camera, DefaultEstimator, RenderScene};
 use crate::scene::Diagnostic;
@@ -37,6 +38,10 @@ pub struct CompileStats {
     pub spheres: usize,
     /// Ellipsoids (spheres under non-uniform scale).
     pub ellipsoids: usize,
+    /// Discs (`Disc` nodes, and cylinders' caps).
+    pub discs: usize,
+    /// Open cylinder walls (`Cylinder` nodes).
+    pub cylinders: usize,
     /// Materials kept (used by some node).
     pub materials: usize,
     /// Lights.
@@ -137,6 +142,12 @@ pub fn compile_with(
     stats.triangles = builder.triangles.len();
     stats.spheres = builder.spheres.len();
     stats.ellipsoids = builder.ellipsoids.len();
+    for q in &builder.quadrics {
+        match q.shape {
+            QuadricShape::Disc => stats.discs += 1,
+            QuadricShape::Cylinder => stats.cylinders += 1,
+        }
+    }
     stats.materials = materials.list.len();
     stats.textures = materials.textures.list.len();
     stats.images_loaded = materials.textures.images_loaded;

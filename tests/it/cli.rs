@@ -588,3 +588,37 @@ fn plot_draws_curves_from_csv_files_with_their_slopes() {
         "{stderr}"
     );
 }
+
+#[test]
+fn check_counts_discs_and_cylinders() {
+    // One disc lamp, one closed cylinder (a wall and two cap discs) and one open tube: 3 discs
+    // and 2 cylinder walls; scenes without them keep their summary as before.
+    let dir = tempfile::tempdir().expect("tmp");
+    let scene = dir.path().join("q.ron");
+    std::fs::write(
+        &scene,
+        r#"Scene(
+    camera: Pinhole(eye: (0, 1, 4), look_at: (0, 0.5, 0), fov_y: 40),
+    materials: { "grey": (color: (0.5, 0.5, 0.5)) },
+    nodes: [
+        Disc(radius: 0.2, emission: (radiance: (5, 5, 4)), transform: [RotateX(90), Translate(0, 2, 0)]),
+        Cylinder(radius: 0.1, height: 0.5, caps: true, material: "grey"),
+        Cylinder(radius: 0.1, height: 0.5, caps: false, material: "grey", transform: [Translate(1, 0, 0)]),
+    ],
+)"#,
+    )
+    .expect("write");
+    let out = caustic(&["check", scene.to_str().expect("utf8")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("0 ellipsoids, 3 discs, 2 cylinders, "),
+        "{text}"
+    );
+    let plain = caustic(&["check", "scenes/cornell.ron"]);
+    let plain = String::from_utf8_lossy(&plain.stdout);
+    assert!(
+        !plain.contains("disc") && !plain.contains("cylinder"),
+        "{plain}"
+    );
+}
