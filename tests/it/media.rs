@@ -407,3 +407,33 @@ fn caustic_photons_under_a_murky_slab_carry_the_unscattered_share() {
         );
     }
 }
+
+#[test]
+fn a_scene_wide_medium_warns_that_lights_at_infinity_reach_nothing() {
+    let text = r#"Scene(
+    camera: Pinhole(eye: (0, 0, 4), look_at: (0, 0, 0), fov_y: 30),
+    materials: { "grey": (color: (0.5, 0.5, 0.5)) },
+    media: { "fog": (sigma_s: (0.1, 0.1, 0.1)) },
+    medium: "fog",
+    lights: [
+        Point(position: (0, 3, 0), power: (10, 10, 10)),
+        Distant(direction: (0, 1, 0), irradiance: (1, 1, 1)),
+    ],
+    nodes: [ Sphere(material: "grey", center: (0, 0, 0), radius: 1) ],
+)"#;
+    let src = SourceFile::new(std::path::Path::new("inline.ron"), text.to_string()).expect("ron");
+    let file = src.parse().unwrap_or_else(|e| panic!("{e}"));
+    let all = validate(&file);
+    assert!(all.iter().all(|d| !d.is_error()), "{all:?}");
+    let warnings: Vec<String> = all
+        .iter()
+        .map(|d| format!("{}: {}", d.path, d.message))
+        .filter(|m| m.contains("infinitely far away"))
+        .collect();
+    // The distant light is named; the point light, inside the fog, is not.
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].starts_with("lights[1]: a distant light"),
+        "{warnings:?}"
+    );
+}

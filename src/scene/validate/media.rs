@@ -2,7 +2,7 @@
 //! interfaces of materials (docs/media.md), and that the integrator renders them.
 
 use super::*;
-use crate::scene::schema::MediumSpec;
+use crate::scene::schema::{LightSpec, MediumSpec};
 use crate::settings::IntegratorKind;
 
 impl<'a> Validator<'a> {
@@ -13,6 +13,27 @@ impl<'a> Validator<'a> {
         }
         if let Some(name) = &scene.medium {
             self.medium_ref("medium", name);
+            // A scene-wide medium is unbounded: light from infinitely far away crosses an
+            // infinite distance of it, so these lights add nothing (said, not silently dark).
+            for (i, light) in scene.lights.iter().enumerate() {
+                let kind = match light {
+                    LightSpec::Distant { .. } => "a distant light",
+                    LightSpec::Environment { .. } => "an environment",
+                    LightSpec::Sky { .. } => "a sky",
+                    LightSpec::Point { .. } | LightSpec::Spot { .. } | LightSpec::Sphere { .. } => {
+                        continue;
+                    }
+                };
+                self.out.push(
+                    Diagnostic::warning(
+                        format!("lights[{i}]"),
+                        format!(
+                            "{kind} is infinitely far away, and the scene-wide `medium` `{name}` fills all space: its light crosses an infinite distance of it and reaches nothing"
+                        ),
+                    )
+                    .with_help("bound the fog with a closed surface of a material with `interface: true, medium: \"…\"` around the scene instead (docs/media.md)"),
+                );
+            }
         }
         let volumetric = scene.medium.is_some()
             || scene
