@@ -37,6 +37,7 @@ use super::participating::HomogeneousMedium;
 use super::{Interaction, RenderScene, SurfaceHit};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
+use crate::shading::Bsdf;
 use crate::shading::absorption::Absorption;
 
 /// Most volumes a path can be inside at once (deeper nesting drops the oldest).
@@ -357,6 +358,29 @@ impl Medium {
             };
         }
         Vec3::ZERO
+    }
+
+    /// The surface step every tracer takes in a volumetric scene at a hit `v` (camera paths
+    /// and photons alike): `Some((ray, medium))` when the hit is not a surface for this path
+    /// ([`Medium::skips`]: the ray going straight on and the medium beyond,
+    /// [`Medium::pass_through`]); else `None`, with `v`'s dielectric given the index ratio of
+    /// the volumes it separates when two touch ([`Medium::interface_ior`], the new BSDF kept in
+    /// `nested`, which must outlive `v`).
+    #[inline]
+    pub fn surface_step<'s>(
+        self,
+        scene: &RenderScene,
+        ray: &Ray,
+        v: &mut SurfaceHit<'s>,
+        nested: &'s mut Option<Bsdf>,
+    ) -> Option<(Ray, Self)> {
+        if self.skips(scene, v.material) {
+            return Some(self.pass_through(scene, ray, v));
+        }
+        if let Some(eta) = self.interface_ior(scene, v.material) {
+            v.bsdf = nested.insert(v.bsdf.with_ior(eta));
+        }
+        None
     }
 
     /// The ray that goes straight on through the skipped surface of `v` (an interface or a

@@ -180,20 +180,16 @@ pub fn trace_photon(
             } else {
                 power *= medium.transmittance(&ray, &it);
             }
-            if let Interaction::Surface(v) = &mut it {
+            if let Interaction::Surface(v) = &mut it
                 // Interfaces and surfaces inside a volume of higher priority are not there.
-                if medium.skips(scene, v.material) {
-                    skipped += 1;
-                    if skipped > MAX_SKIPPED {
-                        return;
-                    }
-                    (ray, medium) = medium.pass_through(scene, &ray, v);
-                    continue;
+                && let Some(next) = medium.surface_step(scene, &ray, v, &mut nested)
+            {
+                skipped += 1;
+                if skipped > MAX_SKIPPED {
+                    return;
                 }
-                // Two dielectrics touching: the index ratio of the volumes they separate.
-                if let Some(eta) = medium.interface_ior(scene, v.material) {
-                    v.bsdf = nested.insert(v.bsdf.with_ior(eta));
-                }
+                (ray, medium) = next;
+                continue;
             }
         } else {
             // Beer–Lambert absorption along the segment just travelled (1 outside media).
