@@ -53,3 +53,20 @@ pub(super) fn pdf_area_le(cos_t: f32, area: f32, two_sided: bool) -> (f32, f32) 
     };
     (1.0 / area, pdf_dir)
 }
+
+/// Solid-angle density at `p` of sampling a point uniformly by area on an emitter of area
+/// `area` (m²), for the sample `point` with unit normal `n`: `|p − point|² / (A |cos θ_l|)`, 0
+/// behind a one-sided light or where the density is not finite (`p` on the surface). What a
+/// BSDF-sampled ray that hits the light weighs against light sampling (MIS).
+#[inline]
+#[must_use]
+pub(super) fn pdf_area_li_hit(p: Vec3, point: Vec3, n: Vec3, area: f32, two_sided: bool) -> f32 {
+    let d = point - p;
+    let dist2 = d.length_squared();
+    let cos_l = -n.dot(d) / dist2.sqrt();
+    if !(two_sided || cos_l > 0.0) {
+        return 0.0;
+    }
+    let pdf = dist2 / (area * cos_l.abs());
+    if pdf.is_finite() { pdf } else { 0.0 }
+}

@@ -177,14 +177,7 @@ impl MeshLight {
     #[inline]
     #[must_use]
     pub fn pdf_li_hit(&self, p: Vec3, point: Vec3, n: Vec3) -> f32 {
-        let d = point - p;
-        let dist2 = d.length_squared();
-        let cos_l = -n.dot(d) / dist2.sqrt();
-        if !(self.two_sided || cos_l > 0.0) {
-            return 0.0;
-        }
-        let pdf = dist2 / (self.area * cos_l.abs());
-        if pdf.is_finite() { pdf } else { 0.0 }
+        super::area_emission::pdf_area_li_hit(p, point, n, self.area, self.two_sided)
     }
 
     /// Solid-angle density of [`MeshLight::sample_li`] for the unit direction `wi` from `p`:
