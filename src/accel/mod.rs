@@ -2,6 +2,7 @@
 
 pub(crate) mod build;
 pub mod bvh;
+mod query;
 mod traverse;
 
 pub use build::BvhNode;

@@ -1,7 +1,7 @@
 //! Watertight ray–triangle intersection (Woop, Benthin & Wald, JCGT 2013, in pbrt-v4's form):
 //! rays never slip through shared edges or vertices of a closed mesh.
 
-use glam::{BVec4A, Vec3, Vec4};
+use glam::{BVec4A, DVec3, Vec3, Vec4};
 
 use super::Ray;
 use super::float::gamma;
@@ -10,6 +10,8 @@ use super::float::gamma;
 #[derive(Debug, Clone, Copy)]
 pub struct TriRay {
     origin: [f32; 3],
+    /// The ray's direction, for [`plane_hit_f64`].
+    dir: [f32; 3],
     kz: usize,
     sx: f32,
     sy: f32,
@@ -55,6 +57,7 @@ impl TriRay {
         let dz = d[kz];
         Self {
             origin: ray.origin.to_array(),
+            dir: d,
             kz,
             sx: -d[kx] / dz,
             sy: -d[ky] / dz,
@@ -128,15 +131,17 @@ pub fn intersect_triangle_k<const KZ: usize>(
     }
     let (z0, z1, z2) = (p0z * r.sz, p1z * r.sz, p2z * r.sz);
     let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-        return None;
-    }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+    let (behind, beyond) = if det < 0.0 {
+        (t_scaled >= 0.0, t_scaled < t_max * det)
+    } else {
+        (t_scaled <= 0.0, t_scaled > t_max * det)
+    };
+    if beyond && !behind {
         return None;
     }
     let inv_det = 1.0 / det;
     let t = t_scaled * inv_det;
-    // Conservatively reject hits whose distance is not certainly positive.
+    // The sign of a distance within its error bound of the origin is not certain in f32.
     let max_zt = z0.abs().max(z1.abs()).max(z2.abs());
     let delta_z = gamma(3) * max_zt;
     let max_xt = p0x.abs().max(p1x.abs()).max(p2x.abs());
@@ -147,15 +152,51 @@ pub fn intersect_triangle_k<const KZ: usize>(
     let max_e = e0.abs().max(e1.abs()).max(e2.abs());
     let delta_t =
         3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
-    if t <= delta_t {
+    let t = if t.abs() <= delta_t {
+        // Decided in f64 against the plane (the edge tests above stand, so the test stays
+        // watertight): a ray whose origin lies within the f32 bound of another surface (a
+        // point at the seam of a thin wall and a floor) still sees it.
+        plane_hit_f64(r, Vec3::from_array(p0), Vec3::from_array(p1), Vec3::from_array(p2), t_max)?
+    } else if behind {
         return None;
-    }
+    } else {
+        t
+    };
     Some(TriHit {
         t,
         b0: e0 * inv_det,
         b1: e1 * inv_det,
         b2: e2 * inv_det,
     })
+}
+
+/// The distance along `r` to the plane of triangle `(p0, p1, p2)` computed in f64, when it lies
+/// certainly in `(0, t_max)`: the decision of the watertight test for a hit within the f32
+/// error bound of the ray's origin, where f32 cannot tell its sign (pbrt-v4 rejects every such
+/// hit, §6.8.7, which lets a ray from a point micrometres from another surface pass through it).
+/// The vertices and origin are f32, so their differences are exact in f64 and the plane's
+/// normal is rounded by a few units in 2⁻⁵³: a point 10⁻¹² of the scene's size off the plane
+/// is on a certain side. The ray's own surface is not hit: a spawned origin is offset off it by
+/// its error bound (`offset_ray_origin`), which in f64 is a certain distance behind. `None`
+/// when the hit is behind the origin, beyond `t_max`, or undecided even in f64 (the origin on
+/// the plane, or the ray parallel to it).
+#[cold]
+#[inline(never)]
+#[must_use]
+pub fn plane_hit_f64(r: &TriRay, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<f32> {
+    let (a, b, c) = (p0.as_dvec3(), p1.as_dvec3(), p2.as_dvec3());
+    let o = DVec3::from_array(r.origin.map(f64::from));
+    let d = DVec3::from_array(r.dir.map(f64::from));
+    let n = (b - a).cross(c - a);
+    let to = a - o;
+    let (num, den) = (to.dot(n), d.dot(n));
+    let eps = 8.0 * f64::EPSILON;
+    let certain = |v: f64, u: DVec3| v.abs() > eps * u.abs().dot(n.abs());
+    if !certain(num, to) || !certain(den, d) || (num > 0.0) != (den > 0.0) {
+        return None;
+    }
+    let t = num / den;
+    (t < f64::from(t_max)).then(|| (t as f32).max(f32::MIN_POSITIVE))
 }
 
 mod pack8;
@@ -288,14 +329,16 @@ pub fn intersect_pack_k<const KZ: usize>(
     let (z0, z1, z2) = (p0z * sz, p1z * sz, p2z * sz);
     let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
     let t_max_det = Vec4::splat(t_max) * det;
-    let reject_neg = det_neg & (t_scaled.cmpge(zero) | t_scaled.cmplt(t_max_det));
-    let reject_pos = det_pos & (t_scaled.cmple(zero) | t_scaled.cmpgt(t_max_det));
-    let mask: BVec4A = inside & !reject_neg & !reject_pos;
-    if !mask.any() {
+    let behind = (det_neg & t_scaled.cmpge(zero)) | (det_pos & t_scaled.cmple(zero));
+    let beyond = (det_neg & t_scaled.cmplt(t_max_det)) | (det_pos & t_scaled.cmpgt(t_max_det));
+    let mask: BVec4A = inside & !behind & !beyond;
+    // Lanes behind the origin are kept until their distance is known to be certainly negative.
+    let open: BVec4A = inside & !(beyond & !behind);
+    if !open.any() {
         return None;
     }
     let inv_det = Vec4::ONE / det;
-    let t = t_scaled * inv_det;
+    let mut t = t_scaled * inv_det;
     let max_zt = z0.abs().max(z1.abs()).max(z2.abs());
     let delta_z = Vec4::splat(gamma(3)) * max_zt;
     let max_xt = p0x.abs().max(p1x.abs()).max(p2x.abs());
@@ -308,7 +351,25 @@ pub fn intersect_pack_k<const KZ: usize>(
     let delta_t = Vec4::splat(3.0)
         * (Vec4::splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
         * inv_det.abs();
-    let mask = (mask & !t.cmple(delta_t)).bitmask();
+    let near = t.abs().cmple(delta_t);
+    let mut mask = (mask & !near).bitmask();
+    let (mut t_scaled, mut det) = (t_scaled, det);
+    let undecided = (open & near).bitmask();
+    if undecided != 0 {
+        // Within the f32 bound of the origin: decided in f64 (see `plane_hit_f64`).
+        for l in 0..4 {
+            if undecided & (1 << l) == 0 {
+                continue;
+            }
+            let v = |i: usize| Vec3::new(pack.v[i][0][l], pack.v[i][1][l], pack.v[i][2][l]);
+            if let Some(tl) = plane_hit_f64(r, v(0), v(1), v(2), t_max) {
+                mask |= 1 << l;
+                t[l] = tl;
+                t_scaled[l] = tl;
+                det[l] = 1.0;
+            }
+        }
+    }
     if mask == 0 {
         return None;
     }
@@ -577,6 +638,101 @@ mod tests {
         assert_eq!(mismatches, 0);
         // The comparison is not vacuous: a good share of the rays hit something.
         assert!(hits * 3 > total, "{hits} of {total}");
+    }
+
+    #[test]
+    fn a_ray_from_micrometres_before_a_wall_hits_it() {
+        // Issue 47 (thin-wall-photon-leak): the reported divider, a 2.4 m quad at x = 0, and a
+        // shadow ray from a floor point at distance `gap` before it towards the light at
+        // (1.2, 1.2, 0.3). In f32 alone the hit lies within the error bound of the origin up
+        // to ~30 µm (2.4 m × a few 10⁻⁶ × 3) and was dropped: the path tracer's seam leak.
+        let wall = [
+            [
+                Vec3::new(0.0, -0.2, -1.2),
+                Vec3::new(0.0, 2.2, -1.2),
+                Vec3::new(0.0, 2.2, 1.2),
+            ],
+            [
+                Vec3::new(0.0, -0.2, -1.2),
+                Vec3::new(0.0, 2.2, 1.2),
+                Vec3::new(0.0, -0.2, 1.2),
+            ],
+        ];
+        let light = Vec3::new(1.2, 1.2, 0.3);
+        for gap in [1e-3f32, 1e-4, 3e-5, 1e-5, 1e-6, 1e-7, 1e-9] {
+            for z in [-0.5f32, 0.3, 0.9485] {
+                let o = Vec3::new(-gap, 1e-7, z);
+                let ray = Ray {
+                    origin: o,
+                    dir: light - o,
+                    t_max: 1.0 - 1e-4,
+                };
+                let r = TriRay::new(&ray);
+                let hits = wall
+                    .iter()
+                    .filter_map(|t| intersect_triangle(&r, t[0], t[1], t[2], ray.t_max))
+                    .count();
+                assert_eq!(hits, 1, "gap {gap}, z {z}");
+                assert_eq!(pack_mismatches(&ray, &wall, ray.t_max), 0);
+                // From the far side, the wall is behind the origin.
+                let o = Vec3::new(gap, 1e-7, z);
+                let ray = Ray {
+                    origin: o,
+                    dir: light - o,
+                    t_max: 1.0 - 1e-4,
+                };
+                let r = TriRay::new(&ray);
+                assert!(
+                    wall.iter()
+                        .all(|t| intersect_triangle(&r, t[0], t[1], t[2], ray.t_max).is_none()),
+                    "gap {gap}, z {z}: hit from the lit side"
+                );
+                assert_eq!(pack_mismatches(&ray, &wall, ray.t_max), 0);
+            }
+        }
+    }
+
+    #[test]
+    fn rays_spawned_off_a_triangle_do_not_rehit_it_or_its_neighbours_in_packs() {
+        // The f64 decision near the origin keeps pbrt's guarantee: an origin offset by its
+        // error bound is certainly off its own triangle and the coplanar or creased neighbours
+        // sharing its edges (scalar and packs agree bit for bit).
+        let floor = [
+            [Vec3::new(-2.0, 0.0, -1.0), Vec3::new(-2.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 1.0)],
+            [Vec3::new(-2.0, 0.0, -1.0), Vec3::new(2.0, 0.0, 1.0), Vec3::new(2.0, 0.0, -1.0)],
+            // A wall standing on the floor's edge at x = 2 (a concave crease).
+            [Vec3::new(2.0, 0.0, -1.0), Vec3::new(2.0, 0.0, 1.0), Vec3::new(2.0, 2.0, 1.0)],
+        ];
+        let mut rng = crate::sampling::Rng::new(3, 5);
+        let mut rehits = 0;
+        for _ in 0..2000 {
+            let (u, v) = rng.next_2d();
+            let (b1, b2) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let tri = floor[usize::from(rng.next_f32() < 0.5)];
+            let h = TriHit {
+                t: 0.0,
+                b0: 1.0 - b1 - b2,
+                b1,
+                b2,
+            };
+            let p = tri[0] * h.b0 + tri[1] * h.b1 + tri[2] * h.b2;
+            let err = hit_point_error(&h, tri[0], tri[1], tri[2]);
+            let (a, b) = rng.next_2d();
+            // Any direction of the upper hemisphere, some grazing, none into the wall.
+            let phi = std::f32::consts::TAU * a;
+            let cos = 1e-4 + 0.9999 * b * b;
+            let sin = (1.0 - cos * cos).sqrt();
+            let w = Vec3::new(-(sin * phi.cos()).abs(), cos, sin * phi.sin());
+            let o = crate::geometry::offset::offset_ray_origin(p, err, Vec3::Y, w);
+            let ray = Ray::new(o, w);
+            let r = TriRay::new(&ray);
+            rehits += floor[..2]
+                .iter()
+                .filter(|t| intersect_triangle(&r, t[0], t[1], t[2], f32::INFINITY).is_some())
+                .count();
+            assert_eq!(pack_mismatches(&ray, &floor, f32::INFINITY), 0);
+        }
+        assert_eq!(rehits, 0);
     }
 
     #[test]
