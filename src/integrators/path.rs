@@ -447,7 +447,7 @@ impl<'a> PathTracer<'a> {
                         ("global", global, LightPath::Indirect),
                     ] {
                         let Some(map) = map else { continue };
-                        let e = map.estimate(sp.p, wo, &fr, bsdf);
+                        let e = map.estimate(sp.p, wo, &fr, bsdf, &scene.geometry);
                         cx.counters.photon_estimates += 1;
                         l.add(kind, beta * e.radiance);
                         if O::ACTIVE {

@@ -397,6 +397,7 @@ fn a_quad_lights_irradiance_through_the_global_photon_map_matches_lamberts_polyg
             Vec3::Y,
             &up,
             &white,
+            &scene.geometry,
         );
         assert!(!e.cut, "the estimate at {x:?} reached the largest radius");
         let got = f64::from(e.radiance.x) * PI;

@@ -208,7 +208,7 @@ fn photons_on_a_smooth_shaded_low_poly_ball_read_the_shadow_rays_light_per_face(
                 } else {
                     0.0
                 };
-                est += f64::from(map.estimate(sp.p, out, &fr, &white).radiance.x);
+                est += f64::from(map.estimate(sp.p, out, &fr, &white, g).radiance.x);
                 exact += f64::from(shadow_ray);
                 n += 1;
             }

@@ -371,7 +371,9 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
         let tree = KdTree::from_tree_order(photons, BuildOptions::default())?;
         memory += tree.memory_bytes();
         *radius = r;
-        Ok(Some(PhotonMap::new(tree, k as usize, r, kernel)))
+        let mut map = PhotonMap::new(tree, k as usize, r, kernel);
+        map.mark_walls(&scene.geometry);
+        Ok(Some(map))
     };
     let caustic_kernel = match p.caustic_cone {
         Some(k) => Kernel::Cone(k),

@@ -16,7 +16,7 @@ use super::aim::CausticTargets;
 use super::emit::{LightEmitter, split_by_power};
 use super::estimate::{IrradianceCache, Kernel, PhotonMap};
 use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
-use crate::render_scene::RenderScene;
+use crate::render_scene::{Geometry, RenderScene};
 use crate::sampling::Sampler;
 use crate::sampling::rng::mix64;
 use crate::spatial::{KdTree, Photon};
@@ -470,6 +470,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
+            &scene.geometry,
             photons,
             MapKind::Caustic,
             p.caustic_gather,
@@ -508,6 +509,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
+            &scene.geometry,
             photons,
             MapKind::Global,
             p.gather,
@@ -565,7 +567,7 @@ pub(super) fn precompute_irradiance(
         global
             .as_ref()
             .or(caustic.as_ref())
-            .and_then(|sites| IrradianceCache::build(sites, &maps, cancel))
+            .and_then(|sites| IrradianceCache::build(sites, &maps, &scene.geometry, cancel))
     } else {
         None
     };
@@ -578,6 +580,7 @@ pub(super) fn precompute_irradiance(
 /// Builds the kd-tree of one map's photons, or says why there is none.
 #[allow(clippy::too_many_arguments)]
 fn finish_map(
+    geometry: &Geometry,
     photons: Vec<Photon>,
     kind: MapKind,
     k: u32,
@@ -602,10 +605,12 @@ fn finish_map(
             return None;
         }
     };
-    *build_time += t.elapsed();
     *memory += tree.memory_bytes();
     *radius = r;
-    Some(PhotonMap::new(tree, k as usize, r, kernel))
+    let mut map = PhotonMap::new(tree, k as usize, r, kernel);
+    map.mark_walls(geometry);
+    *build_time += t.elapsed();
+    Some(map)
 }
 
 /// Mean of a flux's channels (W).
