@@ -9,6 +9,7 @@ use caustic::integrators::photon::aim::CausticTargets;
 use caustic::integrators::photon::emit::LightEmitter;
 use caustic::integrators::photon::maps::trace_map;
 use caustic::integrators::photon::trace::{MapKind, TraceCounts, TraceSettings};
+use caustic::integrators::photon::walls::Walls;
 use caustic::integrators::photon::{Kernel, PhotonMap, build_maps};
 use caustic::integrators::{Context, Counters, Integrator, NoTrace};
 use caustic::render::{RenderOptions, render};
@@ -97,7 +98,7 @@ fn point_light_over_a_plane_matches_the_inverse_square_cosine_law() {
             Vec3::Y,
             &up(),
             &lambert(),
-            &scene.geometry,
+            Walls::of(&scene, None),
         );
         let irradiance = f64::from(e.radiance.x) * PI;
         assert!(
@@ -619,7 +620,7 @@ fn estimates_at_a_planes_edge_and_corner_read_the_boundary_bias() {
             Vec3::Y,
             &up(),
             &lambert(),
-            &scene.geometry,
+            Walls::of(&scene, None),
         );
         let r2 = f64::from(x * x + z * z);
         let exact = 2.0 / (4.0 + r2).powf(1.5);

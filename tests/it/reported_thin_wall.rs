@@ -20,6 +20,7 @@ use caustic::integrators::photon::emit::LightEmitter;
 use caustic::integrators::photon::maps::trace_map;
 use caustic::integrators::photon::trace::{MapKind, TraceSettings};
 use caustic::integrators::photon::{Kernel, PhotonMap};
+use caustic::integrators::photon::walls::Walls;
 use caustic::pipeline::SceneOverrides;
 use caustic::render::{Film, RenderOptions};
 use caustic::sampling::Sampler;
@@ -193,7 +194,7 @@ fn the_wall_test_does_not_darken_contact_regions_or_concave_corners() {
         let e = map.irradiance(
             Vec3::new(x[0] as f32, 0.0, x[1] as f32),
             Vec3::Y,
-            &scene.geometry,
+            Walls::of(&scene, None),
         );
         assert!(!e.cut, "{x:?}: the estimate reached the largest radius");
         let r = f64::from(e.radius);

@@ -49,7 +49,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::radius_field::RadiusField;
-use super::walls;
+use super::walls::{self, Walls};
 use crate::render_scene::Geometry;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 use crate::spatial::{HasPosition, HashGrid, KdTree, KnnHeap, Photon};
@@ -365,10 +365,10 @@ impl PhotonMap {
         wo: Vec3,
         fr: &ShadingFrame,
         bsdf: &Bsdf,
-        geometry: &Geometry,
+        walls: Walls<'_>,
     ) -> Estimate {
         let at = bsdf.at(wo, fr);
-        self.gather(p, fr.ng, geometry, |power, wi, cos_p| {
+        self.gather(p, fr.ng, walls, |power, wi, cos_p| {
             let cos_s = wi.dot(fr.ns).max(0.0);
             at.eval(wi, TransportMode::Radiance) * power * (cos_s / cos_p)
         })
@@ -378,8 +378,8 @@ impl PhotonMap {
     /// nearest photons that no wall of `geometry` separates from `p` (the estimate's
     /// `radiance` field holds it).
     #[must_use]
-    pub fn irradiance(&self, p: Vec3, n: Vec3, geometry: &Geometry) -> Estimate {
-        self.gather(p, n, geometry, |power, _, _| power)
+    pub fn irradiance(&self, p: Vec3, n: Vec3, walls: Walls<'_>) -> Estimate {
+        self.gather(p, n, walls, |power, _, _| power)
     }
 
     /// The density estimate at `p` (surface normal `ng`, on the query's side): the kernel-
@@ -390,11 +390,11 @@ impl PhotonMap {
         &self,
         p: Vec3,
         ng: Vec3,
-        geometry: &Geometry,
+        walls: Walls<'_>,
         value: impl Fn(Vec3, Vec3, f32) -> Vec3,
     ) -> Estimate {
         if let Some(pass) = &self.pass {
-            return self.gather_within(pass, p, ng, geometry, value);
+            return self.gather_within(pass, p, ng, walls, value);
         }
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
@@ -425,7 +425,7 @@ impl PhotonMap {
             let r = r2.sqrt();
             let photons = self.tree.items();
             let mut sum = Vec3::ZERO;
-            let mut sight = Sight::new(geometry, p, ng);
+            let mut sight = Sight::new(walls, p, ng);
             for n in heap.iter() {
                 if Some(n.index) == skip || (self.shrink < 1.0 && n.dist2 >= r2) {
                     continue;
@@ -462,14 +462,14 @@ impl PhotonMap {
         pass: &PassLookup,
         p: Vec3,
         ng: Vec3,
-        geometry: &Geometry,
+        walls: Walls<'_>,
         value: impl Fn(Vec3, Vec3, f32) -> Vec3,
     ) -> Estimate {
         let r = self.shrink * pass.field.radius(p);
         let q = p.to_array();
         let mut sum = Vec3::ZERO;
         let mut found = 0;
-        let mut sight = Sight::new(geometry, p, ng);
+        let mut sight = Sight::new(walls, p, ng);
         // Marks made for a smaller disc than this one do not hold: every photon is tested.
         let unmarked = r > self.wall_radius;
         let mut add = |ph: &Landing, dist2: f32| {
@@ -512,7 +512,7 @@ impl PhotonMap {
 /// The wall test of one estimate at query point `q` (unit geometric normal `nq` on the side
 /// of `ωo`), counting the rays it traces and the photons it hides.
 struct Sight<'g> {
-    geometry: &'g Geometry,
+    walls: Walls<'g>,
     q: Vec3,
     nq: Vec3,
     rays: u32,
@@ -521,9 +521,9 @@ struct Sight<'g> {
 
 impl<'g> Sight<'g> {
     #[inline]
-    fn new(geometry: &'g Geometry, q: Vec3, nq: Vec3) -> Self {
+    fn new(walls: Walls<'g>, q: Vec3, nq: Vec3) -> Self {
         Self {
-            geometry,
+            walls,
             q,
             nq,
             rays: 0,
@@ -540,7 +540,7 @@ impl<'g> Sight<'g> {
             return false;
         }
         self.rays += 1;
-        let hidden = walls::separated(self.geometry, self.q, self.nq, p, np);
+        let hidden = walls::separated(&self.walls, self.q, self.nq, p, np);
         self.hidden += u32::from(hidden);
         hidden
     }
@@ -613,7 +613,7 @@ impl IrradianceCache {
     pub fn build(
         sites: &PhotonMap,
         maps: &[&PhotonMap],
-        geometry: &Geometry,
+        walls: Walls<'_>,
         cancel: Option<&std::sync::atomic::AtomicBool>,
     ) -> Option<Self> {
         use rayon::prelude::*;
@@ -635,7 +635,7 @@ impl IrradianceCache {
                 }
                 let (p, n) = (ph.position(), ph.normal());
                 let (e, radius) = maps.iter().fold((Vec3::ZERO, 0.0), |(e, r), m| {
-                    let est = m.irradiance(p, n, geometry);
+                    let est = m.irradiance(p, n, walls);
                     let r = if std::ptr::eq(*m, sites) {
                         est.radius
                     } else {
@@ -646,7 +646,7 @@ impl IrradianceCache {
                 IrradiancePoint {
                     photon: Photon::new(p, -n, n, e),
                     radius,
-                    near_wall: walls::near_wall(geometry, p, n, max_radius),
+                    near_wall: walls::near_wall(walls.geometry(), p, n, max_radius),
                 }
             })
             .collect();
@@ -679,8 +679,8 @@ impl IrradianceCache {
     /// ~25°) that no wall of `geometry` separates from `p` ([`walls`]), or `None` when no such
     /// point lies within the largest radius.
     #[must_use]
-    pub fn lookup(&self, p: Vec3, ng: Vec3, geometry: &Geometry) -> Option<Vec3> {
-        self.lookup_with_radius(p, ng, geometry).map(|(e, _)| e)
+    pub fn lookup(&self, p: Vec3, ng: Vec3, walls: Walls<'_>) -> Option<Vec3> {
+        self.lookup_with_radius(p, ng, walls).map(|(e, _)| e)
     }
 
     /// [`IrradianceCache::lookup`], with the radius (scene units) of the estimate the point's
@@ -690,7 +690,7 @@ impl IrradianceCache {
         &self,
         p: Vec3,
         ng: Vec3,
-        geometry: &Geometry,
+        walls: Walls<'_>,
     ) -> Option<(Vec3, f32)> {
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
@@ -705,7 +705,7 @@ impl IrradianceCache {
                 .find(|c| {
                     let (cp, cn) = (c.photon.position(), c.photon.normal());
                     !(walls::needs_ray(p, ng, cp, cn, c.near_wall)
-                        && walls::separated(geometry, p, ng, cp, cn))
+                        && walls::separated(&walls, p, ng, cp, cn))
                 })
                 .map(|c| (c.photon.power(), c.radius))
         })
@@ -761,7 +761,7 @@ mod tests {
             for _ in 0..250 {
                 let (a, b) = rng.next_2d();
                 let p = Vec3::new(a - 0.5, b - 0.5, 0.0);
-                let e = map.estimate(p, Vec3::Z, &up_frame(), &white_lambert(), &Geometry::default());
+                let e = map.estimate(p, Vec3::Z, &up_frame(), &white_lambert(), Walls::every_surface(&Geometry::default()));
                 assert!(!e.cut);
                 sum += f64::from(e.radiance.x / exact);
                 count += 1;
@@ -793,7 +793,7 @@ mod tests {
             ng: -Vec3::Z,
             entering: false,
         };
-        let e = map.estimate(Vec3::ZERO, -Vec3::Z, &down, &white_lambert(), &Geometry::default());
+        let e = map.estimate(Vec3::ZERO, -Vec3::Z, &down, &white_lambert(), Walls::every_surface(&Geometry::default()));
         assert_eq!(e.radiance, Vec3::ZERO);
         assert_eq!(e.found, 20);
     }
@@ -802,7 +802,7 @@ mod tests {
     fn coincident_photons_give_a_finite_estimate() {
         let photons = vec![Photon::new(Vec3::ZERO, -Vec3::Z, Vec3::Z, Vec3::ONE); 500];
         let map = PhotonMap::new(KdTree::build(photons).expect("tree"), 50, 1.0, Kernel::Box);
-        let e = map.estimate(Vec3::ZERO, Vec3::Z, &up_frame(), &white_lambert(), &Geometry::default());
+        let e = map.estimate(Vec3::ZERO, Vec3::Z, &up_frame(), &white_lambert(), Walls::every_surface(&Geometry::default()));
         assert!(e.radiance.is_finite() && e.radiance.x > 0.0);
         assert_eq!(e.radius, MIN_RADIUS_FRACTION);
     }
@@ -831,7 +831,7 @@ mod tests {
             for _ in 0..200 {
                 let (a, b) = queries.next_2d();
                 let p = Vec3::new(side * 0.5 * (a - 0.5), side * 0.5 * (b - 0.5), 0.0);
-                let e = map.irradiance(p, Vec3::Z, &Geometry::default());
+                let e = map.irradiance(p, Vec3::Z, Walls::every_surface(&Geometry::default()));
                 assert!(!e.cut && e.radius < 1e-4, "{e:?}");
                 sum += f64::from(e.radiance.x / lambda);
             }
@@ -851,7 +851,7 @@ mod tests {
             Vec3::Z,
             &up_frame(),
             &white_lambert(),
-            &Geometry::default(),
+            Walls::every_surface(&Geometry::default()),
         );
         assert_eq!(e.radiance, Vec3::ZERO);
         assert!(e.cut);

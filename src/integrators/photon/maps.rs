@@ -16,6 +16,7 @@ use super::aim::CausticTargets;
 use super::emit::{LightEmitter, split_by_power};
 use super::estimate::{IrradianceCache, Kernel, PhotonMap};
 use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
+use super::walls::Walls;
 use crate::render_scene::{Geometry, RenderScene};
 use crate::sampling::Sampler;
 use crate::sampling::rng::mix64;
@@ -567,7 +568,7 @@ pub(super) fn precompute_irradiance(
         global
             .as_ref()
             .or(caustic.as_ref())
-            .and_then(|sites| IrradianceCache::build(sites, &maps, &scene.geometry, cancel))
+            .and_then(|sites| IrradianceCache::build(sites, &maps, Walls::of(scene, None), cancel))
     } else {
         None
     };

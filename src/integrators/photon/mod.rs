@@ -38,7 +38,8 @@ use super::trace_log::RayKind;
 use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
-use crate::render_scene::{Geometry, Interaction, Medium, RenderScene, SurfaceHit, SurfacePoint};
+use crate::render_scene::{Interaction, Medium, RenderScene, SurfaceHit, SurfacePoint};
+use walls::Walls;
 use crate::sampling::Sampler;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 
@@ -317,7 +318,7 @@ impl<'a> PhotonMapper<'a> {
     ) -> (Radiance, Option<String>) {
         let (sp, fr, bsdf, wo) = (&v.sp, &v.frame, v.bsdf, v.wo);
         let direct = self.direct(sp, fr, bsdf, wo, sampler, counters);
-        if !full && let Some(l) = cached_radiance(maps, &self.scene.geometry, sp, fr, bsdf, wo, counters) {
+        if !full && let Some(l) = cached_radiance(maps, Walls::of(self.scene, Some(sp.object)), sp, fr, bsdf, wo, counters) {
             let note = describe.then(|| {
                 format!(
                     "direct ({:.4}, {:.4}, {:.4}); caustic + indirect {} ({:.4}, {:.4}, {:.4}) (dim branch)",
@@ -342,7 +343,7 @@ impl<'a> PhotonMapper<'a> {
         let caustic = maps
             .caustic
             .as_ref()
-            .map(|m| counted(m, &self.scene.geometry, sp.p, wo, fr, bsdf, counters));
+            .map(|m| counted(m, Walls::of(self.scene, Some(sp.object)), sp.p, wo, fr, bsdf, counters));
         let gather = self.final_gather;
         let (indirect, global) = if gather > 0 {
             (
@@ -353,7 +354,7 @@ impl<'a> PhotonMapper<'a> {
             let e = maps
                 .global
                 .as_ref()
-                .map(|m| counted(m, &self.scene.geometry, sp.p, wo, fr, bsdf, counters));
+                .map(|m| counted(m, Walls::of(self.scene, Some(sp.object)), sp.p, wo, fr, bsdf, counters));
             (e.map_or(Vec3::ZERO, |e| e.radiance), e)
         };
         let caustic_l = caustic.map_or(Vec3::ZERO, |e| e.radiance);
@@ -473,20 +474,22 @@ impl<'a> PhotonMapper<'a> {
                     let near = maps
                         .irradiance
                         .as_ref()
-                        .and_then(|c| c.lookup_with_radius(gp.p, gfr.ng, &scene.geometry));
+                        .and_then(|c| c.lookup_with_radius(gp.p, gfr.ng, Walls::of(scene, Some(gp.object))));
                     short = shortcuts < SHORT_GATHER_BOUNCES
                         && near.is_some_and(|(_, r)| g.hit.t < SHORT_GATHER * r);
                     if short {
                         // The caustics here still come from their map; the rest of the light
                         // arriving here is gathered by the bounce below.
                         if let Some(map) = &maps.caustic {
-                            lo += counted(map, &scene.geometry, gp.p, gwo, &gfr, g.bsdf, counters).radiance;
+                            lo += counted(map, Walls::of(scene, Some(gp.object)), gp.p, gwo, &gfr, g.bsdf, counters)
+                                .radiance;
                         }
                     } else if let Some((e, _)) = near.filter(|_| g.bsdf.is_diffuse_only()) {
                         lo += g.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e;
                     } else {
                         for map in [&maps.caustic, &maps.global].into_iter().flatten() {
-                            lo += counted(map, &scene.geometry, gp.p, gwo, &gfr, g.bsdf, counters).radiance;
+                            lo += counted(map, Walls::of(scene, Some(gp.object)), gp.p, gwo, &gfr, g.bsdf, counters)
+                                .radiance;
                         }
                     }
                     sum += beta * lo;
@@ -536,7 +539,7 @@ impl<'a> PhotonMapper<'a> {
 ///   shininess 1 / 10 / 50 (issue 29, glossy-final-gather).
 fn cached_radiance(
     maps: &PhotonMaps,
-    geometry: &Geometry,
+    walls: Walls<'_>,
     sp: &SurfacePoint,
     fr: &ShadingFrame,
     bsdf: &Bsdf,
@@ -545,30 +548,30 @@ fn cached_radiance(
 ) -> Option<Vec3> {
     let cache = maps.irradiance.as_ref()?;
     if bsdf.is_diffuse_only() {
-        let e = cache.lookup(sp.p, fr.ng, geometry)?;
+        let e = cache.lookup(sp.p, fr.ng, walls)?;
         return Some(bsdf.eval(wo, fr.ns, fr, TransportMode::Radiance) * e);
     }
     let mut l = Vec3::ZERO;
     for map in [&maps.caustic, &maps.global].into_iter().flatten() {
-        l += counted(map, geometry, sp.p, wo, fr, bsdf, counters).radiance;
+        l += counted(map, walls, sp.p, wo, fr, bsdf, counters).radiance;
     }
     Some(l)
 }
 
-/// `map`'s estimate at `p` towards `wo` through `bsdf` (photons a wall of `geometry`
+/// `map`'s estimate at `p` towards `wo` through `bsdf` (photons one of `walls`
 /// separates from `p` left out), counted in `counters` (estimates made, and those the largest
 /// radius cut short).
 #[inline]
 fn counted(
     map: &PhotonMap,
-    geometry: &Geometry,
+    walls: Walls<'_>,
     p: Vec3,
     wo: Vec3,
     fr: &ShadingFrame,
     bsdf: &Bsdf,
     counters: &mut Counters,
 ) -> Estimate {
-    let e = map.estimate(p, wo, fr, bsdf, geometry);
+    let e = map.estimate(p, wo, fr, bsdf, walls);
     counters.photon_estimates += 1;
     counters.photon_radius_cut += u64::from(e.cut);
     e

@@ -23,7 +23,11 @@
 //!   tessellated curve, a crease the lift did not clear) or an object lying against it (the
 //!   underside of a ball at its contact, a floor under a lifted curved receiver): the segment
 //!   walks on through it. A divider, a box standing on the floor, a riser between two levels
-//!   stand across the receiver: the photon is rejected.
+//!   stand across the receiver: the photon is rejected. Nor is a surface that lets light
+//!   through (the water line on a pool's wall: the photons above it arrived through the
+//!   water, and what differs across it is a blur like any shadow edge's), nor one of the query
+//!   point's own object (the bumps of a lumpy mesh between two of its points) a wall
+//!   ([`Walls`]).
 //! - **Where a ray is traced.** Every segment of an estimate of radius `r` around photon `p`
 //!   lies in the ball of radius [`reach`] around `p`, and when `q` is not below `p`'s tangent
 //!   plane the whole segment lies above that plane (by at least `τ`). A wall crossing it then
@@ -34,7 +38,8 @@
 //!   floor, or a query point below the photon's plane by more than the curvature between them
 //!   explains (a step), costs one segment (a closest-hit ray per crossing).
 //!
-//! What is not resolved: a surface parallel to the receiver is never a wall, so photons on a
+//! What is not resolved: a partition in the same mesh as the floor is not a wall to the floor's
+//! points; a surface parallel to the receiver is never a wall, so photons on a
 //! shelf's top are still read under the shelf when it is closer than the disc's radius (the
 //! normal test cannot tell them apart either); a sheet meeting the floor at less than ~26° is
 //! taken for an object lying on it; a gap under a wall narrower than the lift (micrometres)
@@ -44,8 +49,58 @@ use glam::Vec3;
 
 use crate::geometry::offset::offset_ray_origin;
 use crate::geometry::{Aabb, Ray};
-use crate::render_scene::Geometry;
 use crate::render_scene::geometry::{PrimKind, PrimRef};
+use crate::render_scene::{Geometry, RenderScene};
+
+/// What can be a wall for one estimate: the scene's surfaces except those that let light
+/// through (glass, water: the photons beyond them arrived through them, and what differs
+/// across them is a blur like any shadow edge's) and except the query point's own object (its
+/// bumps, creases and curvature are the receiver, not a wall across it).
+#[derive(Debug, Clone, Copy)]
+pub struct Walls<'a> {
+    geometry: &'a Geometry,
+    scene: Option<&'a RenderScene>,
+    object: Option<u32>,
+}
+
+impl<'a> Walls<'a> {
+    /// The walls of `scene` for a query point on object `object` (`None`: not on an object of
+    /// the scene, such as an irradiance-cache point being built).
+    #[must_use]
+    pub fn of(scene: &'a RenderScene, object: Option<u32>) -> Self {
+        Self {
+            geometry: &scene.geometry,
+            scene: Some(scene),
+            object,
+        }
+    }
+
+    /// Every surface of `geometry` as a wall (no materials, no own object): for maps tested
+    /// on bare geometry.
+    #[must_use]
+    pub fn every_surface(geometry: &'a Geometry) -> Self {
+        Self {
+            geometry,
+            scene: None,
+            object: None,
+        }
+    }
+
+    /// The geometry rays are traced in.
+    #[must_use]
+    pub fn geometry(&self) -> &'a Geometry {
+        self.geometry
+    }
+
+    /// Whether a surface of object `object` can be a wall (opaque, not the query's own).
+    #[inline]
+    fn can_block(&self, object: u32) -> bool {
+        Some(object) != self.object
+            && self
+                .scene
+                .is_none_or(|s| s.objects.get(object as usize).is_none() || s.is_opaque(object))
+    }
+}
 
 /// Relative size, in units of the larger coordinate's magnitude (plus 1), of the rounding
 /// tolerance of positions on a surface ([`tolerance`]).
@@ -136,10 +191,12 @@ pub fn needs_ray(q: Vec3, nq: Vec3, p: Vec3, np: Vec3, near_wall: bool) -> bool 
 
 /// True when a wall separates the query point `q` (unit geometric normal `nq` on the side of
 /// `ωo`) from the photon at `p` (unit geometric normal `np` on the side it arrived from): the
-/// lifted segment between them crosses a surface standing across the receiver (module docs).
-/// Traces one closest-hit ray per surface crossed, at most `MAX_CROSSINGS` + 1.
+/// lifted segment between them crosses an opaque surface of another object than the query's,
+/// standing across the receiver (module docs). Traces one closest-hit ray per surface crossed,
+/// at most `MAX_CROSSINGS` + 1.
 #[must_use]
-pub fn separated(geometry: &Geometry, q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> bool {
+pub fn separated(walls: &Walls<'_>, q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> bool {
+    let geometry = walls.geometry;
     let tol = tolerance(p).max(tolerance(q));
     let d = q.distance(p);
     if !(d > tol) {
@@ -158,7 +215,10 @@ pub fn separated(geometry: &Geometry, q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> b
             return false;
         };
         let sp = geometry.surface(&ray, &hit);
-        if sp.ng.dot(nq).abs() <= PARALLEL_COSINE && sp.ng.dot(np).abs() <= PARALLEL_COSINE {
+        if sp.ng.dot(nq).abs() <= PARALLEL_COSINE
+            && sp.ng.dot(np).abs() <= PARALLEL_COSINE
+            && walls.can_block(sp.object)
+        {
             return true;
         }
         origin = offset_ray_origin(sp.p, sp.p_error, sp.ng, b - sp.p);
@@ -227,7 +287,8 @@ mod tests {
     /// Whether an estimate at `q` (normal `nq`) leaves out the photon at `p` (normal `np`):
     /// the estimate's own two steps, the mark (radius 5 cm) and the ray.
     fn hides(g: &Geometry, q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> bool {
-        needs_ray(q, nq, p, np, near_wall(g, p, np, 0.05)) && separated(g, q, nq, p, np)
+        needs_ray(q, nq, p, np, near_wall(g, p, np, 0.05))
+            && separated(&Walls::every_surface(g), q, nq, p, np)
     }
 
     #[test]
@@ -291,7 +352,10 @@ mod tests {
                             continue;
                         }
                         tested += usize::from(needs_ray(q, Vec3::Y, p, Vec3::Y, true));
-                        assert!(!separated(&g, q, Vec3::Y, p, Vec3::Y), "r {r}: {q} {p}");
+                        assert!(
+                            !separated(&Walls::every_surface(&g), q, Vec3::Y, p, Vec3::Y),
+                            "r {r}: {q} {p}"
+                        );
                     }
                 }
             }
@@ -308,7 +372,10 @@ mod tests {
                         if np.dot(nq) <= 0.1 {
                             continue;
                         }
-                        assert!(!separated(&g, q, nq, p, np), "r {r}: θ {theta} {dt} {phi}");
+                        assert!(
+                            !separated(&Walls::every_surface(&g), q, nq, p, np),
+                            "r {r}: θ {theta} {dt} {phi}"
+                        );
                     }
                 }
             }
