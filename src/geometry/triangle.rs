@@ -156,7 +156,13 @@ pub fn intersect_triangle_k<const KZ: usize>(
         // Decided in f64 against the plane (the edge tests above stand, so the test stays
         // watertight): a ray whose origin lies within the f32 bound of another surface (a
         // point at the seam of a thin wall and a floor) still sees it.
-        plane_hit_f64(r, Vec3::from_array(p0), Vec3::from_array(p1), Vec3::from_array(p2), t_max)?
+        plane_hit_f64(
+            r,
+            Vec3::from_array(p0),
+            Vec3::from_array(p1),
+            Vec3::from_array(p2),
+            t_max,
+        )?
     } else if behind {
         return None;
     } else {
@@ -698,16 +704,32 @@ mod tests {
         // error bound is certainly off its own triangle and the coplanar or creased neighbours
         // sharing its edges (scalar and packs agree bit for bit).
         let floor = [
-            [Vec3::new(-2.0, 0.0, -1.0), Vec3::new(-2.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 1.0)],
-            [Vec3::new(-2.0, 0.0, -1.0), Vec3::new(2.0, 0.0, 1.0), Vec3::new(2.0, 0.0, -1.0)],
+            [
+                Vec3::new(-2.0, 0.0, -1.0),
+                Vec3::new(-2.0, 0.0, 1.0),
+                Vec3::new(2.0, 0.0, 1.0),
+            ],
+            [
+                Vec3::new(-2.0, 0.0, -1.0),
+                Vec3::new(2.0, 0.0, 1.0),
+                Vec3::new(2.0, 0.0, -1.0),
+            ],
             // A wall standing on the floor's edge at x = 2 (a concave crease).
-            [Vec3::new(2.0, 0.0, -1.0), Vec3::new(2.0, 0.0, 1.0), Vec3::new(2.0, 2.0, 1.0)],
+            [
+                Vec3::new(2.0, 0.0, -1.0),
+                Vec3::new(2.0, 0.0, 1.0),
+                Vec3::new(2.0, 2.0, 1.0),
+            ],
         ];
         let mut rng = crate::sampling::Rng::new(3, 5);
         let mut rehits = 0;
         for _ in 0..2000 {
             let (u, v) = rng.next_2d();
-            let (b1, b2) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let (b1, b2) = if u + v > 1.0 {
+                (1.0 - u, 1.0 - v)
+            } else {
+                (u, v)
+            };
             let tri = floor[usize::from(rng.next_f32() < 0.5)];
             let h = TriHit {
                 t: 0.0,

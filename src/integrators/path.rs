@@ -448,13 +448,8 @@ impl<'a> PathTracer<'a> {
                         ("global", global, LightPath::Indirect),
                     ] {
                         let Some(map) = map else { continue };
-                        let e = map.estimate(
-                            sp.p,
-                            wo,
-                            &fr,
-                            bsdf,
-                            Walls::of(scene, Some(sp.object)),
-                        );
+                        let e =
+                            map.estimate(sp.p, wo, &fr, bsdf, Walls::of(scene, Some(sp.object)));
                         cx.counters.photon_estimates += 1;
                         l.add(kind, beta * e.radiance);
                         if O::ACTIVE {

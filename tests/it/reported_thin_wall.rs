@@ -19,8 +19,8 @@ use caustic::integrators::photon::aim::CausticTargets;
 use caustic::integrators::photon::emit::LightEmitter;
 use caustic::integrators::photon::maps::trace_map;
 use caustic::integrators::photon::trace::{MapKind, TraceSettings};
-use caustic::integrators::photon::{Kernel, PhotonMap};
 use caustic::integrators::photon::walls::Walls;
+use caustic::integrators::photon::{Kernel, PhotonMap};
 use caustic::pipeline::SceneOverrides;
 use caustic::render::{Film, RenderOptions};
 use caustic::sampling::Sampler;
@@ -66,7 +66,10 @@ fn no_light_reaches_the_dark_room_through_a_single_quad_wall() {
         };
         let (film, _) = render_file(&case, &overrides, &RenderOptions::default());
         let max = brightest(&film);
-        assert!(max == 0.0, "{integrator:?}: the dark room reads up to {max}");
+        assert!(
+            max == 0.0,
+            "{integrator:?}: the dark room reads up to {max}"
+        );
     }
     // The default estimator (path tracing with a progressive caustic map), with a glass ball in
     // the lit room focusing the light onto the floor beside the divider (0.105 on 79282ac).
@@ -98,7 +101,10 @@ fn no_light_reaches_the_dark_room_through_a_single_quad_wall() {
     std::fs::remove_dir_all(&dir).ok();
     assert!(stats.photon_estimates > 0, "the caustic map was read");
     let max = brightest(&film);
-    assert!(max == 0.0, "default estimator: the dark room reads up to {max}");
+    assert!(
+        max == 0.0,
+        "default estimator: the dark room reads up to {max}"
+    );
 }
 
 /// A ball of radius 0.3 resting on a floor at the origin, a wall standing on the floor at
@@ -223,5 +229,8 @@ fn the_wall_test_does_not_darken_contact_regions_or_concave_corners() {
     }
     let mean = sum / points.len() as f64;
     assert!((mean - 1.0).abs() < 0.03, "mean ratio {mean:.4}");
-    assert!(rays > 0, "the ball and the wall made the estimates test photons");
+    assert!(
+        rays > 0,
+        "the ball and the wall made the estimates test photons"
+    );
 }

@@ -102,8 +102,9 @@ pub fn intersect_pack8_k<const KZ: usize>(
     let t_max_det = splat(t_max) * det;
     let behind =
         ((det_neg & t_scaled.simd_ge(zero)) | (det_pos & t_scaled.simd_le(zero))).to_bitmask();
-    let beyond = ((det_neg & t_scaled.simd_lt(t_max_det)) | (det_pos & t_scaled.simd_gt(t_max_det)))
-        .to_bitmask();
+    let beyond = ((det_neg & t_scaled.simd_lt(t_max_det))
+        | (det_pos & t_scaled.simd_gt(t_max_det)))
+    .to_bitmask();
     let mask = inside & !behind & !beyond;
     // Lanes behind the origin are kept until their distance is known to be certainly negative.
     let open = inside & !(beyond & !behind);

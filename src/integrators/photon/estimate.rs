@@ -686,12 +686,7 @@ impl IrradianceCache {
     /// [`IrradianceCache::lookup`], with the radius (scene units) of the estimate the point's
     /// irradiance came from.
     #[must_use]
-    pub fn lookup_with_radius(
-        &self,
-        p: Vec3,
-        ng: Vec3,
-        walls: Walls<'_>,
-    ) -> Option<(Vec3, f32)> {
+    pub fn lookup_with_radius(&self, p: Vec3, ng: Vec3, walls: Walls<'_>) -> Option<(Vec3, f32)> {
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
             heap.set_k(LOOKUP_K);
@@ -761,7 +756,13 @@ mod tests {
             for _ in 0..250 {
                 let (a, b) = rng.next_2d();
                 let p = Vec3::new(a - 0.5, b - 0.5, 0.0);
-                let e = map.estimate(p, Vec3::Z, &up_frame(), &white_lambert(), Walls::every_surface(&Geometry::default()));
+                let e = map.estimate(
+                    p,
+                    Vec3::Z,
+                    &up_frame(),
+                    &white_lambert(),
+                    Walls::every_surface(&Geometry::default()),
+                );
                 assert!(!e.cut);
                 sum += f64::from(e.radiance.x / exact);
                 count += 1;
@@ -793,7 +794,13 @@ mod tests {
             ng: -Vec3::Z,
             entering: false,
         };
-        let e = map.estimate(Vec3::ZERO, -Vec3::Z, &down, &white_lambert(), Walls::every_surface(&Geometry::default()));
+        let e = map.estimate(
+            Vec3::ZERO,
+            -Vec3::Z,
+            &down,
+            &white_lambert(),
+            Walls::every_surface(&Geometry::default()),
+        );
         assert_eq!(e.radiance, Vec3::ZERO);
         assert_eq!(e.found, 20);
     }
@@ -802,7 +809,13 @@ mod tests {
     fn coincident_photons_give_a_finite_estimate() {
         let photons = vec![Photon::new(Vec3::ZERO, -Vec3::Z, Vec3::Z, Vec3::ONE); 500];
         let map = PhotonMap::new(KdTree::build(photons).expect("tree"), 50, 1.0, Kernel::Box);
-        let e = map.estimate(Vec3::ZERO, Vec3::Z, &up_frame(), &white_lambert(), Walls::every_surface(&Geometry::default()));
+        let e = map.estimate(
+            Vec3::ZERO,
+            Vec3::Z,
+            &up_frame(),
+            &white_lambert(),
+            Walls::every_surface(&Geometry::default()),
+        );
         assert!(e.radiance.is_finite() && e.radiance.x > 0.0);
         assert_eq!(e.radius, MIN_RADIUS_FRACTION);
     }

@@ -39,9 +39,9 @@ use super::{Counters, LightPath, Radiance};
 use crate::geometry::Ray;
 use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{Interaction, Medium, RenderScene, SurfaceHit, SurfacePoint};
-use walls::Walls;
 use crate::sampling::Sampler;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
+use walls::Walls;
 
 /// Bounces after which Russian roulette may end a camera path's specular chain.
 const ROULETTE_DEPTH: u32 = 3;
@@ -318,7 +318,17 @@ impl<'a> PhotonMapper<'a> {
     ) -> (Radiance, Option<String>) {
         let (sp, fr, bsdf, wo) = (&v.sp, &v.frame, v.bsdf, v.wo);
         let direct = self.direct(sp, fr, bsdf, wo, sampler, counters);
-        if !full && let Some(l) = cached_radiance(maps, Walls::of(self.scene, Some(sp.object)), sp, fr, bsdf, wo, counters) {
+        if !full
+            && let Some(l) = cached_radiance(
+                maps,
+                Walls::of(self.scene, Some(sp.object)),
+                sp,
+                fr,
+                bsdf,
+                wo,
+                counters,
+            )
+        {
             let note = describe.then(|| {
                 format!(
                     "direct ({:.4}, {:.4}, {:.4}); caustic + indirect {} ({:.4}, {:.4}, {:.4}) (dim branch)",
@@ -340,10 +350,17 @@ impl<'a> PhotonMapper<'a> {
             r.add(LightPath::Indirect, l);
             return (r, note);
         }
-        let caustic = maps
-            .caustic
-            .as_ref()
-            .map(|m| counted(m, Walls::of(self.scene, Some(sp.object)), sp.p, wo, fr, bsdf, counters));
+        let caustic = maps.caustic.as_ref().map(|m| {
+            counted(
+                m,
+                Walls::of(self.scene, Some(sp.object)),
+                sp.p,
+                wo,
+                fr,
+                bsdf,
+                counters,
+            )
+        });
         let gather = self.final_gather;
         let (indirect, global) = if gather > 0 {
             (
@@ -351,10 +368,17 @@ impl<'a> PhotonMapper<'a> {
                 None,
             )
         } else {
-            let e = maps
-                .global
-                .as_ref()
-                .map(|m| counted(m, Walls::of(self.scene, Some(sp.object)), sp.p, wo, fr, bsdf, counters));
+            let e = maps.global.as_ref().map(|m| {
+                counted(
+                    m,
+                    Walls::of(self.scene, Some(sp.object)),
+                    sp.p,
+                    wo,
+                    fr,
+                    bsdf,
+                    counters,
+                )
+            });
             (e.map_or(Vec3::ZERO, |e| e.radiance), e)
         };
         let caustic_l = caustic.map_or(Vec3::ZERO, |e| e.radiance);
@@ -471,25 +495,40 @@ impl<'a> PhotonMapper<'a> {
                 let mut short = false;
                 if g.bsdf.has_local() {
                     let mut lo = self.direct(&gp, &gfr, g.bsdf, gwo, sampler, counters);
-                    let near = maps
-                        .irradiance
-                        .as_ref()
-                        .and_then(|c| c.lookup_with_radius(gp.p, gfr.ng, Walls::of(scene, Some(gp.object))));
+                    let near = maps.irradiance.as_ref().and_then(|c| {
+                        c.lookup_with_radius(gp.p, gfr.ng, Walls::of(scene, Some(gp.object)))
+                    });
                     short = shortcuts < SHORT_GATHER_BOUNCES
                         && near.is_some_and(|(_, r)| g.hit.t < SHORT_GATHER * r);
                     if short {
                         // The caustics here still come from their map; the rest of the light
                         // arriving here is gathered by the bounce below.
                         if let Some(map) = &maps.caustic {
-                            lo += counted(map, Walls::of(scene, Some(gp.object)), gp.p, gwo, &gfr, g.bsdf, counters)
-                                .radiance;
+                            lo += counted(
+                                map,
+                                Walls::of(scene, Some(gp.object)),
+                                gp.p,
+                                gwo,
+                                &gfr,
+                                g.bsdf,
+                                counters,
+                            )
+                            .radiance;
                         }
                     } else if let Some((e, _)) = near.filter(|_| g.bsdf.is_diffuse_only()) {
                         lo += g.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e;
                     } else {
                         for map in [&maps.caustic, &maps.global].into_iter().flatten() {
-                            lo += counted(map, Walls::of(scene, Some(gp.object)), gp.p, gwo, &gfr, g.bsdf, counters)
-                                .radiance;
+                            lo += counted(
+                                map,
+                                Walls::of(scene, Some(gp.object)),
+                                gp.p,
+                                gwo,
+                                &gfr,
+                                g.bsdf,
+                                counters,
+                            )
+                            .radiance;
                         }
                     }
                     sum += beta * lo;

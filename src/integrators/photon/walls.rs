@@ -302,7 +302,10 @@ mod tests {
                 let beyond = Vec3::new(dx, 0.0, 0.95);
                 assert!(hides(&g, q, Vec3::Y, beyond, Vec3::Y), "gap {gap}, {dx}");
                 let before = Vec3::new(-gap - dx, 0.0, 0.95);
-                assert!(!hides(&g, q, Vec3::Y, before, Vec3::Y), "gap {gap}, own {dx}");
+                assert!(
+                    !hides(&g, q, Vec3::Y, before, Vec3::Y),
+                    "gap {gap}, own {dx}"
+                );
             }
         }
     }
@@ -313,7 +316,13 @@ mod tests {
         for x in [-0.04f32, -0.01, 0.0, 0.01, 0.04] {
             let p = Vec3::new(x, 0.0, 0.5);
             assert!(!near_wall(&g, p, Vec3::Y, 0.05), "{x}");
-            assert!(!needs_ray(Vec3::new(0.0, 0.0, 0.49), Vec3::Y, p, Vec3::Y, false));
+            assert!(!needs_ray(
+                Vec3::new(0.0, 0.0, 0.49),
+                Vec3::Y,
+                p,
+                Vec3::Y,
+                false
+            ));
         }
         // Beside the divider, photons are marked.
         let g = rooms(true).build();
@@ -361,7 +370,11 @@ mod tests {
             }
             assert!(tested > 200);
             let on_ball = |theta: f32, phi: f32| {
-                let n = Vec3::new(theta.sin() * phi.cos(), -theta.cos(), theta.sin() * phi.sin());
+                let n = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    -theta.cos(),
+                    theta.sin() * phi.sin(),
+                );
                 (Vec3::new(0.0, r, 0.0) + r * n, n)
             };
             for theta in [0.3f32, 0.8, 1.6, 2.6] {
@@ -390,11 +403,36 @@ mod tests {
         let (lo, hi) = (Vec3::new(0.0, 0.0, -0.01), Vec3::new(0.02, 0.02, 0.01));
         let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
         for f in [
-            [c(lo.x, lo.y, lo.z), c(lo.x, hi.y, lo.z), c(lo.x, hi.y, hi.z), c(lo.x, lo.y, hi.z)],
-            [c(hi.x, lo.y, lo.z), c(hi.x, hi.y, lo.z), c(hi.x, hi.y, hi.z), c(hi.x, lo.y, hi.z)],
-            [c(lo.x, lo.y, lo.z), c(hi.x, lo.y, lo.z), c(hi.x, hi.y, lo.z), c(lo.x, hi.y, lo.z)],
-            [c(lo.x, lo.y, hi.z), c(hi.x, lo.y, hi.z), c(hi.x, hi.y, hi.z), c(lo.x, hi.y, hi.z)],
-            [c(lo.x, hi.y, lo.z), c(hi.x, hi.y, lo.z), c(hi.x, hi.y, hi.z), c(lo.x, hi.y, hi.z)],
+            [
+                c(lo.x, lo.y, lo.z),
+                c(lo.x, hi.y, lo.z),
+                c(lo.x, hi.y, hi.z),
+                c(lo.x, lo.y, hi.z),
+            ],
+            [
+                c(hi.x, lo.y, lo.z),
+                c(hi.x, hi.y, lo.z),
+                c(hi.x, hi.y, hi.z),
+                c(hi.x, lo.y, hi.z),
+            ],
+            [
+                c(lo.x, lo.y, lo.z),
+                c(hi.x, lo.y, lo.z),
+                c(hi.x, hi.y, lo.z),
+                c(lo.x, hi.y, lo.z),
+            ],
+            [
+                c(lo.x, lo.y, hi.z),
+                c(hi.x, lo.y, hi.z),
+                c(hi.x, hi.y, hi.z),
+                c(lo.x, hi.y, hi.z),
+            ],
+            [
+                c(lo.x, hi.y, lo.z),
+                c(hi.x, hi.y, lo.z),
+                c(hi.x, hi.y, hi.z),
+                c(lo.x, hi.y, hi.z),
+            ],
         ] {
             quad(&mut b, f);
         }
@@ -404,12 +442,36 @@ mod tests {
         assert!(!hides(&g, q, Vec3::Y, Vec3::new(-0.03, 0.0, 0.0), Vec3::Y));
         // Beside its side face z = 0.01, 5 mm from it: the floor along the face is seen.
         let side = Vec3::new(0.005, 0.0, 0.015);
-        assert!(!hides(&g, side, Vec3::Y, Vec3::new(0.015, 0.0, 0.03), Vec3::Y));
-        assert!(!hides(&g, side, Vec3::Y, Vec3::new(0.02, 0.0, 0.011), Vec3::Y));
+        assert!(!hides(
+            &g,
+            side,
+            Vec3::Y,
+            Vec3::new(0.015, 0.0, 0.03),
+            Vec3::Y
+        ));
+        assert!(!hides(
+            &g,
+            side,
+            Vec3::Y,
+            Vec3::new(0.02, 0.0, 0.011),
+            Vec3::Y
+        ));
         // On the cube's top, its own photons are visible; the floor is far below its plane.
         let top = Vec3::new(0.01, 0.02, 0.0);
-        assert!(!hides(&g, top, Vec3::Y, Vec3::new(0.015, 0.02, 0.005), Vec3::Y));
+        assert!(!hides(
+            &g,
+            top,
+            Vec3::Y,
+            Vec3::new(0.015, 0.02, 0.005),
+            Vec3::Y
+        ));
         // A query on the floor below the top's plane by more than curvature explains: a ray.
-        assert!(needs_ray(q, Vec3::Y, Vec3::new(0.005, 0.02, 0.0), Vec3::Y, false));
+        assert!(needs_ray(
+            q,
+            Vec3::Y,
+            Vec3::new(0.005, 0.02, 0.0),
+            Vec3::Y,
+            false
+        ));
     }
 }
