@@ -115,6 +115,24 @@ impl PixelSums {
     #[inline]
     pub fn add(&mut self, index: usize, l: Vec3) {
         let l = l.as_dvec3();
+        if l.abs().max_element() < MAIN_LIMIT {
+            let (s, q) = (&mut self.sums[index], &mut self.squares[index]);
+            for c in 0..3 {
+                s[c] = s[c].saturating_add(fixed(l[c], SCALE));
+                q[c] = q[c].saturating_add(fixed(l[c] * l[c], SCALE_SQ));
+            }
+            self.counts[index] += 1;
+        } else {
+            self.add_wide(index, l);
+        }
+    }
+
+    /// [`PixelSums::add`] for a sample with a channel of magnitude [`MAIN_LIMIT`] or more: such
+    /// channels go to the pixel's wide sums, the others to its 128-bit sums as usual. Out of
+    /// line, so that the common path stays small enough to inline into the tile loop.
+    #[cold]
+    #[inline(never)]
+    fn add_wide(&mut self, index: usize, l: DVec3) {
         let (s, q) = (&mut self.sums[index], &mut self.squares[index]);
         for c in 0..3 {
             if l[c].abs() < MAIN_LIMIT {
@@ -138,6 +156,9 @@ impl PixelSums {
             self.squares[to][c] = self.squares[to][c].saturating_add(other.squares[from][c]);
         }
         self.counts[to] += other.counts[from];
+        if other.wide.is_empty() {
+            return;
+        }
         if let Some(w) = other.wide.get(&(from as u32)) {
             self.wide.entry(to as u32).or_default().add(w);
         }
