@@ -182,6 +182,23 @@ impl<'a> PathTracer<'a> {
         ray: Ray,
         cx: &mut Context<'_, O>,
     ) -> Radiance {
+        if self.scene.volumetric {
+            self.trace_paths::<O, true>(maps, ray, cx)
+        } else {
+            self.trace_paths::<O, false>(maps, ray, cx)
+        }
+    }
+
+    /// [`PathTracer::li_with_maps`] with `VOLUMETRIC` = [`RenderScene::volumetric`]: one copy of
+    /// the loop per kind of scene, so that scenes without media run a loop without the media's
+    /// code (it made the path loop of every scene 1.6 % slower in instructions on cbox).
+    fn trace_paths<O: PathObserver, const VOLUMETRIC: bool>(
+        &self,
+        maps: PathMaps<'_>,
+        ray: Ray,
+        cx: &mut Context<'_, O>,
+    ) -> Radiance {
+        debug_assert_eq!(VOLUMETRIC, self.scene.volumetric);
         let scene = self.scene;
         let params = &scene.params;
         let mut l = Radiance::default();
@@ -243,7 +260,7 @@ impl<'a> PathTracer<'a> {
                 let mut textured = None;
                 let mut nested = None;
                 let mut it = scene.interact(&ray, |t| cone.width_at(&ray, t), &mut textured);
-                if scene.volumetric {
+                if VOLUMETRIC {
                     // Participating media (docs/media.md): free-flight sampling along the
                     // segment; an event before the surface is a medium vertex.
                     if let Some(m) = medium.participating(scene) {
@@ -429,8 +446,7 @@ impl<'a> PathTracer<'a> {
                     let u = cx.sampler.get_2d(u_point);
                     let scatter = may_scatter && !read_global;
                     // At diffuse depth 0 direct light is Whitted's: through glass too.
-                    let through =
-                        (params.diffuse_depth == 0 || scene.volumetric).then_some((v, medium));
+                    let through = (params.diffuse_depth == 0 || VOLUMETRIC).then_some((v, medium));
                     let c = self.direct(sp, &at, index, pmf, u, scatter, through, cx, node);
                     l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
                 }
@@ -600,6 +616,7 @@ impl PathTracer<'_> {
     /// shadow ray keeps the media's transmittance, crossing interfaces and false hits only
     /// ([`Medium::transmittance_through`]). Logged as a shadow record.
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     fn direct<O: PathObserver>(
         &self,
         sp: &SurfacePoint,
