@@ -19,6 +19,8 @@ use crate::sampling::Sampler;
 use crate::shading::TransportMode;
 use crate::spatial::Photon;
 
+use super::volume::VolumePhoton;
+
 /// Largest factor by which a photon's flux may grow along its path (the adjoint shading-normal
 /// factor can exceed 1 at grazing angles on bumped surfaces; Veach 1997 §5.3). Bounds the
 /// worst photon's flux so one grazing photon cannot leave a bright spot.
@@ -47,6 +49,8 @@ pub struct TraceCounts {
     pub reached_specular: u64,
     /// Photons stored (a path may store several in the global map).
     pub stored: u64,
+    /// Volume photons stored (caustic paths scattering in a medium, [`trace_photon_into`]).
+    pub volume_stored: u64,
     /// Total flux stored (W per channel).
     pub stored_flux: Vec3,
     /// Photon paths cut by `max_bounces` while they still carried flux.
@@ -65,6 +69,7 @@ impl TraceCounts {
         self.emitted += other.emitted;
         self.reached_specular += other.reached_specular;
         self.stored += other.stored;
+        self.volume_stored += other.volume_stored;
         self.stored_flux += other.stored_flux;
         self.lost_at_depth += other.lost_at_depth;
         self.lost_flux += other.lost_flux;
@@ -111,11 +116,33 @@ impl TraceSettings {
 /// measure what the cut takes away (`lost_flux`).
 pub fn trace_photon(
     scene: &RenderScene,
+    ray: Ray,
+    power: Vec3,
+    settings: TraceSettings,
+    sampler: &mut Sampler,
+    out: &mut Vec<Photon>,
+    counts: &mut TraceCounts,
+) {
+    trace_photon_into(scene, ray, power, settings, sampler, out, None, counts);
+}
+
+/// [`trace_photon`], also storing **volume photons** into `volume` when given (the volume
+/// caustic map, `volume.rs`): a caustic photon crossing a scattering medium after at least one
+/// specular bounce draws a free-flight distance along the segment, and where that falls before
+/// the segment's end stores a photon with its flux times the free-flight weight `σs T(t)/p(t)`
+/// (the flux scattered there, in expectation). The photon itself goes on unscattered with its
+/// expected share `exp(−σt d)`, as without `volume`, so the surface caustic map keeps its
+/// meaning. Global photons store no volume photons. With `volume` `None`, no random number
+/// is drawn for it: the path is [`trace_photon`]'s.
+#[allow(clippy::too_many_arguments)]
+pub fn trace_photon_into(
+    scene: &RenderScene,
     mut ray: Ray,
     mut power: Vec3,
     settings: TraceSettings,
     sampler: &mut Sampler,
     out: &mut Vec<Photon>,
+    mut volume: Option<&mut Vec<VolumePhoton>>,
     counts: &mut TraceCounts,
 ) {
     let max_flux = power.max_element() * MAX_FLUX_GROWTH;
@@ -138,6 +165,27 @@ pub fn trace_photon(
                     Interaction::Surface(v) => v.hit.t * len,
                 };
                 if settings.kind == MapKind::Caustic {
+                    // Light → specular⁺ scattering here: a volume photon where a free flight
+                    // ends before the surface (its flux σs T(t)/p(t) of the photon's).
+                    if bounces > 0
+                        && !cut
+                        && m.scatters()
+                        && let Some(store) = volume.as_deref_mut()
+                        && let Some(id) = medium.participating_index()
+                        && let FreeFlight::Scatter { t, weight } =
+                            m.sample_distance(t_hit, sampler.next_2d())
+                    {
+                        let flux = power * weight;
+                        if flux.is_finite() && flux.max_element() > 0.0 {
+                            store.push(VolumePhoton {
+                                position: ray.origin + ray.dir * (t / len),
+                                direction: ray.dir / len,
+                                power: flux,
+                                medium: id,
+                            });
+                            counts.volume_stored += 1;
+                        }
+                    }
                     // Caustic photons are the light that crosses media without scattering
                     // (a scattered photon is no longer on a specular path): their expected
                     // share, exp(−σt d), instead of sampling events and dropping the scattered.
