@@ -285,6 +285,7 @@ impl<'a> PathTracer<'a> {
                         // Light → specular⁺ → here, scattered anywhere on the segment: the
                         // volume caustic map's beam estimate, where the path may still
                         // scatter (a medium vertex sampled below then counts none of it).
+                        let mut beamed = false;
                         if let Some(vm) = maps.volume
                             && !background_only
                             && depth < params.max_depth
@@ -292,6 +293,7 @@ impl<'a> PathTracer<'a> {
                             && let Some(id) = medium.participating_index()
                         {
                             let e = vm.beam(ray.origin, ray.dir / len, t_hit, id, m);
+                            beamed = true;
                             cx.counters.photon_estimates += 1;
                             l.add(
                                 LightPath::classify(diffuse_bounces + 1, true),
@@ -349,8 +351,9 @@ impl<'a> PathTracer<'a> {
                                 specular = false;
                                 since_local = Some(0);
                                 map_read = false;
-                                // The beam estimate above held this vertex's light → specular⁺.
-                                volume_read = maps.volume.is_some();
+                                // The beam estimate above held this vertex's light → specular⁺
+                                // (it is made wherever a vertex can follow, so always here).
+                                volume_read = beamed;
                                 prev_pdf = s.pdf;
                                 prev_p = p;
                                 kind = RayKind::Scatter;

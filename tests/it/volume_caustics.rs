@@ -225,3 +225,32 @@ fn the_default_and_path_agree_on_volumetric_caustics_and_the_split_is_exact() {
     assert!(cm < 0.67 * pm, "camera paths alone {cm} vs path {pm}");
     assert!((pm - cm) > 10.0 * (pse * pse + cse * cse).sqrt());
 }
+
+/// The volume caustic map is traced in parallel batches and read by every render thread: the
+/// same bytes for 1, 2 and 7 threads, on the gallery's tank with enough photons per pass for
+/// several batches (20 000: 10 batches of 2 048).
+#[test]
+fn volume_caustics_are_the_same_for_any_thread_count() {
+    use caustic::render::{RenderOptions, render};
+    let text =
+        std::fs::read_to_string(crate::common::root().join("benches/scenes/volume_caustic.ron"))
+            .expect("scene");
+    let text = text.replace(
+        "width: 320, height: 240, samples_per_pixel: 64",
+        "width: 40, height: 30, samples_per_pixel: 3",
+    );
+    let mut scene = scene_from_text(&text);
+    scene.params.photons.caustic = 20_000;
+    let images: Vec<Vec<Vec3>> = [1, 2, 7]
+        .iter()
+        .map(|&t| {
+            let options = RenderOptions {
+                threads: Some(t),
+                ..RenderOptions::default()
+            };
+            render(&scene, &options).expect("renders").film.pixels
+        })
+        .collect();
+    assert!(images[0].iter().any(|p| p.max_element() > 0.0));
+    assert!(images[0] == images[1] && images[1] == images[2]);
+}
