@@ -13,8 +13,9 @@
 # RMSE is also given at exactly the budget: its noise part (noise_rmse) scaled by
 # √(cpu/budget), its remainder (bias, and the reference's noise) kept,
 # √(rmse² − noise² + noise²·cpu/budget).
-# REF_SPP (default 2048) and REF_DIR (default ../volume_caustic_ref): the reference is two
-# independent `path` halves of REF_SPP each (seeds 101, 102), rendered once and kept there.
+# REF_SPP (default 16384: about 250 CPU s a half) and REF_DIR (default ../volume_caustic_ref):
+# the reference is two independent `path` halves of REF_SPP each (seeds 101, 102), rendered
+# once and kept there.
 #
 # Figures per estimator, of the mean of its two seeds against the reference's two halves
 # (scripts/mitsuba/z8.py with --ref2 --noise): rmse, relmse, mean_ratio, z8 (χ²/dof of the 8×8
@@ -26,7 +27,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 budget=${1:-40}
-ref_spp=${2:-2048}
+ref_spp=${2:-16384}
 REF_DIR=${3:-../volume_caustic_ref}
 source scripts/caustic_bin.sh
 M=../shared/bench/mitsuba
