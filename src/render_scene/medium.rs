@@ -143,6 +143,14 @@ impl Medium {
         }
     }
 
+    /// The index in `RenderScene::media` of the participating medium that holds, if any (what
+    /// tells a volume photon's medium from another's on either side of a boundary).
+    #[inline]
+    #[must_use]
+    pub fn participating_index(&self) -> Option<u32> {
+        (self.participating != NONE).then_some(self.participating)
+    }
+
     /// The fraction of light (per channel) kept along the segment `ray` travelled to reach
     /// `interaction` (its length is the hit distance times `|ray.dir|`; an escaped ray
     /// travelled infinitely far): the Beer–Lambert `absorption` only. Exactly 1 in a clear
