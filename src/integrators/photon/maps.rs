@@ -209,7 +209,7 @@ pub fn trace_map(
     let results: Vec<(usize, Vec<Photon>, TraceCounts)> = jobs
         .par_iter()
         .map(|&(l, start, end)| {
-            let mut sampler = Sampler::new(params.sampler, params.seed, 1);
+            let mut sampler = Sampler::new(params.sampler, settings.seed, 1);
             let mut out = Vec::new();
             let mut counts = TraceCounts::default();
             let mut cones = Vec::new();
@@ -413,7 +413,12 @@ pub fn build_maps_with(
     let targets = &prepared.targets;
     let cancel = prepared.cancel.as_deref();
     summary.targets = targets.len();
-    let mut sampler = Sampler::new(scene.params.sampler, scene.params.seed, 1);
+    // The pilot maps of a progressive render may take their own seed (a golden check's).
+    let seed = match (pass, p.pilot_seed) {
+        (Some(super::passes::PILOT_PASS), Some(pilot)) => pilot,
+        _ => scene.params.seed,
+    };
+    let mut sampler = Sampler::new(scene.params.sampler, seed, 1);
 
     // Caustic budgets: lights with their own count keep it; the rest share `caustic` by power.
     let shared: Vec<f64> = weights
@@ -463,6 +468,7 @@ pub fn build_maps_with(
             max_bounces: p.max_bounces,
             pass,
             near_specular: set.near_specular,
+            seed,
         };
         let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
         summary.caustic = counts;
@@ -501,6 +507,7 @@ pub fn build_maps_with(
             max_bounces: p.max_bounces,
             pass,
             near_specular: set.near_specular,
+            seed,
         };
         let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
         summary.global = counts;
