@@ -197,6 +197,19 @@ pub fn trace_map(
     settings: TraceSettings,
     cancel: Option<&AtomicBool>,
 ) -> (Vec<Photon>, Vec<TraceCounts>) {
+    trace_map_seeded(scene, emitters, targets, settings, scene.params.seed, cancel)
+}
+
+/// [`trace_map`] with the photon streams of `seed` instead of the render's (a progressive
+/// render's pilot maps with [`crate::render_scene::PhotonParams::pilot_seed`]).
+fn trace_map_seeded(
+    scene: &RenderScene,
+    emitters: &[LightEmitter],
+    targets: &CausticTargets,
+    settings: TraceSettings,
+    seed: u64,
+    cancel: Option<&AtomicBool>,
+) -> (Vec<Photon>, Vec<TraceCounts>) {
     let jobs: Vec<(usize, u64, u64)> = emitters
         .iter()
         .enumerate()
@@ -209,7 +222,7 @@ pub fn trace_map(
     let results: Vec<(usize, Vec<Photon>, TraceCounts)> = jobs
         .par_iter()
         .map(|&(l, start, end)| {
-            let mut sampler = Sampler::new(params.sampler, settings.seed, 1);
+            let mut sampler = Sampler::new(params.sampler, seed, 1);
             let mut out = Vec::new();
             let mut counts = TraceCounts::default();
             let mut cones = Vec::new();
@@ -468,9 +481,8 @@ pub fn build_maps_with(
             max_bounces: p.max_bounces,
             pass,
             near_specular: set.near_specular,
-            seed,
         };
-        let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
+        let (photons, counts) = trace_map_seeded(scene, &e, targets, settings, seed, cancel);
         summary.caustic = counts;
         if is_raised(cancel) {
             return cancelled(summary);
@@ -507,9 +519,8 @@ pub fn build_maps_with(
             max_bounces: p.max_bounces,
             pass,
             near_specular: set.near_specular,
-            seed,
         };
-        let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
+        let (photons, counts) = trace_map_seeded(scene, &e, targets, settings, seed, cancel);
         summary.global = counts;
         if is_raised(cancel) {
             return cancelled(summary);

@@ -91,9 +91,6 @@ pub struct TraceSettings {
     /// through mirrors (caustic paths go on, nothing is stored there, the bounce is not a
     /// diffuse one). `None`: only delta lobes are specular (the photon integrator).
     pub near_specular: Option<f32>,
-    /// The seed of the photon streams: the render's, or for a progressive render's pilot maps
-    /// [`crate::render_scene::PhotonParams::pilot_seed`] when set.
-    pub seed: u64,
 }
 
 impl TraceSettings {
