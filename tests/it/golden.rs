@@ -103,7 +103,10 @@ fn unchanged_progressive_user_scenes_are_called_changed_at_most_at_the_rate_alph
             let v = test
                 .compare((&golden.blocks, &golden.cells), (&now.blocks, &now.cells))
                 .expect("same shape");
-            let s = v.structure.as_ref().expect("16 batches: the structure test runs");
+            let s = v
+                .structure
+                .as_ref()
+                .expect("16 batches: the structure test runs");
             alarms += u32::from(v.changed());
             structure_alarms += u32::from(s.changed());
             old_alarms += u32::from(
@@ -147,7 +150,11 @@ fn every_kind_of_change_is_caught_on_the_pool() {
             "materials.basin.color=[0.4275, 0.6175, 0.7125]",
             false,
         ),
-        ("sun −5 %", "lights[0].irradiance=[2.85, 2.66, 2.375]", false),
+        (
+            "sun −5 %",
+            "lights[0].irradiance=[2.85, 2.66, 2.375]",
+            false,
+        ),
         ("water ior 1.36", "materials.water.ior=1.36", false),
         (
             "ripple amplitude 0.008",
@@ -172,7 +179,11 @@ fn every_kind_of_change_is_caught_on_the_pool() {
         );
         assert!(v.changed(), "{what} missed: structure p {}", s.p);
         if pattern {
-            assert!(s.changed(), "{what}: the structure test missed it (p {})", s.p);
+            assert!(
+                s.changed(),
+                "{what}: the structure test missed it (p {})",
+                s.p
+            );
         }
     }
     eprintln!("power on the pool: {:.1} s", start.elapsed().as_secs_f64());

@@ -197,7 +197,14 @@ pub fn trace_map(
     settings: TraceSettings,
     cancel: Option<&AtomicBool>,
 ) -> (Vec<Photon>, Vec<TraceCounts>) {
-    trace_map_seeded(scene, emitters, targets, settings, scene.params.seed, cancel)
+    trace_map_seeded(
+        scene,
+        emitters,
+        targets,
+        settings,
+        scene.params.seed,
+        cancel,
+    )
 }
 
 /// [`trace_map`] with the photon streams of `seed` instead of the render's (a progressive
