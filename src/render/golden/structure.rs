@@ -489,7 +489,7 @@ pub fn structure_floor(cells: &BatchBlocks, alpha: f64) -> f64 {
     // Every cell as noisy as the median lit cell (noiseless cells would make any change of
     // theirs certain to be caught, and say nothing of the others).
     let sum = n * ratios[ratios.len() / 2];
-    if !(sum > 0.0) {
+    if sum.is_nan() || sum <= 0.0 {
         return f64::INFINITY;
     }
     // λ − z₀.₀₅·√(2N + 4λ) = z_α·√(2N): solve for λ by iteration (increasing in λ).
