@@ -205,19 +205,28 @@ pub fn trace_map(
     settings: TraceSettings,
     cancel: Option<&AtomicBool>,
 ) -> (Vec<Photon>, Vec<TraceCounts>) {
-    let (photons, _, counts) =
-        trace_map_with_volume(scene, emitters, targets, settings, false, cancel);
+    let (photons, _, counts) = trace_map_with_volume(
+        scene,
+        emitters,
+        targets,
+        settings,
+        scene.params.seed,
+        false,
+        cancel,
+    );
     (photons, counts)
 }
 
-/// [`trace_map`], also storing the caustic paths' volume photons when `volume` is true
-/// ([`trace_photon_into`]), in the same (light, index) order: the same list for any thread
-/// count.
+/// [`trace_map`] with the photon streams of `seed` instead of the render's (a progressive
+/// render's pilot maps with [`crate::render_scene::PhotonParams::pilot_seed`]), also storing
+/// the caustic paths' volume photons when `volume` is true ([`trace_photon_into`]), in the same
+/// (light, index) order: the same list for any thread count.
 pub fn trace_map_with_volume(
     scene: &RenderScene,
     emitters: &[LightEmitter],
     targets: &CausticTargets,
     settings: TraceSettings,
+    seed: u64,
     volume: bool,
     cancel: Option<&AtomicBool>,
 ) -> (Vec<Photon>, Vec<VolumePhoton>, Vec<TraceCounts>) {
@@ -233,7 +242,7 @@ pub fn trace_map_with_volume(
     let results: Vec<(usize, Vec<Photon>, Vec<VolumePhoton>, TraceCounts)> = jobs
         .par_iter()
         .map(|&(l, start, end)| {
-            let mut sampler = Sampler::new(params.sampler, params.seed, 1);
+            let mut sampler = Sampler::new(params.sampler, seed, 1);
             let mut out = Vec::new();
             let mut vol = Vec::new();
             let mut counts = TraceCounts::default();
@@ -452,7 +461,12 @@ pub fn build_maps_with(
     let targets = &prepared.targets;
     let cancel = prepared.cancel.as_deref();
     summary.targets = targets.len();
-    let mut sampler = Sampler::new(scene.params.sampler, scene.params.seed, 1);
+    // The pilot maps of a progressive render may take their own seed (a golden check's).
+    let seed = match (pass, p.pilot_seed) {
+        (Some(super::passes::PILOT_PASS), Some(pilot)) => pilot,
+        _ => scene.params.seed,
+    };
+    let mut sampler = Sampler::new(scene.params.sampler, seed, 1);
 
     // Caustic budgets: lights with their own count keep it; the rest share `caustic` by power.
     let shared: Vec<f64> = weights
@@ -505,7 +519,7 @@ pub fn build_maps_with(
             near_specular: set.near_specular,
         };
         let (photons, volume, counts) =
-            trace_map_with_volume(scene, &e, targets, settings, set.volume, cancel);
+            trace_map_with_volume(scene, &e, targets, settings, seed, set.volume, cancel);
         volume_photons = volume;
         summary.caustic = counts;
         if is_raised(cancel) {
@@ -544,7 +558,8 @@ pub fn build_maps_with(
             pass,
             near_specular: set.near_specular,
         };
-        let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
+        let (photons, _, counts) =
+            trace_map_with_volume(scene, &e, targets, settings, seed, false, cancel);
         summary.global = counts;
         if is_raised(cancel) {
             return cancelled(summary);

@@ -383,7 +383,7 @@ fn coarse_batches(b: &BatchBlocks, x0: u32, y0: u32, span: u32) -> Vec<[f64; 3]>
 
 /// The mean of a block's batch means weighted by the batches' samples, and the estimated
 /// variance of that mean: Σ wⱼ² (mⱼ − m̄)² / (Σ w)² · K/(K − 1) (s²/K for equal batches).
-fn mean_and_variance(values: &[[f64; 3]], weights: &[u32]) -> ([f64; 3], [f64; 3]) {
+pub(crate) fn mean_and_variance(values: &[[f64; 3]], weights: &[u32]) -> ([f64; 3], [f64; 3]) {
     let k = values.len() as f64;
     let total: f64 = weights.iter().map(|w| f64::from(*w)).sum();
     let mut mean = [0.0; 3];
