@@ -22,6 +22,10 @@ use crate::sampling::Sampler;
 use crate::sampling::rng::mix64;
 use crate::spatial::{KdTree, Photon};
 
+/// The pass number whose photon streams make the pilot maps of the radius fields (`passes.rs`). Sample
+/// indices are below the `u32` sample count, so no pass of a render is ever this one.
+pub const PILOT_PASS: u32 = u32::MAX;
+
 /// Photons per parallel work item.
 const BATCH: u64 = 2048;
 
@@ -463,7 +467,7 @@ pub fn build_maps_with(
     summary.targets = targets.len();
     // The pilot maps of a progressive render may take their own seed (a golden check's).
     let seed = match (pass, p.pilot_seed) {
-        (Some(super::passes::PILOT_PASS), Some(pilot)) => pilot,
+        (Some(PILOT_PASS), Some(pilot)) => pilot,
         _ => scene.params.seed,
     };
     let mut sampler = Sampler::new(scene.params.sampler, seed, 1);

@@ -21,7 +21,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use super::maps::{MapScene, MapSet, PhotonMaps, build_maps_with};
+use super::maps::{MapScene, MapSet, PILOT_PASS, PhotonMaps, build_maps_with};
 use super::radius_field::RadiusField;
 use super::volume::{VolumeMap, volume_radius_field};
 use crate::render_scene::RenderScene;
@@ -46,10 +46,6 @@ impl RadiusSchedule {
         r2.sqrt() as f32
     }
 }
-
-/// The pass number whose photon streams make the pilot maps of the radius fields. Sample
-/// indices are below the `u32` sample count, so no pass of a render is ever this one.
-pub const PILOT_PASS: u32 = u32::MAX;
 
 /// The radius fields of the caustic and global maps (`None`: that map has no pilot photons).
 #[derive(Debug, Clone, Default)]

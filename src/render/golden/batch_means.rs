@@ -26,6 +26,10 @@ use glam::DVec3;
 use super::quantile::{student_upper_quantile, student_upper_tail};
 use crate::render::PixelSums;
 
+/// Probability of catching a change at the detection floor (the floors of the block means,
+/// `floor.rs`, and of the structure test, `structure.rs`).
+pub const POWER: f64 = 0.95;
+
 /// Most batches a golden keeps: beyond about 60 degrees of freedom Student's t is within 2 % of
 /// the normal law at the test's quantiles, and more batches only grow the file.
 pub const MAX_BATCHES: u32 = 64;

@@ -15,8 +15,7 @@ use super::batch_means::{BatchBlocks, MAX_BATCHES, scale_spans};
 use super::quantile::student_upper_quantile;
 use crate::integrators::photon::RadiusSchedule;
 
-/// Probability of catching a change at the floor.
-pub const POWER: f64 = 0.95;
+pub use super::batch_means::POWER;
 
 /// Fraction of the image the `--detect` advice aims at: a change over a square this share of
 /// the image (the scale whose blocks are closest to it in area).

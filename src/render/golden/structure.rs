@@ -495,7 +495,7 @@ pub fn structure_floor(cells: &BatchBlocks, alpha: f64) -> f64 {
     // λ − z₀.₀₅·√(2N + 4λ) = z_α·√(2N): solve for λ by iteration (increasing in λ).
     let (za, zb) = (
         normal_upper_quantile(alpha),
-        normal_upper_quantile(1.0 - super::floor::POWER),
+        normal_upper_quantile(1.0 - super::batch_means::POWER),
     );
     let c = za * (2.0 * n).sqrt();
     let mut lambda = c;
