@@ -209,19 +209,7 @@ pub fn recommend_structure_spp(
     let min = super::structure::MIN_BATCHES as u32;
     let reaches =
         |spp: u32| predicted_structure_floor(floor, golden_spp, spp, progressive_alpha) <= target;
-    let (mut lo, mut hi) = (min, min);
-    while !reaches(hi) {
-        if hi >= limit {
-            return None;
-        }
-        lo = hi;
-        hi = hi.saturating_mul(2).min(limit);
-    }
-    while lo < hi {
-        let mid = lo + (hi - lo) / 2;
-        if reaches(mid) { hi = mid } else { lo = mid + 1 }
-    }
-    Some(hi)
+    fewest_spp(min, limit, reaches)
 }
 
 /// The fewest samples per pixel (at least 2, at most `limit`) whose predicted floor at `scale`
@@ -239,7 +227,14 @@ pub fn recommend_spp(
     let reaches = |spp: u32| {
         predicted_floor(floor, scale, golden_spp, spp, alpha, progressive_alpha) <= target
     };
-    let (mut lo, mut hi) = (2u32, 2u32);
+    // The predicted floor falls with spp (fewer-batch t quantiles and 1/√spp both help).
+    fewest_spp(2, limit, reaches)
+}
+
+/// The fewest samples per pixel from `start` to `limit` for which `reaches` holds, assuming it
+/// stays true above (doubling, then bisection); `None` when even `limit` does not reach.
+fn fewest_spp(start: u32, limit: u32, reaches: impl Fn(u32) -> bool) -> Option<u32> {
+    let (mut lo, mut hi) = (start, start);
     while !reaches(hi) {
         if hi >= limit {
             return None;
@@ -247,7 +242,6 @@ pub fn recommend_spp(
         lo = hi;
         hi = hi.saturating_mul(2).min(limit);
     }
-    // The predicted floor falls with spp (fewer-batch t quantiles and 1/√spp both help).
     while lo < hi {
         let mid = lo + (hi - lo) / 2;
         if reaches(mid) { hi = mid } else { lo = mid + 1 }
