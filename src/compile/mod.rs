@@ -23,9 +23,6 @@ use std::time::{Duration, Instant};
 // The validator's bound on a volumetric scene's materials is the one the volume stack holds.
 use crate::render_scene::medium::MAX_VOLUMETRIC_MATERIALS;
 
-// The validator's bound on a volumetric scene's materials is the one the volume stack holds.
-const _: () = assert!(crate::scene::validate::MAX_VOLUMETRIC_MATERIALS == MAX_VOLUMETRIC_MATERIALS);
-
 use crate::accel::BvhStats;
 use crate::geometry::quadric::QuadricShape;
 use crate::render_scene::geometry::GeometryBuilder;
@@ -198,7 +195,7 @@ pub fn compile_with(
             m.interior.priority.is_some() || m.interior.medium.is_some() || m.interior.interface
         });
     if volumetric && materials.list.len() > MAX_VOLUMETRIC_MATERIALS {
-        // Imported (glTF, .mtl) materials count too, which validation does not see.
+        // Counted here, not in validation: imported (glTF, .mtl) materials count too.
         return Err(vec![Diagnostic::error(
             "materials",
             format!(

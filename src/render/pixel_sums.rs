@@ -116,15 +116,21 @@ impl PixelSums {
     pub fn add(&mut self, index: usize, l: Vec3) {
         let l = l.as_dvec3();
         if l.abs().max_element() < MAIN_LIMIT {
-            let (s, q) = (&mut self.sums[index], &mut self.squares[index]);
             for c in 0..3 {
-                s[c] = s[c].saturating_add(fixed(l[c], SCALE));
-                q[c] = q[c].saturating_add(fixed(l[c] * l[c], SCALE_SQ));
+                self.add_main(index, c, l[c]);
             }
             self.counts[index] += 1;
         } else {
             self.add_wide(index, l);
         }
+    }
+
+    /// Adds sample channel value `v` (magnitude below [`MAIN_LIMIT`]) to channel `c` of pixel
+    /// `index`'s 128-bit sums.
+    #[inline(always)]
+    fn add_main(&mut self, index: usize, c: usize, v: f64) {
+        self.sums[index][c] = self.sums[index][c].saturating_add(fixed(v, SCALE));
+        self.squares[index][c] = self.squares[index][c].saturating_add(fixed(v * v, SCALE_SQ));
     }
 
     /// [`PixelSums::add`] for a sample with a channel of magnitude [`MAIN_LIMIT`] or more: such
@@ -133,11 +139,9 @@ impl PixelSums {
     #[cold]
     #[inline(never)]
     fn add_wide(&mut self, index: usize, l: DVec3) {
-        let (s, q) = (&mut self.sums[index], &mut self.squares[index]);
         for c in 0..3 {
             if l[c].abs() < MAIN_LIMIT {
-                s[c] = s[c].saturating_add(fixed(l[c], SCALE));
-                q[c] = q[c].saturating_add(fixed(l[c] * l[c], SCALE_SQ));
+                self.add_main(index, c, l[c]);
             } else {
                 // Integral at both scales (|l| ≥ 2³⁰), so the conversion is exact.
                 let w = self.wide.entry(index as u32).or_default();

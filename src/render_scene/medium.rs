@@ -100,7 +100,7 @@ pub struct Medium {
     len: u8,
     /// Material indices of the volumes entered, oldest first (`len` of them). 16 bits, so that
     /// the medium every path vertex carries stays small (a volumetric scene has at most
-    /// [`MAX_VOLUMETRIC_MATERIALS`] materials: validation says so).
+    /// [`MAX_VOLUMETRIC_MATERIALS`] materials: compilation says so).
     volumes: [u16; MAX_VOLUMES],
 }
 

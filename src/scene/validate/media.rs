@@ -5,11 +5,6 @@ use super::*;
 use crate::scene::schema::{LightSpec, MediumSpec};
 use crate::settings::IntegratorKind;
 
-/// Most materials a scene with media, priorities or interfaces may have: the volume stack each
-/// path carries stores material indices in 16 bits (`render_scene::medium`, whose constant of
-/// the same name `compile` checks equal to this one).
-pub const MAX_VOLUMETRIC_MATERIALS: usize = 1 << 16;
-
 impl<'a> Validator<'a> {
     /// Every medium's coefficients, the scene's `medium`, and the integrator.
     pub(super) fn media(&mut self, scene: &'a SceneFile) {
@@ -45,18 +40,6 @@ impl<'a> Validator<'a> {
                 .materials
                 .values()
                 .any(|m| m.medium.is_some() || m.priority.is_some() || m.interface);
-        if volumetric && scene.materials.len() > MAX_VOLUMETRIC_MATERIALS {
-            self.out.push(
-                Diagnostic::error(
-                    "materials",
-                    format!(
-                        "a scene with media, priorities or interfaces may have at most {MAX_VOLUMETRIC_MATERIALS} materials; this one has {}",
-                        scene.materials.len()
-                    ),
-                )
-                .with_help("merge materials that are the same, or split the scene"),
-            );
-        }
         if let Some(kind @ (IntegratorKind::Whitted | IntegratorKind::Photon)) =
             scene.render.integrator
             && volumetric

@@ -3,7 +3,6 @@
 mod light;
 mod material;
 mod media;
-pub use media::MAX_VOLUMETRIC_MATERIALS;
 mod node;
 mod photons;
 mod render;
