@@ -8,17 +8,21 @@
 #        room), with the scene's own integrator (the default estimator where none is named)
 #        and with `--integrator path`: one `golden update` at W×H, SPP, then N `golden check`s
 #        of the unchanged scene with seeds 1001…1000+N. A check that says "changed" (exit 3) is
-#        a false alarm. Writes OUT/false.tsv (kind, integrator, scene, alarms, checks) as it
-#        goes, so a stopped run keeps what it measured.
-# power  On tests/golden_scenes/pool_sun.ron (and scenes/cornell.ron for a colour and a
-#        light): `golden update --detect 5%` (the spp it recommends for a 5 % floor), then NP
-#        checks of each change: a material colour 5 % darker, one light 5 % dimmer, the
-#        water's ior 1.33 → 1.36, the ripple amplitude 0.004 → 0.005. A check that says
-#        "changed" caught it. Writes OUT/power.tsv.
-# cost   `golden update --detect 5%` of every scene in scenes/ at W×H, then the wall time of
-#        one `golden check scenes/` (run this on an idle machine: `taskset -c 0,1`).
+#        a false alarm. Writes OUT/false.tsv (kind, integrator, scene, alarms, checks, spp) as
+#        it goes, so a stopped run keeps what it measured. SPP defaults to 16: at least 12
+#        batches, so that the structure test runs besides the block means.
+# power  On tests/golden_scenes/pool_sun.ron and scenes/cornell.ron: one `golden update
+#        --detect 5%` per scene (the spp it recommends for a 5 % floor), then NP checks of each
+#        change against it: a material colour 5 % darker, one light 5 % dimmer, the water's
+#        ior 1.33 → 1.36, the ripple amplitude 0.004 → 0.005, 0.006 and 0.008. A check that
+#        says "changed" caught it. Writes OUT/power.tsv.
+# cost   `golden update --detect 5%` of every scene in scenes/ at W×H, then the CPU time
+#        (user + system, /usr/bin/time) of one `golden check scenes/` at those settings, and
+#        of each scene's check alone. Writes OUT/cost.tsv.
 #
-# Environment: N (200), NP (40), W (40), H (30), SPP (8), INTEGRATORS ("default path").
+# Environment: N (200), NP (40), W (40), H (30), SPP (16), INTEGRATORS ("default path"),
+# SCENES_ONLY (a space-separated list of scene paths instead of all), THREADS (passed as
+# --threads), CASES (power cases in order: "colour sun ior ripple8 ripple6 ripple5 red light").
 # Summarize with: scripts/golden_calibration.sh BIN OUT summary (rates with 95 % Wilson
 # intervals). Run it in the background on a shared machine:
 #   nice -n 10 scripts/golden_calibration.sh target/release/caustic /tmp/gcal all > /tmp/gcal.log 2>&1 &
@@ -30,8 +34,12 @@ N=${N:-200}
 NP=${NP:-40}
 W=${W:-40}
 H=${H:-30}
-SPP=${SPP:-8}
+SPP=${SPP:-16}
 INTEGRATORS=${INTEGRATORS:-default path}
+THREADS=${THREADS:-}
+CASES=${CASES:-colour sun ior ripple8 ripple6 ripple5 red light}
+THREAD_FLAGS=()
+if [ -n "$THREADS" ]; then THREAD_FLAGS=(--threads "$THREADS"); fi
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=$(cd "$(dirname "$BIN")" && pwd)/$(basename "$BIN")
 mkdir -p "$OUT"
@@ -40,6 +48,9 @@ cd "$ROOT" || exit 2
 
 # The user-written scenes first (the progressive ones the issue found failing), then scenes/.
 SCENES=(tests/golden_scenes/*.ron scenes/*.ron scenes/*.toml)
+if [ -n "${SCENES_ONLY:-}" ]; then
+    read -r -a SCENES <<<"$SCENES_ONLY"
+fi
 
 flags_for() { # integrator → extra flags
     if [ "$1" = path ]; then echo "--integrator path"; fi
@@ -53,14 +64,14 @@ false_alarms() {
             mkdir -p "$dir"
             # shellcheck disable=SC2046
             if ! "$BIN" golden update "$scene" -o "$dir" --width "$W" --height "$H" --spp "$SPP" \
-                $(flags_for "$integ") -q >"$dir/update.txt" 2>&1; then
+                $(flags_for "$integ") "${THREAD_FLAGS[@]}" -q >"$dir/update.txt" 2>&1; then
                 echo "update failed: $scene ($integ)" >&2
                 continue
             fi
             alarms=0
             for i in $(seq 1 "$N"); do
                 "$BIN" golden check "$scene" --golden "$dir" --seed $((1000 + i)) -q \
-                    --error-dir "$dir/errors" >"$dir/check.txt" 2>&1
+                    "${THREAD_FLAGS[@]}" --error-dir "$dir/errors" >"$dir/check.txt" 2>&1
                 rc=$?
                 if [ $rc -eq 3 ]; then
                     alarms=$((alarms + 1))
@@ -69,32 +80,42 @@ false_alarms() {
                     echo "check failed ($rc): $scene ($integ) seed $((1000 + i))" >&2
                 fi
             done
-            printf 'false\t%s\t%s\t%d\t%d\n' "$integ" "$name" "$alarms" "$N" >>"$OUT/false.tsv"
+            printf 'false\t%s\t%s\t%d\t%d\t%s\n' "$integ" "$name" "$alarms" "$N" "$SPP" >>"$OUT/false.tsv"
             echo "false alarms: $integ $name $alarms / $N"
         done
     done
 }
 
-# power INTEGRATOR SCENE LABEL SET...
+# golden_for INTEGRATOR SCENE → prints the folder of its `--detect 5%` golden (made once).
+golden_for() {
+    local integ=$1 scene=$2
+    local dir
+    dir="$OUT/power/$integ/$(basename "$scene")"
+    if [ ! -f "$dir/$(basename "$scene").golden" ]; then
+        mkdir -p "$dir"
+        # shellcheck disable=SC2046
+        "$BIN" golden update "$scene" -o "$dir" --width "$W" --height "$H" --spp "$SPP" --detect 5% \
+            $(flags_for "$integ") "${THREAD_FLAGS[@]}" -q >"$dir/update.txt" 2>&1 ||
+            echo "update failed: $scene ($integ)" >&2
+    fi
+    echo "$dir"
+}
+
+# power_case INTEGRATOR SCENE LABEL SET...
 power_case() {
     local integ=$1 scene=$2 label=$3
     shift 3
-    local dir="$OUT/power/$integ/$label"
-    mkdir -p "$dir"
-    # shellcheck disable=SC2046
-    "$BIN" golden update "$scene" -o "$dir" --width "$W" --height "$H" --spp "$SPP" --detect 5% \
-        $(flags_for "$integ") -q >"$dir/update.txt" 2>&1 || {
-        echo "update failed: $label" >&2
-        return
-    }
+    local dir
+    dir=$(golden_for "$integ" "$scene")
+    [ -f "$dir/$(basename "$scene").golden" ] || return
     local spp
-    spp=$(grep -o '[0-9]* spp' "$dir/update.txt" | tail -1 | cut -d' ' -f1)
+    spp=$(grep -o '[0-9]* spp, ' "$dir/update.txt" | tail -1 | cut -d' ' -f1)
     local caught=0
     local sets=()
     for s in "$@"; do sets+=(--set "$s"); done
     for i in $(seq 1 "$NP"); do
         "$BIN" golden check "$scene" --golden "$dir" --seed $((5000 + i)) -q "${sets[@]}" \
-            --error-dir "$dir/errors" >"$dir/check.txt" 2>&1
+            "${THREAD_FLAGS[@]}" --error-dir "$dir/errors" >"$dir/check.txt" 2>&1
         [ $? -eq 3 ] && caught=$((caught + 1))
     done
     printf 'power\t%s\t%s\t%d\t%d\t%s\n' "$integ" "$label" "$caught" "$NP" "$spp" >>"$OUT/power.tsv"
@@ -104,12 +125,19 @@ power_case() {
 power() {
     local pool=tests/golden_scenes/pool_sun.ron cornell=scenes/cornell.ron
     for integ in $INTEGRATORS; do
-        power_case "$integ" "$pool" "pool: basin colour -5%" "materials.basin.color=[0.4275, 0.6175, 0.7125]"
-        power_case "$integ" "$pool" "pool: sun -5%" "lights[0].irradiance=[2.85, 2.66, 2.375]"
-        power_case "$integ" "$pool" "pool: water ior 1.33->1.36" "materials.water.ior=1.36"
-        power_case "$integ" "$pool" "pool: ripple amplitude 0.004->0.005" "textures.ripples.amplitude=0.005"
-        power_case "$integ" "$cornell" "cornell: red wall -5%" "materials.red.color=[0.665, 0.114, 0.095]"
-        power_case "$integ" "$cornell" "cornell: light -5%" "lights[0].power=[42.75, 40.85, 37.05]"
+        for case in $CASES; do
+            case "$case" in
+            colour) power_case "$integ" "$pool" "pool: basin colour -5%" "materials.basin.color=[0.4275, 0.6175, 0.7125]" ;;
+            sun) power_case "$integ" "$pool" "pool: sun -5%" "lights[0].irradiance=[2.85, 2.66, 2.375]" ;;
+            ior) power_case "$integ" "$pool" "pool: water ior 1.33->1.36" "materials.water.ior=1.36" ;;
+            ripple8) power_case "$integ" "$pool" "pool: ripple amplitude 0.004->0.008" "textures.ripples.amplitude=0.008" ;;
+            ripple6) power_case "$integ" "$pool" "pool: ripple amplitude 0.004->0.006" "textures.ripples.amplitude=0.006" ;;
+            ripple5) power_case "$integ" "$pool" "pool: ripple amplitude 0.004->0.005" "textures.ripples.amplitude=0.005" ;;
+            red) power_case "$integ" "$cornell" "cornell: red wall -5%" "materials.red.color=[0.665, 0.114, 0.095]" ;;
+            light) power_case "$integ" "$cornell" "cornell: light -5%" "lights[0].power=[42.75, 40.85, 37.05]" ;;
+            *) echo "unknown power case \`$case\`" >&2 ;;
+            esac
+        done
     done
 }
 
@@ -117,12 +145,21 @@ cost() {
     local dir="$OUT/cost"
     mkdir -p "$dir"
     "$BIN" golden update scenes/ -o "$dir" --width "$W" --height "$H" --spp "$SPP" --detect 5% -q \
-        >"$dir/update.txt" 2>&1
-    local t0 t1
-    t0=$(date +%s.%N)
-    "$BIN" golden check scenes/ --golden "$dir" -q >"$dir/check.txt" 2>&1
-    t1=$(date +%s.%N)
-    echo "cost: golden check scenes/ at the --detect 5% settings: $(echo "$t1 - $t0" | bc) s" | tee "$OUT/cost.txt"
+        "${THREAD_FLAGS[@]}" >"$dir/update.txt" 2>&1
+    : >"$OUT/cost.tsv"
+    for scene in scenes/*.ron scenes/*.toml; do
+        /usr/bin/time -f '%U %S %e' -o "$dir/time.txt" \
+            "$BIN" golden check "$scene" --golden "$dir" -q "${THREAD_FLAGS[@]}" >/dev/null 2>&1
+        local spp
+        spp=$(grep "^$scene:" "$dir/update.txt" | grep -o '[0-9]* spp, ' | tail -1 | cut -d' ' -f1)
+        read -r user sys wall <"$dir/time.txt"
+        printf 'cost\t%s\t%s\t%s\t%s\t%s\n' "$(basename "$scene")" "$spp" "$user" "$sys" "$wall" >>"$OUT/cost.tsv"
+        echo "cost: $scene at $spp spp: user $user s, system $sys s, wall $wall s"
+    done
+    /usr/bin/time -f '%U %S %e' -o "$dir/time.txt" \
+        "$BIN" golden check scenes/ --golden "$dir" -q "${THREAD_FLAGS[@]}" >"$dir/check.txt" 2>&1
+    read -r user sys wall <"$dir/time.txt"
+    echo "cost: golden check scenes/ at the --detect 5% settings: user $user s, system $sys s (CPU $(echo "$user + $sys" | bc) s), wall $wall s" | tee "$OUT/cost.txt"
 }
 
 summary() {
@@ -141,8 +178,8 @@ for f, title in (("false.tsv", "false alarms"), ("power.tsv", "caught")):
     path = os.path.join(out, f)
     if not os.path.exists(path):
         continue
-    print(f"| integrator | scene / change | {title} | rate | 95 % interval |" + (" spp |" if f == "power.tsv" else ""))
-    print("|---|---|---|---|---|" + ("---|" if f == "power.tsv" else ""))
+    print(f"| integrator | scene / change | {title} | rate | 95 % interval | spp |")
+    print("|---|---|---|---|---|---|")
     for line in open(path):
         parts = line.rstrip("\n").split("\t")
         integ, name, k, n = parts[1], parts[2], int(parts[3]), int(parts[4])

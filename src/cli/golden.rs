@@ -16,7 +16,7 @@ use caustic::pipeline::{SceneOverrides, prepare};
 use caustic::render::RenderOptions;
 use caustic::render::golden::floor::{self, DetectSearch, DetectStep, DetectionFloor};
 use caustic::render::golden::{
-    BatchBlocks, BatchTest, GoldenImage, GoldenMeta, PixelEstimates, golden_file_name,
+    BatchBlocks, GoldenImage, GoldenMeta, GoldenTest, PixelEstimates, golden_file_name,
     render_batches, report, scene_files,
 };
 use caustic::settings::{IntegratorKind, SamplerKind};
@@ -215,22 +215,28 @@ fn combined(
 struct Rendered {
     estimates: PixelEstimates,
     batches: BatchBlocks,
+    cells: BatchBlocks,
     meta: GoldenMeta,
     /// The settings hash as if rendered with `hash_seed` instead of its own seed.
     hash_at_seed: u64,
 }
 
 /// Prepares and renders `path` batch by batch; refuses fewer than 2 samples per pixel (no
-/// noise estimate).
+/// noise estimate). `golden_seed` (a check's) is the golden's seed: the settings hash is also
+/// computed as if rendered with it, and the progressive integrators' pilot maps are traced
+/// from it, so that golden and check have the same radius field and thus the same expected
+/// image (docs/golden.md).
 fn render_scene(
     path: &Path,
     overrides: &SceneOverrides,
     block: u32,
     threads: Option<usize>,
     quiet: bool,
-    hash_seed: Option<u64>,
+    golden_seed: Option<u64>,
 ) -> Result<Rendered, Error> {
+    let hash_seed = golden_seed;
     let mut prepared = prepare(path, overrides)?;
+    prepared.render_scene.params.photons.pilot_seed = golden_seed;
     if !quiet {
         print_warnings(&prepared.warnings);
     }
@@ -277,6 +283,7 @@ fn render_scene(
     Ok(Rendered {
         estimates: PixelEstimates::from_sums(&out.output.sums),
         batches: out.batches,
+        cells: out.cells,
         meta,
         hash_at_seed,
     })
@@ -292,24 +299,26 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
     let overrides = a.scene.overrides();
     for path in &scenes {
         let mut r = render_scene(path, &overrides, a.block, a.threads, a.quiet, None)?;
-        let mut floor = DetectionFloor::of(&r.batches, a.alpha);
+        let mut floor = DetectionFloor::of(&r.batches, &r.cells, a.alpha);
         if let Some(target) = a.detect {
             let (w, h) = (r.estimates.width, r.estimates.height);
             let mut search = DetectSearch::new(target, a.alpha, a.detect_limit);
             while let DetectStep::Render(spp) = search.next(&floor, r.meta.spp, w, h) {
                 let scale = &floor.scales[floor.detect_scale(w, h)];
                 println!(
-                    "{}: {} spp catch a change of {} % over {side}×{side} px (≈ {} % of the image) in 95 % of checks; measuring at {spp} spp",
+                    "{}: {} spp catch a change of {} % over {side}×{side} px (≈ {} % of the image), or a pattern change of ±{} % over {cell}×{cell} px cells, in 95 % of checks; measuring at {spp} spp",
                     path.display(),
                     r.meta.spp,
                     report::number((1000.0 * scale.median).round() / 10.0),
                     report::number(100.0 * floor::DETECT_AREA),
-                    side = scale.side
+                    report::number((1000.0 * floor.structure).round() / 10.0),
+                    side = scale.side,
+                    cell = floor.cell
                 );
                 let mut more = overrides.clone();
                 more.render.samples_per_pixel = Some(spp);
                 let next = render_scene(path, &more, a.block, a.threads, a.quiet, None)?;
-                let next_floor = DetectionFloor::of(&next.batches, a.alpha);
+                let next_floor = DetectionFloor::of(&next.batches, &next.cells, a.alpha);
                 let (was, now) = (
                     search.reached(&floor, w, h),
                     search.reached(&next_floor, w, h),
@@ -325,7 +334,7 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
             }
             if !search.reached(&floor, w, h) {
                 println!(
-                    "{}: warning: {} spp do not reach a floor of {} % over {side}×{side} px (--detect-limit {})",
+                    "{}: warning: {} spp do not reach a floor of {} % over {side}×{side} px and over the structure test's cells (--detect-limit {})",
                     path.display(),
                     r.meta.spp,
                     report::number(100.0 * target),
@@ -340,6 +349,7 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
         GoldenImage {
             estimates: r.estimates,
             batches: r.batches,
+            cells: r.cells,
             meta: r.meta,
         }
         .write(&target)?;
@@ -355,7 +365,7 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
 
 fn check(a: &CheckArgs) -> Result<(), Error> {
     let scenes = scene_files(&a.scene.scene, &a.more).map_err(|e| usage(e.to_string()))?;
-    let test = BatchTest { alpha: a.alpha };
+    let test = GoldenTest { alpha: a.alpha };
     let own = a.scene.overrides();
     let error_dir = a.error_dir.clone().unwrap_or_else(|| a.golden.clone());
     let (mut changed, mut failed) = (0usize, 0usize);
@@ -393,7 +403,7 @@ fn check_one(
     path: &Path,
     a: &CheckArgs,
     own: &SceneOverrides,
-    test: &BatchTest,
+    test: &GoldenTest,
     error_dir: &Path,
 ) -> Result<Outcome, Error> {
     let golden_path = a.golden.join(golden_file_name(path));
@@ -421,6 +431,7 @@ fn check_one(
         &verdict::Now {
             estimates: &r.estimates,
             batches: &r.batches,
+            cells: &r.cells,
             meta: &r.meta,
             hash_at_golden_seed: r.hash_at_seed,
         },

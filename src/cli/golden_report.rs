@@ -10,7 +10,7 @@ use caustic::Error;
 use caustic::render::golden::pixel_variance::pixel_z;
 use caustic::render::golden::report;
 use caustic::render::golden::{
-    BatchBlocks, BatchTest, BatchVerdict, GoldenImage, GoldenMeta, PixelEstimates,
+    BatchBlocks, BatchVerdict, GoldenImage, GoldenMeta, GoldenTest, PixelEstimates,
 };
 
 use caustic::analysis::error_image::{self, ErrorScale};
@@ -29,6 +29,8 @@ pub struct Now<'a> {
     pub estimates: &'a PixelEstimates,
     /// Block means per batch (for the test).
     pub batches: &'a BatchBlocks,
+    /// Cell means per batch (for the structure test).
+    pub cells: &'a BatchBlocks,
     /// What it was rendered from.
     pub meta: &'a GoldenMeta,
     /// Its settings hash computed with the golden's seed.
@@ -50,7 +52,7 @@ pub fn report(
     path: &Path,
     golden: &GoldenImage,
     now: &Now<'_>,
-    test: &BatchTest,
+    test: &GoldenTest,
     error_dir: &Path,
 ) -> Result<Outcome, Error> {
     let name = path.display();
@@ -85,14 +87,16 @@ pub fn report(
         );
         return Ok(Outcome::Changed);
     }
-    let v = test
-        .compare(&golden.batches, now.batches)
+    let verdict = test
+        .compare((&golden.batches, &golden.cells), (now.batches, now.cells))
         .map_err(|e| Error::Usage(format!("{name}: {e}")))?;
+    let v = &verdict.blocks;
     let seeds = format!("seed {}, golden's {}", now.meta.seed, golden.meta.seed);
-    if !v.changed() {
+    if !verdict.changed() {
         println!(
-            "{name}: same within noise ({}; {seeds})",
-            report::summary(&v)
+            "{name}: same within noise ({}; {}; {seeds})",
+            report::summary(v),
+            report::structure_summary(&verdict.structure)
         );
         return Ok(Outcome::Same);
     }
@@ -102,18 +106,26 @@ pub fn report(
         path.file_name()
             .map_or_else(|| "scene".into(), |n| n.to_string_lossy().into_owned())
     ));
-    write_error_image(g, now.estimates, &v, &image)?;
+    write_error_image(g, now.estimates, v, &image)?;
+    let structure = verdict.structure.as_ref().ok().filter(|s| s.changed());
+    let what = match (changed.len(), structure.is_some()) {
+        (0, _) => "the pattern of light is beyond its noise".to_string(),
+        (1, false) => "1 block is beyond its noise".to_string(),
+        (n, false) => format!("{n} blocks are beyond their noise"),
+        (1, true) => "1 block and the pattern of light are beyond their noise".to_string(),
+        (n, true) => format!("{n} blocks and the pattern of light are beyond their noise"),
+    };
     println!(
-        "{name}: CHANGED: {} ({seeds}); error image `{}`",
-        if changed.len() == 1 {
-            "1 block is beyond its noise".to_string()
-        } else {
-            format!("{} blocks are beyond their noise", changed.len())
-        },
+        "{name}: CHANGED: {what} ({seeds}); error image `{}`",
         image.display()
     );
-    for line in report::changed_lines(&v, LISTED) {
+    for line in report::changed_lines(v, LISTED) {
         println!("{line}");
+    }
+    if let Some(s) = structure {
+        for line in report::structure_lines(s) {
+            println!("{line}");
+        }
     }
     Ok(Outcome::Changed)
 }

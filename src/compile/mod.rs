@@ -20,6 +20,9 @@ pub mod settings;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+// The validator's bound on a volumetric scene's materials is the one the volume stack holds.
+use crate::render_scene::medium::MAX_VOLUMETRIC_MATERIALS;
+
 use crate::accel::BvhStats;
 use crate::geometry::quadric::QuadricShape;
 use crate::render_scene::geometry::GeometryBuilder;
@@ -191,6 +194,16 @@ pub fn compile_with(
         || materials.list.iter().any(|(_, m)| {
             m.interior.priority.is_some() || m.interior.medium.is_some() || m.interior.interface
         });
+    if volumetric && materials.list.len() > MAX_VOLUMETRIC_MATERIALS {
+        // Counted here, not in validation: imported (glTF, .mtl) materials count too.
+        return Err(vec![Diagnostic::error(
+            "materials",
+            format!(
+                "a scene with media, priorities or interfaces may have at most {MAX_VOLUMETRIC_MATERIALS} materials, imported ones included; this one has {}",
+                materials.list.len()
+            ),
+        )]);
+    }
     let (material_names, materials) = materials.list.into_iter().unzip();
     Ok((
         RenderScene {

@@ -83,6 +83,7 @@ pub fn resolve(
         min_bounces: value(p.min_bounces),
         final_gather: value(p.final_gather),
         max_bounces: value(p.max_bounces),
+        pilot_seed: None,
     };
     let RenderSettings {
         width: _,

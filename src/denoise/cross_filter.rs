@@ -214,9 +214,12 @@ fn colour_distance(
     for ch in 0..3 {
         let (yp, yq) = (&c[ch][p_at..p_at + len], &c[ch][q_at..q_at + len]);
         let (vp, vq) = (&v[ch][p_at..p_at + len], &v[ch][q_at..q_at + len]);
-        for ((((d, &a), &b), &va), &vb) in row.iter_mut().zip(yp).zip(yq).zip(vp).zip(vq) {
-            let t = a - b;
-            *d += (t * t - (va + va.min(vb))) / (EPS + va + vb);
+        // Indexed over slices of one length (no bounds checks): vectorises, where the
+        // five-way zip ran scalar.
+        let row = &mut row[..len];
+        for i in 0..len {
+            let (t, va, vb) = (yp[i] - yq[i], vp[i], vq[i]);
+            row[i] += (t * t - (va + va.min(vb))) / (EPS + va + vb);
         }
     }
 }
@@ -287,18 +290,20 @@ fn filter_band(
                     let cx = &layer.c[half];
                     let dc = &patch[half][b_at..b_at + len];
                     for k in 0..CANDIDATES {
-                        let wt = &mut wt[..len];
-                        for ((o, &d), &e) in wt.iter_mut().zip(dc).zip(df.iter()) {
-                            *o = exp_neg((d * inv_k2[k]).max(e));
+                        let (wt, df) = (&mut wt[..len], &df[..len]);
+                        let inv = inv_k2[k];
+                        for i in 0..len {
+                            wt[i] = exp_neg((dc[i] * inv).max(df[i]));
                         }
-                        for (s, &o) in wsum[half][k][b_at..b_at + len].iter_mut().zip(wt.iter()) {
-                            *s += o;
+                        let s = &mut wsum[half][k][b_at..b_at + len];
+                        for i in 0..len {
+                            s[i] += wt[i];
                         }
                         for ch in 0..3 {
                             let (cp, cq) = (&cx[ch][p_at..p_at + len], &cx[ch][q_at..q_at + len]);
                             let a = &mut acc[half][k][ch][b_at..b_at + len];
-                            for (((a, &o), &p), &q) in a.iter_mut().zip(wt.iter()).zip(cp).zip(cq) {
-                                *a += o * (q - p);
+                            for i in 0..len {
+                                a[i] += wt[i] * (cq[i] - cp[i]);
                             }
                         }
                     }

@@ -22,8 +22,12 @@ pub fn exp_neg(x: f32) -> f32 {
     let n = t.floor();
     let f = t - n;
     let p = 1.0 + f * (C[0] + f * (C[1] + f * (C[2] + f * (C[3] + f * (C[4] + f * C[5])))));
-    // n ≥ −116: 2^n is a normal float.
-    let scale = f32::from_bits(((n as i32 + 127) as u32) << 23);
+    // n ≥ −116: 2^n is a normal float. Its exponent field n + 127 (an integer in 11..=127) is
+    // read off the low mantissa bits of 2²³ + n + 127 (exact): bit operations only, where a
+    // float-to-integer `as` (saturating) kept the loop from vectorising (20 % of the
+    // denoiser's instructions under callgrind).
+    let biased = (n + (127.0 + 8_388_608.0)).to_bits() & 0x007f_ffff;
+    let scale = f32::from_bits(biased << 23);
     if inside { p * scale } else { 0.0 }
 }
 

@@ -58,6 +58,7 @@ impl<'a> ProgressivePath<'a> {
             global: true,
             global_any_bounce: false,
             near_specular: Some(NEAR_SPECULAR_ALPHA),
+            volume: scatters(scene),
         };
         Self::new(scene, set, 0)
     }
@@ -71,6 +72,7 @@ impl<'a> ProgressivePath<'a> {
             global: scene.params.photons.global > 0,
             global_any_bounce: true,
             near_specular: Some(NEAR_SPECULAR_ALPHA),
+            volume: scatters(scene),
         };
         Self::new(scene, set, 1)
     }
@@ -122,9 +124,16 @@ impl<'a> ProgressivePath<'a> {
             global_has_caustics: self.global_has_caustics,
             near_specular: self.near_specular,
             caustic_lights: &self.caustic_lights,
+            volume: m.volume.as_ref(),
         };
         self.path.li_with_maps(maps, ray, cx)
     }
+}
+
+/// True if the scene has a medium that scatters: then caustic photons also store volume
+/// photons (the volume caustic map, `photon/volume.rs`), and camera paths read it.
+fn scatters(scene: &RenderScene) -> bool {
+    scene.volumetric && scene.media.iter().any(|m| m.scatters())
 }
 
 impl<'a> super::Estimator<'a> for ProgressivePath<'a> {

@@ -115,11 +115,33 @@ impl PixelSums {
     #[inline]
     pub fn add(&mut self, index: usize, l: Vec3) {
         let l = l.as_dvec3();
-        let (s, q) = (&mut self.sums[index], &mut self.squares[index]);
+        if l.abs().max_element() < MAIN_LIMIT {
+            for c in 0..3 {
+                self.add_main(index, c, l[c]);
+            }
+            self.counts[index] += 1;
+        } else {
+            self.add_wide(index, l);
+        }
+    }
+
+    /// Adds sample channel value `v` (magnitude below [`MAIN_LIMIT`]) to channel `c` of pixel
+    /// `index`'s 128-bit sums.
+    #[inline(always)]
+    fn add_main(&mut self, index: usize, c: usize, v: f64) {
+        self.sums[index][c] = self.sums[index][c].saturating_add(fixed(v, SCALE));
+        self.squares[index][c] = self.squares[index][c].saturating_add(fixed(v * v, SCALE_SQ));
+    }
+
+    /// [`PixelSums::add`] for a sample with a channel of magnitude [`MAIN_LIMIT`] or more: such
+    /// channels go to the pixel's wide sums, the others to its 128-bit sums as usual. Out of
+    /// line, so that the common path stays small enough to inline into the tile loop.
+    #[cold]
+    #[inline(never)]
+    fn add_wide(&mut self, index: usize, l: DVec3) {
         for c in 0..3 {
             if l[c].abs() < MAIN_LIMIT {
-                s[c] = s[c].saturating_add(fixed(l[c], SCALE));
-                q[c] = q[c].saturating_add(fixed(l[c] * l[c], SCALE_SQ));
+                self.add_main(index, c, l[c]);
             } else {
                 // Integral at both scales (|l| ≥ 2³⁰), so the conversion is exact.
                 let w = self.wide.entry(index as u32).or_default();
@@ -138,6 +160,9 @@ impl PixelSums {
             self.squares[to][c] = self.squares[to][c].saturating_add(other.squares[from][c]);
         }
         self.counts[to] += other.counts[from];
+        if other.wide.is_empty() {
+            return;
+        }
         if let Some(w) = other.wide.get(&(from as u32)) {
             self.wide.entry(to as u32).or_default().add(w);
         }

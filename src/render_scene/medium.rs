@@ -43,6 +43,10 @@ use crate::shading::absorption::Absorption;
 /// Most volumes a path can be inside at once (deeper nesting drops the oldest).
 pub const MAX_VOLUMES: usize = 8;
 
+/// Most materials a volumetric scene may have: the volume stack stores material indices in 16
+/// bits.
+pub const MAX_VOLUMETRIC_MATERIALS: usize = 1 << 16;
+
 /// No participating medium (an index into `RenderScene::media` otherwise).
 const NONE: u32 = u32::MAX;
 
@@ -94,8 +98,10 @@ pub struct Medium {
     /// The participating medium that holds ([`NONE`]: none).
     participating: u32,
     len: u8,
-    /// Material indices of the volumes entered, oldest first (`len` of them).
-    volumes: [u32; MAX_VOLUMES],
+    /// Material indices of the volumes entered, oldest first (`len` of them). 16 bits, so that
+    /// the medium every path vertex carries stays small (a volumetric scene has at most
+    /// [`MAX_VOLUMETRIC_MATERIALS`] materials: compilation says so).
+    volumes: [u16; MAX_VOLUMES],
 }
 
 impl Medium {
@@ -135,6 +141,14 @@ impl Medium {
         } else {
             scene.media.get(self.participating as usize)
         }
+    }
+
+    /// The index in `RenderScene::media` of the participating medium that holds, if any (what
+    /// tells a volume photon's medium from another's on either side of a boundary).
+    #[inline]
+    #[must_use]
+    pub fn participating_index(&self) -> Option<u32> {
+        (self.participating != NONE).then_some(self.participating)
     }
 
     /// The fraction of light (per channel) kept along the segment `ray` travelled to reach
@@ -210,13 +224,20 @@ impl Medium {
         }
     }
 
-    /// The stack after crossing a surface of `material` inwards (`entering`) or outwards.
+    /// The stack after crossing a surface of `material` inwards (`entering`) or outwards. Out of
+    /// line: only volumetric scenes call it, and inlined it made every path loop larger.
+    #[inline(never)]
     #[must_use]
     pub fn crossed(mut self, scene: &RenderScene, material: u32, entering: bool) -> Self {
         let interior = &scene.materials[material as usize].interior;
         if !interior.encloses {
             return self;
         }
+        // Validation keeps a volumetric scene's material indices within 16 bits; a larger one
+        // (unreachable) is no volume rather than a wrong one.
+        let Ok(material) = u16::try_from(material) else {
+            return self;
+        };
         let len = self.len as usize;
         let at = self.volumes[..len].iter().rposition(|&m| m == material);
         match (entering, at) {
@@ -258,7 +279,11 @@ impl Medium {
     /// The volume of highest priority (newest among equals) among those `keep` accepts.
     fn top(&self, scene: &RenderScene, keep: impl Fn(u32) -> bool) -> Option<u32> {
         let mut best: Option<(i32, u32)> = None;
-        for &m in self.volumes[..self.len as usize].iter().rev() {
+        for m in self.volumes[..self.len as usize]
+            .iter()
+            .rev()
+            .map(|&m| u32::from(m))
+        {
             if !keep(m) {
                 continue;
             }
@@ -284,7 +309,7 @@ impl Medium {
             return false;
         };
         self.volumes[..self.len as usize].iter().any(|&m| {
-            m != material
+            u32::from(m) != material
                 && scene.materials[m as usize]
                     .interior
                     .priority

@@ -124,6 +124,12 @@ pub struct PhotonParams {
     pub final_gather: u32,
     /// Most bounces of a photon path.
     pub max_bounces: u32,
+    /// Seed of the progressive integrators' pilot maps, which set the radius field `R(x)` of
+    /// every pass (`integrators::photon::passes`); `None`: the render's seed. A `golden check`
+    /// renders with another seed than its golden but the golden's pilot seed, so that both
+    /// renders have the same expected image (the same blur), not only the same settings
+    /// (docs/golden.md). Not a scene setting.
+    pub pilot_seed: Option<u64>,
 }
 
 /// A named scene object, for diagnostics and ray-tree dumps.

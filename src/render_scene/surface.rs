@@ -173,32 +173,37 @@ impl Geometry {
                     },
                 }
             }
-            PrimKind::Quadric => {
-                let q = &self.quadrics[hit.prim.index()];
-                let o = q.object_from_world.transform_point3(ray.origin.as_dvec3());
-                let d = q.object_from_world.transform_vector3(ray.dir.as_dvec3());
-                // Re-solved in f64 (as for ellipsoids), then moved exactly onto the surface.
-                let t = q.shape.hit_t(o, d).unwrap_or(f64::from(hit.t));
-                let po = q.shape.reproject(o + d * t);
-                let p = q.world_from_object.transform_point3(po).as_vec3();
-                let n = (q.normal_to_world * q.shape.normal(po))
-                    .as_vec3()
-                    .normalize();
-                SurfacePoint {
-                    p,
-                    p_outside: p,
-                    p_error: p.abs() * gamma(3),
-                    ng: n,
-                    ns: n,
-                    object: q.object,
-                    local: Local {
-                        prim: hit.prim,
-                        b1: 0.0,
-                        b2: 0.0,
-                        unit: po.as_vec3(),
-                    },
-                }
-            }
+            PrimKind::Quadric => self.quadric_surface(ray, hit),
+        }
+    }
+
+    /// [`Geometry::surface`] of a disc or cylinder hit: out of line, so that the common kinds'
+    /// surface records stay as cheap as before the kind existed.
+    #[inline(never)]
+    fn quadric_surface(&self, ray: &Ray, hit: &Hit) -> SurfacePoint {
+        let q = &self.quadrics[hit.prim.index()];
+        let o = q.object_from_world.transform_point3(ray.origin.as_dvec3());
+        let d = q.object_from_world.transform_vector3(ray.dir.as_dvec3());
+        // Re-solved in f64 (as for ellipsoids), then moved exactly onto the surface.
+        let t = q.shape.hit_t(o, d).unwrap_or(f64::from(hit.t));
+        let po = q.shape.reproject(o + d * t);
+        let p = q.world_from_object.transform_point3(po).as_vec3();
+        let n = (q.normal_to_world * q.shape.normal(po))
+            .as_vec3()
+            .normalize();
+        SurfacePoint {
+            p,
+            p_outside: p,
+            p_error: p.abs() * gamma(3),
+            ng: n,
+            ns: n,
+            object: q.object,
+            local: Local {
+                prim: hit.prim,
+                b1: 0.0,
+                b2: 0.0,
+                unit: po.as_vec3(),
+            },
         }
     }
 

@@ -220,4 +220,28 @@ mod tests {
         };
         assert!(emission.is_some());
     }
+
+    /// A scene with a medium given by its coefficients: its unset albedo form goes through the
+    /// override tree as `null` and must come back unset (it failed with "invalid type: null",
+    /// so `--set` and `--exposure` refused every scene with `media`).
+    #[test]
+    fn overrides_keep_a_mediums_unset_form() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/scenes/foggy_box.ron");
+        let scene = crate::scene::source::SourceFile::read(&path)
+            .and_then(|s| s.parse())
+            .unwrap();
+        let set = apply_overrides(
+            &scene,
+            &[
+                "render.exposure=1".into(),
+                "media.fog.sigma_s=(0.1, 0.2, 0.3)".into(),
+            ],
+        )
+        .unwrap();
+        let fog = &set.media["fog"];
+        assert_eq!(fog.sigma_s, Some([0.1, 0.2, 0.3]));
+        assert_eq!(fog.sigma_a, scene.media["fog"].sigma_a);
+        assert_eq!((fog.albedo, fog.mean_free_path), (None, None));
+    }
 }

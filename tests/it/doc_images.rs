@@ -45,6 +45,8 @@ const SCRIPT_MADE: &[(&str, &str)] = &[
     ("bath_steam.png", "scripts/media_images.sh"),
     ("glass_of_water.png", "scripts/media_images.sh"),
     ("foggy_box.png", "scripts/media_images.sh"),
+    ("volume_caustic.png", "scripts/media_images.sh"),
+    ("fog_window.png", "scripts/media_images.sh"),
 ];
 
 /// Largest fraction of the sampled pixels that may differ by more than one 8-bit step.

@@ -55,4 +55,5 @@ mod sun_caustic;
 mod target_error;
 mod textures;
 mod transmission_nee;
+mod volume_caustics;
 mod watertight;

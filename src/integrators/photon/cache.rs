@@ -158,6 +158,8 @@ fn put_counts(out: &mut Vec<u8>, per_light: &[TraceCounts]) {
             stored_flux,
             lost_at_depth,
             lost_flux,
+            // The photon integrator, the cache's only user, stores no volume photons.
+            volume_stored: _,
         } = *c;
         for v in [emitted, reached_specular, stored, lost_at_depth] {
             put_u64(out, v);
@@ -291,6 +293,7 @@ impl CacheReader<'_> {
                     stored_flux: self.vec3()?,
                     lost_at_depth,
                     lost_flux: self.vec3()?,
+                    volume_stored: 0,
                 })
             })
             .collect()
@@ -401,6 +404,8 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
         caustic,
         global,
         irradiance,
+        volume_photons: Vec::new(),
+        volume: None,
         summary,
     })
 }

@@ -15,12 +15,17 @@ use rayon::prelude::*;
 use super::aim::CausticTargets;
 use super::emit::{LightEmitter, split_by_power};
 use super::estimate::{IrradianceCache, Kernel, PhotonMap};
-use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon};
+use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon_into};
+use super::volume::{VolumeMap, VolumePhoton};
 use super::walls::Walls;
 use crate::render_scene::{Geometry, RenderScene};
 use crate::sampling::Sampler;
 use crate::sampling::rng::mix64;
 use crate::spatial::{KdTree, Photon};
+
+/// The pass number whose photon streams make the pilot maps of the radius fields (`passes.rs`). Sample
+/// indices are below the `u32` sample count, so no pass of a render is ever this one.
+pub const PILOT_PASS: u32 = u32::MAX;
 
 /// Photons per parallel work item.
 const BATCH: u64 = 2048;
@@ -145,6 +150,13 @@ impl std::fmt::Display for PhotonSummary {
             &self.global_skipped,
             self.global_radius,
         )?;
+        let volume = PhotonSummary::total(&self.caustic).volume_stored;
+        if volume > 0 {
+            writeln!(
+                f,
+                "photons: volume caustic map: {volume} stored where caustic paths scatter in a medium (light → specular⁺ → medium)"
+            )?;
+        }
         if self.irradiance_points > 0 {
             writeln!(
                 f,
@@ -198,6 +210,31 @@ pub fn trace_map(
     settings: TraceSettings,
     cancel: Option<&AtomicBool>,
 ) -> (Vec<Photon>, Vec<TraceCounts>) {
+    let (photons, _, counts) = trace_map_with_volume(
+        scene,
+        emitters,
+        targets,
+        settings,
+        scene.params.seed,
+        false,
+        cancel,
+    );
+    (photons, counts)
+}
+
+/// [`trace_map`] with the photon streams of `seed` instead of the render's (a progressive
+/// render's pilot maps with [`crate::render_scene::PhotonParams::pilot_seed`]), also storing
+/// the caustic paths' volume photons when `volume` is true ([`trace_photon_into`]), in the same
+/// (light, index) order: the same list for any thread count.
+pub fn trace_map_with_volume(
+    scene: &RenderScene,
+    emitters: &[LightEmitter],
+    targets: &CausticTargets,
+    settings: TraceSettings,
+    seed: u64,
+    volume: bool,
+    cancel: Option<&AtomicBool>,
+) -> (Vec<Photon>, Vec<VolumePhoton>, Vec<TraceCounts>) {
     let jobs: Vec<(usize, u64, u64)> = emitters
         .iter()
         .enumerate()
@@ -207,11 +244,12 @@ pub fn trace_map(
         })
         .collect();
     let params = &scene.params;
-    let results: Vec<(usize, Vec<Photon>, TraceCounts)> = jobs
+    let results: Vec<(usize, Vec<Photon>, Vec<VolumePhoton>, TraceCounts)> = jobs
         .par_iter()
         .map(|&(l, start, end)| {
-            let mut sampler = Sampler::new(params.sampler, params.seed, 1);
+            let mut sampler = Sampler::new(params.sampler, seed, 1);
             let mut out = Vec::new();
+            let mut vol = Vec::new();
             let mut counts = TraceCounts::default();
             let mut cones = Vec::new();
             let e = &emitters[l];
@@ -226,28 +264,32 @@ pub fn trace_map(
                     MapKind::Caustic => e.caustic(targets, &mut sampler, &mut cones),
                 };
                 if let Some((ray, power)) = emitted {
-                    trace_photon(
+                    trace_photon_into(
                         scene,
                         ray,
                         power,
                         settings,
                         &mut sampler,
                         &mut out,
+                        volume.then_some(&mut vol),
                         &mut counts,
                     );
                 }
             }
-            (l, out, counts)
+            (l, out, vol, counts)
         })
         .collect();
     let mut per_light = vec![TraceCounts::default(); emitters.len()];
     let total: usize = results.iter().map(|r| r.1.len()).sum();
+    let total_volume: usize = results.iter().map(|r| r.2.len()).sum();
     let mut photons = Vec::with_capacity(total);
-    for (l, out, counts) in results {
+    let mut volume_photons = Vec::with_capacity(total_volume);
+    for (l, out, vol, counts) in results {
         per_light[l].add(&counts);
         photons.extend_from_slice(&out);
+        volume_photons.extend_from_slice(&vol);
     }
-    (photons, per_light)
+    (photons, volume_photons, per_light)
 }
 
 /// Whether the cancel flag `cancel` is raised.
@@ -323,6 +365,12 @@ pub struct PhotonMaps {
     /// Both maps' irradiance at a subset of photons, for final gathering (built only when
     /// `final_gather > 0`).
     pub irradiance: Option<IrradianceCache>,
+    /// The caustic paths' volume photons as traced (with [`MapSet::volume`]), before a
+    /// progressive pass gives them radii and makes them [`PhotonMaps::volume`].
+    pub volume_photons: Vec<VolumePhoton>,
+    /// The volume caustic map the camera paths read (`volume.rs`; built by the progressive
+    /// passes, `None` without volume photons).
+    pub volume: Option<VolumeMap>,
     /// Counts, radii and timings.
     pub summary: PhotonSummary,
 }
@@ -342,6 +390,7 @@ pub fn build_maps_cancellable(scene: &RenderScene, cancel: Option<Arc<AtomicBool
         global: true,
         global_any_bounce: false,
         near_specular: None,
+        volume: false,
     };
     let mut prepared = MapScene::new(scene, all);
     prepared.cancel = cancel;
@@ -388,6 +437,9 @@ pub struct MapSet {
     /// Near-specular surfaces (GGX α up to this) are specular for photon paths
     /// ([`TraceSettings::near_specular`]); `None`: only delta lobes are.
     pub near_specular: Option<f32>,
+    /// Caustic paths also store volume photons where they scatter in a medium (the volume
+    /// caustic map of the progressive integrators, `volume.rs`).
+    pub volume: bool,
 }
 
 /// Traces and builds the caustic and/or global maps of the scene's `photons` settings from the
@@ -414,7 +466,12 @@ pub fn build_maps_with(
     let targets = &prepared.targets;
     let cancel = prepared.cancel.as_deref();
     summary.targets = targets.len();
-    let mut sampler = Sampler::new(scene.params.sampler, scene.params.seed, 1);
+    // The pilot maps of a progressive render may take their own seed (a golden check's).
+    let seed = match (pass, p.pilot_seed) {
+        (Some(PILOT_PASS), Some(pilot)) => pilot,
+        _ => scene.params.seed,
+    };
+    let mut sampler = Sampler::new(scene.params.sampler, seed, 1);
 
     // Caustic budgets: lights with their own count keep it; the rest share `caustic` by power.
     let shared: Vec<f64> = weights
@@ -444,6 +501,7 @@ pub fn build_maps_with(
     summary.auto_radius = p.max_radius.is_none();
 
     let t0 = Instant::now();
+    let mut volume_photons = Vec::new();
     let mut build_time = Duration::ZERO;
     let mut memory = 0;
     let caustic = if !set.caustic {
@@ -465,7 +523,9 @@ pub fn build_maps_with(
             pass,
             near_specular: set.near_specular,
         };
-        let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
+        let (photons, volume, counts) =
+            trace_map_with_volume(scene, &e, targets, settings, seed, set.volume, cancel);
+        volume_photons = volume;
         summary.caustic = counts;
         if is_raised(cancel) {
             return cancelled(summary);
@@ -504,7 +564,8 @@ pub fn build_maps_with(
             pass,
             near_specular: set.near_specular,
         };
-        let (photons, counts) = trace_map(scene, &e, targets, settings, cancel);
+        let (photons, _, counts) =
+            trace_map_with_volume(scene, &e, targets, settings, seed, false, cancel);
         summary.global = counts;
         if is_raised(cancel) {
             return cancelled(summary);
@@ -538,6 +599,8 @@ pub fn build_maps_with(
         caustic,
         global,
         irradiance,
+        volume_photons,
+        volume: None,
         summary,
     }
 }

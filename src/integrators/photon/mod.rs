@@ -23,11 +23,13 @@ pub mod maps;
 pub mod passes;
 pub mod radius_field;
 pub mod trace;
+pub mod volume;
 pub mod walls;
 
 pub use estimate::{Estimate, IrradianceCache, Kernel, PhotonMap};
 pub use maps::{MapSet, PhotonMaps, PhotonSummary, build_maps};
 pub use passes::{PassTotals, ProgressivePhotons, RadiusSchedule};
+pub use volume::{BeamEstimate, VolumeMap, VolumePhoton};
 
 use glam::Vec3;
 

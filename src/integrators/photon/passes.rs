@@ -21,8 +21,9 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use super::maps::{MapScene, MapSet, PhotonMaps, build_maps_with};
+use super::maps::{MapScene, MapSet, PILOT_PASS, PhotonMaps, build_maps_with};
 use super::radius_field::RadiusField;
+use super::volume::{VolumeMap, volume_radius_field};
 use crate::render_scene::RenderScene;
 
 /// Knaus & Zwicker's radius schedule.
@@ -46,10 +47,6 @@ impl RadiusSchedule {
     }
 }
 
-/// The pass number whose photon streams make the pilot maps of the radius fields. Sample
-/// indices are below the `u32` sample count, so no pass of a render is ever this one.
-pub const PILOT_PASS: u32 = u32::MAX;
-
 /// The radius fields of the caustic and global maps (`None`: that map has no pilot photons).
 #[derive(Debug, Clone, Default)]
 pub struct PassFields {
@@ -57,6 +54,8 @@ pub struct PassFields {
     pub caustic: Option<Arc<RadiusField>>,
     /// `R(x)` of the global map.
     pub global: Option<Arc<RadiusField>>,
+    /// `R(x)` of the volume caustic map's beam estimate (`volume.rs`).
+    pub volume: Option<Arc<RadiusField>>,
 }
 
 /// Totals over the passes a progressive render has traced (for its summary).
@@ -136,6 +135,7 @@ impl<'a> ProgressivePhotons<'a> {
                 let f = PassFields {
                     caustic: field(&pilot.caustic),
                     global: field(&pilot.global),
+                    volume: volume_radius_field(&pilot.volume_photons).map(Arc::new),
                 };
                 self.totals.time += t.elapsed();
                 self.fields = Some(f.clone());
@@ -162,6 +162,16 @@ impl<'a> ProgressivePhotons<'a> {
                 None => m.set_shrink(shrink),
             }
         }
+        // The volume photons' spheres: radius `shrink · R(x)` (2-D kernel across the ray, so the
+        // surface maps' schedule); without pilot volume photons, the pass's own field.
+        let volume = std::mem::take(&mut self.maps.volume_photons);
+        self.maps.volume = match &fields.volume {
+            Some(f) => VolumeMap::build(volume, |p| shrink * f.radius(p)),
+            None => match volume_radius_field(&volume) {
+                Some(f) => VolumeMap::build(volume, |p| shrink * f.radius(p)),
+                None => None,
+            },
+        };
         let s = &self.maps.summary;
         for c in s.caustic.iter().chain(&s.global) {
             self.totals.emitted += c.emitted;

@@ -19,10 +19,21 @@ use crate::sampling::Sampler;
 use crate::shading::TransportMode;
 use crate::spatial::Photon;
 
+use super::volume::VolumePhoton;
+
 /// Largest factor by which a photon's flux may grow along its path (the adjoint shading-normal
 /// factor can exceed 1 at grazing angles on bumped surfaces; Veach 1997 §5.3). Bounds the
 /// worst photon's flux so one grazing photon cannot leave a bright spot.
 pub const MAX_FLUX_GROWTH: f32 = 10.0;
+
+/// Free flights drawn along each medium segment of a caustic path for the volume caustic map
+/// ([`trace_photon_into`]), each storing a photon with `1/VOLUME_SAMPLES` of the flux where it
+/// ends before the segment does: 4 times the volume photons of one draw for no more photon
+/// paths, so the beam estimate's radius is `4^{−1/3}` ≈ 0.63 of one draw's at the same
+/// noise. (On `tests/it/volume_caustics.rs` one draw with 1 000 caustic photons per pass left
+/// the image 22 % dark after 192 passes, from discs reaching over the water's surface; 8 000
+/// photons, 12 %: a bias in proportion to the radius.)
+pub const VOLUME_SAMPLES: u32 = 4;
 
 /// Most surfaces a photon may cross straight on (interfaces, false hits of nested volumes)
 /// before it is dropped: a guard against a ray caught on one surface by rounding.
@@ -47,6 +58,8 @@ pub struct TraceCounts {
     pub reached_specular: u64,
     /// Photons stored (a path may store several in the global map).
     pub stored: u64,
+    /// Volume photons stored (caustic paths scattering in a medium, [`trace_photon_into`]).
+    pub volume_stored: u64,
     /// Total flux stored (W per channel).
     pub stored_flux: Vec3,
     /// Photon paths cut by `max_bounces` while they still carried flux.
@@ -65,6 +78,7 @@ impl TraceCounts {
         self.emitted += other.emitted;
         self.reached_specular += other.reached_specular;
         self.stored += other.stored;
+        self.volume_stored += other.volume_stored;
         self.stored_flux += other.stored_flux;
         self.lost_at_depth += other.lost_at_depth;
         self.lost_flux += other.lost_flux;
@@ -111,11 +125,33 @@ impl TraceSettings {
 /// measure what the cut takes away (`lost_flux`).
 pub fn trace_photon(
     scene: &RenderScene,
+    ray: Ray,
+    power: Vec3,
+    settings: TraceSettings,
+    sampler: &mut Sampler,
+    out: &mut Vec<Photon>,
+    counts: &mut TraceCounts,
+) {
+    trace_photon_into(scene, ray, power, settings, sampler, out, None, counts);
+}
+
+/// [`trace_photon`], also storing **volume photons** into `volume` when given (the volume
+/// caustic map, `volume.rs`): a caustic photon crossing a scattering medium after at least one
+/// specular bounce draws [`VOLUME_SAMPLES`] free-flight distances along the segment, and where
+/// one falls before the segment's end stores a photon with its flux times the free-flight
+/// weight `σs T(t)/p(t)`, over [`VOLUME_SAMPLES`] (the flux scattered there, in expectation). The photon itself goes on unscattered with its
+/// expected share `exp(−σt d)`, as without `volume`, so the surface caustic map keeps its
+/// meaning. Global photons store no volume photons. With `volume` `None`, no random number
+/// is drawn for it: the path is [`trace_photon`]'s.
+#[allow(clippy::too_many_arguments)]
+pub fn trace_photon_into(
+    scene: &RenderScene,
     mut ray: Ray,
     mut power: Vec3,
     settings: TraceSettings,
     sampler: &mut Sampler,
     out: &mut Vec<Photon>,
+    mut volume: Option<&mut Vec<VolumePhoton>>,
     counts: &mut TraceCounts,
 ) {
     let max_flux = power.max_element() * MAX_FLUX_GROWTH;
@@ -138,6 +174,32 @@ pub fn trace_photon(
                     Interaction::Surface(v) => v.hit.t * len,
                 };
                 if settings.kind == MapKind::Caustic {
+                    // Light → specular⁺ scattering here: a volume photon where a free flight
+                    // ends before the surface (its flux σs T(t)/p(t) of the photon's).
+                    if bounces > 0
+                        && !cut
+                        && m.scatters()
+                        && let Some(store) = volume.as_deref_mut()
+                        && let Some(id) = medium.participating_index()
+                    {
+                        for _ in 0..VOLUME_SAMPLES {
+                            let FreeFlight::Scatter { t, weight } =
+                                m.sample_distance(t_hit, sampler.next_2d())
+                            else {
+                                continue;
+                            };
+                            let flux = power * weight / VOLUME_SAMPLES as f32;
+                            if flux.is_finite() && flux.max_element() > 0.0 {
+                                store.push(VolumePhoton {
+                                    position: ray.origin + ray.dir * (t / len),
+                                    direction: ray.dir / len,
+                                    power: flux,
+                                    medium: id,
+                                });
+                                counts.volume_stored += 1;
+                            }
+                        }
+                    }
                     // Caustic photons are the light that crosses media without scattering
                     // (a scattered photon is no longer on a specular path): their expected
                     // share, exp(−σt d), instead of sampling events and dropping the scattered.

@@ -26,6 +26,10 @@ use glam::DVec3;
 use super::quantile::{student_upper_quantile, student_upper_tail};
 use crate::render::PixelSums;
 
+/// Probability of catching a change at the detection floor (the floors of the block means,
+/// `floor.rs`, and of the structure test, `structure.rs`).
+pub const POWER: f64 = 0.95;
+
 /// Most batches a golden keeps: beyond about 60 degrees of freedom Student's t is within 2 % of
 /// the normal law at the test's quantiles, and more batches only grow the file.
 pub const MAX_BATCHES: u32 = 64;
@@ -383,7 +387,7 @@ fn coarse_batches(b: &BatchBlocks, x0: u32, y0: u32, span: u32) -> Vec<[f64; 3]>
 
 /// The mean of a block's batch means weighted by the batches' samples, and the estimated
 /// variance of that mean: Σ wⱼ² (mⱼ − m̄)² / (Σ w)² · K/(K − 1) (s²/K for equal batches).
-fn mean_and_variance(values: &[[f64; 3]], weights: &[u32]) -> ([f64; 3], [f64; 3]) {
+pub(crate) fn mean_and_variance(values: &[[f64; 3]], weights: &[u32]) -> ([f64; 3], [f64; 3]) {
     let k = values.len() as f64;
     let total: f64 = weights.iter().map(|w| f64::from(*w)).sum();
     let mut mean = [0.0; 3];

@@ -15,8 +15,7 @@ use super::batch_means::{BatchBlocks, MAX_BATCHES, scale_spans};
 use super::quantile::student_upper_quantile;
 use crate::integrators::photon::RadiusSchedule;
 
-/// Probability of catching a change at the floor.
-pub const POWER: f64 = 0.95;
+pub use super::batch_means::POWER;
 
 /// Fraction of the image the `--detect` advice aims at: a change over a square this share of
 /// the image (the scale whose blocks are closest to it in area).
@@ -34,13 +33,21 @@ pub struct ScaleFloor {
     pub median: f64,
 }
 
-/// The detection floor of a golden at every scale, finest first.
+/// The detection floor of a golden at every scale, finest first, and of its structure test.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DetectionFloor {
     /// Batches of the golden.
     pub batches: usize,
     /// Per scale, finest first; the last is the whole image.
     pub scales: Vec<ScaleFloor>,
+    /// The structure test's floor ([`super::structure::structure_floor`]): the smallest
+    /// change of every lit cell by ±δ of its light caught in 95 % of checks (infinite when
+    /// not measured).
+    pub structure: f64,
+    /// Side in pixels of the cells of [`DetectionFloor::structure`].
+    pub cell: u32,
+    /// Whether the structure test runs at these samples per pixel (enough batches).
+    pub structure_active: bool,
 }
 
 /// (t* + t₀.₀₅) for a scale of `blocks` blocks at false-alarm rate `alpha` split over
@@ -52,9 +59,21 @@ fn critical(alpha: f64, scales: usize, blocks: usize, k: usize) -> f64 {
 }
 
 impl DetectionFloor {
-    /// The floor of `golden` for checks at false-alarm rate `alpha`.
+    /// The floor of a golden's blocks and cells for checks at false-alarm rate `alpha` (split
+    /// between the two tests as [`super::combined::GoldenTest`] does).
     #[must_use]
-    pub fn of(golden: &BatchBlocks, alpha: f64) -> Self {
+    pub fn of(golden: &BatchBlocks, cells: &BatchBlocks, alpha: f64) -> Self {
+        let structure_active = cells.batches() >= super::structure::MIN_BATCHES;
+        let mut f = Self::of_blocks(golden, super::combined::block_alpha(alpha, cells));
+        f.structure = super::structure::structure_floor(cells, 0.5 * alpha);
+        f.cell = cells.block;
+        f.structure_active = structure_active;
+        f
+    }
+
+    /// The floor of the block means alone at false-alarm rate `alpha` (no structure floor).
+    #[must_use]
+    pub fn of_blocks(golden: &BatchBlocks, alpha: f64) -> Self {
         let k = golden.batches();
         let spans = scale_spans(golden.blocks_x(), golden.blocks_y());
         let scales = spans
@@ -93,7 +112,13 @@ impl DetectionFloor {
                 }
             })
             .collect();
-        Self { batches: k, scales }
+        Self {
+            batches: k,
+            scales,
+            structure: f64::INFINITY,
+            cell: 0,
+            structure_active: false,
+        }
     }
 
     /// The scale the `--detect` advice aims at: blocks closest in area to [`DETECT_AREA`] of
@@ -155,6 +180,38 @@ pub fn predicted_floor(
     s.median * c1 / c0 * (g1 / g0).sqrt()
 }
 
+/// The structure floor predicted for `spp` samples per pixel from a golden's `floor` rendered
+/// at `golden_spp`: δ scales as the standard error, √(growth(spp)/spp) (its critical value
+/// does not depend on the batch count).
+#[must_use]
+pub fn predicted_structure_floor(
+    floor: &DetectionFloor,
+    golden_spp: u32,
+    spp: u32,
+    progressive_alpha: Option<f64>,
+) -> f64 {
+    let g0 = variance_growth(progressive_alpha, golden_spp) / f64::from(golden_spp.max(1));
+    let g1 = variance_growth(progressive_alpha, spp) / f64::from(spp.max(1));
+    floor.structure * (g1 / g0).sqrt()
+}
+
+/// The fewest samples per pixel (at least [`super::structure::MIN_BATCHES`], at most
+/// `limit`) whose predicted structure floor is at most `target`; `None` when even `limit`
+/// does not reach it.
+#[must_use]
+pub fn recommend_structure_spp(
+    floor: &DetectionFloor,
+    golden_spp: u32,
+    target: f64,
+    progressive_alpha: Option<f64>,
+    limit: u32,
+) -> Option<u32> {
+    let min = super::structure::MIN_BATCHES as u32;
+    let reaches =
+        |spp: u32| predicted_structure_floor(floor, golden_spp, spp, progressive_alpha) <= target;
+    fewest_spp(min, limit, reaches)
+}
+
 /// The fewest samples per pixel (at least 2, at most `limit`) whose predicted floor at `scale`
 /// is at most `target` (0.02 for 2 %); `None` when even `limit` does not reach it.
 #[must_use]
@@ -170,7 +227,14 @@ pub fn recommend_spp(
     let reaches = |spp: u32| {
         predicted_floor(floor, scale, golden_spp, spp, alpha, progressive_alpha) <= target
     };
-    let (mut lo, mut hi) = (2u32, 2u32);
+    // The predicted floor falls with spp (fewer-batch t quantiles and 1/√spp both help).
+    fewest_spp(2, limit, reaches)
+}
+
+/// The fewest samples per pixel from `start` to `limit` for which `reaches` holds, assuming it
+/// stays true above (doubling, then bisection); `None` when even `limit` does not reach.
+fn fewest_spp(start: u32, limit: u32, reaches: impl Fn(u32) -> bool) -> Option<u32> {
+    let (mut lo, mut hi) = (start, start);
     while !reaches(hi) {
         if hi >= limit {
             return None;
@@ -178,7 +242,6 @@ pub fn recommend_spp(
         lo = hi;
         hi = hi.saturating_mul(2).min(limit);
     }
-    // The predicted floor falls with spp (fewer-batch t quantiles and 1/√spp both help).
     while lo < hi {
         let mid = lo + (hi - lo) / 2;
         if reaches(mid) { hi = mid } else { lo = mid + 1 }
@@ -229,10 +292,13 @@ impl DetectSearch {
         }
     }
 
-    /// Whether `floor` (of a `width`×`height` golden) reaches the target at the detect scale.
+    /// Whether `floor` (of a `width`×`height` golden) reaches the target at the detect scale
+    /// and, with the structure test running, the structure floor reaches it too.
     #[must_use]
     pub fn reached(&self, floor: &DetectionFloor, width: u32, height: u32) -> bool {
-        floor.scales[floor.detect_scale(width, height)].median <= self.target
+        let structure =
+            floor.cell == 0 || (floor.structure_active && floor.structure <= self.target);
+        floor.scales[floor.detect_scale(width, height)].median <= self.target && structure
     }
 
     /// The next step from the kept render (`floor` at `spp`).
@@ -249,15 +315,29 @@ impl DetectSearch {
         self.rounds += 1;
         let scale = floor.detect_scale(width, height);
         let reached = self.reached(floor, width, height);
-        let advice = recommend_spp(
+        let blocks = recommend_spp(
             floor,
             scale,
             spp,
             DETECT_AIM * self.target,
-            self.alpha,
+            if floor.cell == 0 {
+                self.alpha
+            } else {
+                0.5 * self.alpha
+            },
             None,
             self.limit,
         );
+        // The blocks get half of α once the structure test runs (at the spp aimed at).
+        let structure = if floor.cell == 0 {
+            Some(2)
+        } else {
+            recommend_structure_spp(floor, spp, DETECT_AIM * self.target, None, self.limit)
+        };
+        let advice = match (blocks, structure) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            _ => None,
+        };
         match advice {
             None if spp >= self.limit => DetectStep::Done,
             None => DetectStep::Render(self.limit),
@@ -294,7 +374,7 @@ mod tests {
         let mut b = BatchBlocks::new(4, 4, 4);
         b.push_batch(&[DVec3::splat(1.0); 16], 1);
         b.push_batch(&[DVec3::splat(3.0); 16], 1);
-        let f = DetectionFloor::of(&b, 0.01);
+        let f = DetectionFloor::of_blocks(&b, 0.01);
         assert_eq!(f.scales.len(), 1);
         let c = student_upper_quantile(0.01 / 3.0 / 2.0, 2.0) + student_upper_quantile(0.05, 2.0);
         let want = c * 2f64.sqrt() / 2.0;
@@ -320,7 +400,7 @@ mod tests {
         let mut b = BatchBlocks::new(4, 4, 4);
         b.push_batch(&[DVec3::splat(1.0); 16], 1);
         b.push_batch(&[DVec3::splat(3.0); 16], 1);
-        let f = DetectionFloor::of(&b, 0.01);
+        let f = DetectionFloor::of_blocks(&b, 0.01);
         let mut search = DetectSearch::new(0.5, 0.01, 1 << 16);
         assert!(!search.reached(&f, 4, 4));
         let DetectStep::Render(spp) = search.next(&f, 2, 4, 4) else {

@@ -10,20 +10,26 @@
 //! `path=value` lines so a check can say which settings changed), per pixel the mean and the
 //! variance of the mean per channel as little-endian `f32` (24 bytes a pixel, for the error
 //! image), then the block side, the batch count, each batch's samples per pixel and each
-//! batch's block means as `f64`, and an FNV-1a checksum.
+//! batch's block means as `f64`, then the cells of the structure test ([`structure`]: the cell
+//! side, the cell batch count — 0 when the render has fewer than
+//! [`structure::MIN_BATCHES`] batches, which the test needs —, each cell batch's samples per
+//! pixel and each cell's mean per batch as `f32`), and an FNV-1a checksum.
 //!
 //! The modules: [`batch_means`] (the batches and the test), [`floor`] (the smallest change a
-//! golden catches and the samples per pixel for a requested one), [`record`] (rendering a scene
+//! golden catches and the samples per pixel for a requested one), [`structure`] (the pattern
+//! of light within blocks: a randomization test over small cells), [`record`] (rendering a scene
 //! batch by batch), [`report`] (the verdict in words, the settings that changed),
 //! [`pixel_variance`] (the older per-pixel-variance block test, valid for estimators whose
 //! pixels err independently, used to compare two estimators' images) and [`quantile`].
 
 pub mod batch_means;
+pub mod combined;
 pub mod floor;
 pub mod pixel_variance;
 pub mod quantile;
 pub mod record;
 pub mod report;
+pub mod structure;
 
 use std::path::{Path, PathBuf};
 
@@ -36,16 +42,20 @@ use crate::binfile::meta_text::{MetaText, malformed};
 use crate::render_scene::RenderScene;
 
 pub use batch_means::{BatchBlocks, BatchTest, BatchVerdict};
+pub use combined::{GoldenTest, GoldenVerdict, block_alpha};
 pub use floor::DetectionFloor;
 pub use pixel_variance::{BlockTest, BlockZ, Verdict};
 pub use record::{GoldenRender, render_batches};
+pub use structure::{StructureSkip, StructureTest, StructureVerdict};
 
 /// File signature of a golden image.
-const MAGIC: &[u8; 16] = b"caustic-golden2\n";
+const MAGIC: &[u8; 16] = b"caustic-golden3\n";
 /// Signature of the first format (per-pixel variances only), refused with a clear message.
 const MAGIC_V1: &[u8; 16] = b"caustic-golden1\n";
+/// Signature of the second format (block batches, no cells), refused with a clear message.
+const MAGIC_V2: &[u8; 16] = b"caustic-golden2\n";
 /// First line of the metadata text.
-const HEADER: &str = "caustic-golden 2";
+const HEADER: &str = "caustic-golden 3";
 
 /// Why a golden file could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -272,6 +282,9 @@ pub struct GoldenImage {
     pub estimates: PixelEstimates,
     /// Each block's mean in each batch of passes (for the test).
     pub batches: BatchBlocks,
+    /// Each cell's mean in each (merged) batch, for the structure test; no batch when the
+    /// render had fewer than [`structure::MIN_BATCHES`].
+    pub cells: BatchBlocks,
     /// Settings hash, seed, overrides and settings.
     pub meta: GoldenMeta,
 }
@@ -304,6 +317,20 @@ impl GoldenImage {
                 out.extend_from_slice(&x.to_le_bytes());
             }
         }
+        let c = &self.cells;
+        let kept = c.batches() >= structure::MIN_BATCHES;
+        out.extend_from_slice(&c.block.to_le_bytes());
+        out.extend_from_slice(&(if kept { c.batches() as u32 } else { 0 }).to_le_bytes());
+        if kept {
+            for s in &c.samples {
+                out.extend_from_slice(&s.to_le_bytes());
+            }
+            for m in &c.means {
+                for x in m {
+                    out.extend_from_slice(&(*x as f32).to_le_bytes());
+                }
+            }
+        }
         let sum = fnv1a(&out);
         out.extend_from_slice(&sum.to_le_bytes());
         out
@@ -322,6 +349,11 @@ impl GoldenImage {
         if bytes.len() >= MAGIC_V1.len() && &bytes[..MAGIC_V1.len()] == MAGIC_V1 {
             return Err(bad(
                 "it was written by an older caustic (per-pixel variances, no batches); write it again with `caustic golden update`",
+            ));
+        }
+        if bytes.len() >= MAGIC_V2.len() && &bytes[..MAGIC_V2.len()] == MAGIC_V2 {
+            return Err(bad(
+                "it was written by an older caustic (block batches only, without the cells of the structure test); write it again with `caustic golden update`",
             ));
         }
         if bytes.len() < MAGIC.len() + 24 || &bytes[..MAGIC.len()] != MAGIC {
@@ -373,10 +405,25 @@ impl GoldenImage {
         }
         let mut batches = BatchBlocks::new(width, height, block);
         let blocks = batches.blocks();
-        let expected = count
+        let cells_at = count
             .checked_mul(4)
             .and_then(|s| s.checked_add(count.checked_mul(blocks)?.checked_mul(24)?))
             .and_then(|s| s.checked_add(pixels_end + 8))
+            .ok_or_else(|| bad("absurd size"))?;
+        if cells_at.checked_add(8).is_none_or(|e| e > body.len()) {
+            return Err(bad("size does not match its header"));
+        }
+        let cell = u32::from_le_bytes(word(cells_at));
+        let cell_count = u32::from_le_bytes(word(cells_at + 4)) as usize;
+        if cell == 0 {
+            return Err(bad("its cell side is 0"));
+        }
+        let mut cells = BatchBlocks::new(width, height, cell);
+        let cell_blocks = cells.blocks();
+        let expected = cell_count
+            .checked_mul(4)
+            .and_then(|s| s.checked_add(cell_count.checked_mul(cell_blocks)?.checked_mul(12)?))
+            .and_then(|s| s.checked_add(cells_at + 8))
             .ok_or_else(|| bad("absurd size"))?;
         if expected != body.len() {
             return Err(bad("size does not match its header"));
@@ -395,6 +442,16 @@ impl GoldenImage {
             batches.means.push([d(at), d(at + 8), d(at + 16)]);
             at += 24;
         }
+        at += 8;
+        for _ in 0..cell_count {
+            cells.samples.push(u32::from_le_bytes(word(at)));
+            at += 4;
+        }
+        let s = |at: usize| f64::from(f(at));
+        for _ in 0..cell_count * cell_blocks {
+            cells.means.push([s(at), s(at + 4), s(at + 8)]);
+            at += 12;
+        }
         Ok(Self {
             estimates: PixelEstimates {
                 width,
@@ -403,6 +460,7 @@ impl GoldenImage {
                 variance,
             },
             batches,
+            cells,
             meta,
         })
     }
@@ -440,9 +498,14 @@ mod tests {
         let mut batches = BatchBlocks::new(3, 2, 2);
         batches.push_batch(&[glam::DVec3::splat(0.5); 6], 1);
         batches.push_batch(&[glam::DVec3::new(1.0, 2.0, 3.0); 6], 2);
+        let mut cells = BatchBlocks::new(3, 2, structure::CELL);
+        for j in 0..structure::MIN_BATCHES {
+            cells.push_batch(&[glam::DVec3::splat(j as f64 * 0.25); 6], 1);
+        }
         GoldenImage {
             estimates: PixelEstimates::from_sums(&sums),
             batches,
+            cells,
             meta: GoldenMeta {
                 hash: 0xfeed_0000_beef,
                 seed: 7,
@@ -492,6 +555,15 @@ mod tests {
         old[..16].copy_from_slice(MAGIC_V1);
         let e = GoldenImage::from_bytes(&old, "g.golden").unwrap_err();
         assert!(e.to_string().contains("older caustic"), "{e}");
+        old[..16].copy_from_slice(MAGIC_V2);
+        let e = GoldenImage::from_bytes(&old, "g.golden").unwrap_err();
+        assert!(e.to_string().contains("without the cells"), "{e}");
+        // Too few cell batches for the structure test: none are stored.
+        let mut few = g.clone();
+        few.cells = BatchBlocks::new(3, 2, structure::CELL);
+        few.cells.push_batch(&[glam::DVec3::ONE; 6], 1);
+        let back = GoldenImage::from_bytes(&few.to_bytes(), "g").unwrap();
+        assert_eq!(back.cells.batches(), 0);
         let mut flipped = bytes.clone();
         flipped[bytes.len() - 30] ^= 4;
         let e = GoldenImage::from_bytes(&flipped, "g.golden").unwrap_err();

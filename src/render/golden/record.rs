@@ -10,6 +10,7 @@
 //! of the same settings, but not the bytes of a one-seed render.
 
 use super::batch_means::{BatchBlocks, BatchRecorder, batch_ranges};
+use super::structure::{CELL, MAX_CELL_BATCHES, merge_batches};
 use crate::render::{PixelSums, RenderError, RenderJob, RenderOptions, RenderOutput};
 use crate::render_scene::RenderScene;
 use crate::settings::IntegratorKind;
@@ -21,6 +22,9 @@ pub struct GoldenRender {
     pub output: RenderOutput,
     /// Each batch's block means.
     pub batches: BatchBlocks,
+    /// Each batch's means over cells of [`CELL`] pixels, consecutive batches merged to at most
+    /// [`MAX_CELL_BATCHES`] (for the structure test, [`super::structure`]).
+    pub cells: BatchBlocks,
     /// The photon-map radius shrink parameter α of a progressive integrator (its per-pass
     /// noise grows as the radius shrinks, which the samples-per-pixel advice accounts for);
     /// `None` for the others.
@@ -74,13 +78,16 @@ fn passes(
         .then_some(f64::from(scene.params.photons.alpha));
     let (w, h) = (scene.params.width, scene.params.height);
     let mut recorder = BatchRecorder::new(w, h, block);
+    let mut cells = BatchRecorder::new(w, h, CELL);
     for range in batch_ranges(scene.params.samples_per_pixel) {
         job.render_pass(range.end - range.start)?;
         recorder.record(job.sums(), job.samples_done());
+        cells.record(job.sums(), job.samples_done());
     }
     Ok(GoldenRender {
         output: job.into_output(),
         batches: recorder.finish(),
+        cells: merge_batches(&cells.finish(), MAX_CELL_BATCHES),
         progressive_alpha,
     })
 }
@@ -93,6 +100,7 @@ fn replications(
     let (seed, spp) = (scene.params.seed, scene.params.samples_per_pixel);
     let (w, h) = (scene.params.width, scene.params.height);
     let mut batches = BatchBlocks::new(w, h, block);
+    let mut cells = BatchBlocks::new(w, h, CELL);
     let mut total: Option<RenderOutput> = None;
     let mut result = Ok(());
     for (j, range) in batch_ranges(spp).into_iter().enumerate() {
@@ -107,6 +115,7 @@ fn replications(
         };
         let sums: Vec<glam::DVec3> = (0..(w * h) as usize).map(|i| out.sums.sum(i)).collect();
         batches.push_batch(&sums, range.end - range.start);
+        cells.push_batch(&sums, range.end - range.start);
         total = Some(match total {
             None => out,
             Some(mut t) => {
@@ -127,6 +136,7 @@ fn replications(
     Ok(GoldenRender {
         output,
         batches,
+        cells: merge_batches(&cells, MAX_CELL_BATCHES),
         progressive_alpha: None,
     })
 }

@@ -7,6 +7,7 @@ use serde_json::Value;
 
 use super::batch_means::{BatchVerdict, BlockDiff};
 use super::floor::DetectionFloor;
+use super::structure::{StructureSkip, StructureVerdict};
 
 /// The scene's settings as sorted `(path, value)` pairs, from its serialized form: every field
 /// after overrides, arrays of numbers kept whole (`materials.red.color = [0.7, 0.12, 0.1]`),
@@ -224,6 +225,68 @@ pub fn changed_lines(v: &BatchVerdict, listed: usize) -> Vec<String> {
     lines
 }
 
+/// The structure test's one-line summary for a verdict of "same": its p-value against its
+/// limit, or why it did not run.
+#[must_use]
+pub fn structure_summary(s: &Result<StructureVerdict, StructureSkip>) -> String {
+    match s {
+        Ok(v) => format!(
+            "pattern of light over small cells: p {} where below {} is a change ({} paired batches, {} sign flips)",
+            number(v.p),
+            number(v.alpha),
+            v.batches,
+            super::structure::FLIPS
+        ),
+        Err(e) => format!("pattern of light not tested: {e}"),
+    }
+}
+
+/// The lines that explain a structure change: per cell size, the statistic against what
+/// unchanged renders give, and the cells that moved most.
+#[must_use]
+pub fn structure_lines(v: &StructureVerdict) -> Vec<String> {
+    let mut out = vec![format!(
+        "  the pattern of light over small cells differs from the golden's: the sum of (difference / noise)² over the cells is beyond what {} sign flips of the {} paired batches give (p {} where below {} is a change):",
+        super::structure::FLIPS,
+        v.batches,
+        number(v.p),
+        number(v.alpha)
+    )];
+    for s in &v.scales {
+        out.push(format!(
+            "    over {0}×{0} px cells: {1:.0} for {2} cell-channels, where an unchanged scene gives {3:.0} (median) and exceeds {4:.0} with probability {5}",
+            s.side,
+            s.q,
+            s.terms,
+            s.null_median,
+            s.null_limit,
+            number(v.alpha)
+        ));
+    }
+    if let Some(s) = v.scales.first() {
+        let moves: Vec<String> = s
+            .largest
+            .iter()
+            .map(|m| {
+                format!(
+                    "x {}–{}, y {}–{} {} {} ({:.1} times its noise)",
+                    m.x,
+                    m.x + m.width - 1,
+                    m.y,
+                    m.y + m.height - 1,
+                    CHANNELS[m.channel],
+                    percent(m.golden, m.now),
+                    m.t.abs()
+                )
+            })
+            .collect();
+        if !moves.is_empty() {
+            out.push(format!("    cells that moved most: {}", moves.join("; ")));
+        }
+    }
+    out
+}
+
 /// The detection floor in words: "a change of every channel by ≥ 9.1 % in an 8×8 px block,
 /// ≥ 4.0 % over 16×16 px, …, ≥ 0.8 % of the whole image is caught in 95 % of checks (median
 /// block)".
@@ -246,8 +309,23 @@ pub fn describe_floor(f: &DetectionFloor) -> String {
             }
         })
         .collect();
+    let structure = if f.cell == 0 || !f.structure.is_finite() {
+        String::new()
+    } else if f.structure_active {
+        format!(
+            "; a change of the pattern of light that moves every {0}×{0} px cell by ±{1:.1} % (no change of the mean) is caught in 95 % of checks (approximately)",
+            f.cell,
+            100.0 * f.structure
+        )
+    } else {
+        format!(
+            "; the pattern of light over {0}×{0} px cells is not tested below {1} samples per pixel",
+            f.cell,
+            super::structure::MIN_BATCHES
+        )
+    };
     format!(
-        "a change of {} is caught in 95 % of checks (of every channel; median block; {} batches)",
+        "a change of {} is caught in 95 % of checks (of every channel; median block; {} batches){structure}",
         parts.join(", "),
         f.batches
     )

@@ -6,7 +6,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::Rgb;
-use super::values::exact_floats;
+use super::values::optional_rgb;
 
 /// A homogeneous medium, given either by its coefficients (`sigma_a`, `sigma_s`) or by its
 /// single-scattering `albedo` and `mean_free_path` — not both forms at once.
@@ -48,8 +48,4 @@ impl MediumSpec {
             ),
         }
     }
-}
-
-fn optional_rgb<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Rgb>, D::Error> {
-    exact_floats::<_, 3>(d).map(Some)
 }

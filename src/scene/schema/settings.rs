@@ -12,7 +12,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::Rgb;
-use super::values::exact_floats;
+use super::values::optional_rgb;
 use crate::settings::{IntegratorKind, SamplerKind, TextureFilter, Tonemap};
 
 /// Declares, for a settings struct whose fields are all `Option`s, the layering methods: `or`
@@ -286,27 +286,6 @@ impl Default for PhotonFilter {
     fn default() -> Self {
         PhotonFilter::Cone { k: 1.1 }
     }
-}
-
-/// An optional colour of exactly three numbers (`None` for `null`, as `--set` writes unset).
-fn optional_rgb<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Rgb>, D::Error> {
-    struct Visit;
-    impl<'de> serde::de::Visitor<'de> for Visit {
-        type Value = Option<Rgb>;
-        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-            f.write_str("3 numbers")
-        }
-        fn visit_none<E: serde::de::Error>(self) -> Result<Self::Value, E> {
-            Ok(None)
-        }
-        fn visit_unit<E: serde::de::Error>(self) -> Result<Self::Value, E> {
-            Ok(None)
-        }
-        fn visit_some<D2: serde::Deserializer<'de>>(self, d: D2) -> Result<Self::Value, D2::Error> {
-            exact_floats::<_, 3>(d).map(Some)
-        }
-    }
-    d.deserialize_option(Visit)
 }
 
 #[cfg(test)]

@@ -105,3 +105,27 @@ impl<'de, const N: usize> serde::de::Visitor<'de> for ExactFloats<N> {
         Ok(out)
     }
 }
+
+/// An optional colour of exactly three numbers (`None` for `null`, as `--set` writes an unset
+/// one back: settings' `background`, a medium's coefficients).
+pub(super) fn optional_rgb<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<super::Rgb>, D::Error> {
+    struct Visit;
+    impl<'de> serde::de::Visitor<'de> for Visit {
+        type Value = Option<super::Rgb>;
+        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("3 numbers")
+        }
+        fn visit_none<E: serde::de::Error>(self) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+        fn visit_unit<E: serde::de::Error>(self) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+        fn visit_some<D2: serde::Deserializer<'de>>(self, d: D2) -> Result<Self::Value, D2::Error> {
+            exact_floats::<_, 3>(d).map(Some)
+        }
+    }
+    d.deserialize_option(Visit)
+}
