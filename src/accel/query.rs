@@ -7,7 +7,11 @@ use crate::geometry::Aabb;
 
 /// Most entries the region query keeps waiting: as many as any tree this crate builds can need
 /// (the ray traversal's largest stack: seven children per level, 64 levels).
-const STACK: usize = (WIDTH - 1) * 64 + 1;
+const STACK_MAX: usize = (WIDTH - 1) * 64 + 1;
+
+/// The region query's stack for ordinary trees (those whose [`Bvh::stack_need`] fits): small
+/// enough that clearing it costs little next to the query.
+const STACK_SMALL: usize = 64;
 
 impl Bvh {
     /// True as soon as `leaf(first, count)` is true for a leaf over slots
@@ -18,12 +22,26 @@ impl Bvh {
     pub fn any_leaf_in(
         &self,
         meets: impl Fn(&Aabb) -> bool,
+        leaf: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        if self.stack_need <= STACK_SMALL {
+            self.any_leaf_with::<STACK_SMALL>(meets, leaf)
+        } else {
+            self.any_leaf_with::<STACK_MAX>(meets, leaf)
+        }
+    }
+
+    /// [`Bvh::any_leaf_in`] with a stack of `N` entries (a tree needing more reports "found",
+    /// the caller's safe side).
+    fn any_leaf_with<const N: usize>(
+        &self,
+        meets: impl Fn(&Aabb) -> bool,
         mut leaf: impl FnMut(u32, u32) -> bool,
     ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        let mut stack = [(0u32, 0u32); STACK];
+        let mut stack = [(0u32, 0u32); N];
         let mut sp = 0usize;
         let (mut index, mut count) = (0u32, 0u32);
         loop {
@@ -33,8 +51,8 @@ impl Bvh {
                     if !node.has_child(c) || !meets(&node.child_bounds(c)) {
                         continue;
                     }
-                    if sp == STACK {
-                        // Deeper than any tree built here: say "found", the caller's safe side.
+                    if sp == N {
+                        // Deeper than the stack: say "found", the caller's safe side.
                         return true;
                     }
                     stack[sp] = (node.index[c], node.count[c]);

@@ -183,7 +183,7 @@ fn the_wall_test_does_not_darken_contact_regions_or_concave_corners() {
     );
     let k = 400;
     let mut map = PhotonMap::new(KdTree::build(photons).expect("tree"), k, 0.2, Kernel::Box);
-    map.mark_walls(&scene.geometry);
+    map.mark_walls(Walls::of(&scene, None));
     let points = [
         [0.05f64, 0.0],
         [0.08, 0.03],

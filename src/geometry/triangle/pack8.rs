@@ -6,9 +6,7 @@
 
 use wide::f32x8;
 
-use glam::Vec3;
-
-use super::{TriPack4, TriRay, plane_hit_f64};
+use super::{TriPack4, TriRay, near_lanes_f64};
 use crate::geometry::float::gamma;
 
 /// What [`intersect_pack8_k`] found: like [`PackHits`](super::PackHits) for eight lanes, lane
@@ -100,15 +98,10 @@ pub fn intersect_pack8_k<const KZ: usize>(
     let (z0, z1, z2) = (p0z * sz, p1z * sz, p2z * sz);
     let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
     let t_max_det = splat(t_max) * det;
-    let behind =
-        ((det_neg & t_scaled.simd_ge(zero)) | (det_pos & t_scaled.simd_le(zero))).to_bitmask();
-    let beyond = ((det_neg & t_scaled.simd_lt(t_max_det))
-        | (det_pos & t_scaled.simd_gt(t_max_det)))
-    .to_bitmask();
-    let mask = inside & !behind & !beyond;
-    // Lanes behind the origin are kept until their distance is known to be certainly negative.
-    let open = inside & !(beyond & !behind);
-    if open == 0 {
+    let reject_neg = det_neg & (t_scaled.simd_ge(zero) | t_scaled.simd_lt(t_max_det));
+    let reject_pos = det_pos & (t_scaled.simd_le(zero) | t_scaled.simd_gt(t_max_det));
+    let mask = inside & !(reject_neg | reject_pos).to_bitmask();
+    if mask == 0 {
         return None;
     }
     let inv_det = splat(1.0) / det;
@@ -125,42 +118,51 @@ pub fn intersect_pack8_k<const KZ: usize>(
     let delta_t = splat(3.0)
         * (splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
         * inv_det.abs();
-    let near = t.abs().simd_le(delta_t).to_bitmask();
-    let mut mask = mask & !near;
-    let (mut t, mut t_scaled, mut det) = (t.to_array(), t_scaled.to_array(), det.to_array());
-    let undecided = open & near;
-    if undecided != 0 {
+    let near = mask & t.simd_le(delta_t).to_bitmask();
+    let mask = mask & !near;
+    if near != 0 {
         // Within the f32 bound of the origin: decided in f64 (see `plane_hit_f64`).
-        for l in 0..8 {
-            if undecided & (1 << l) == 0 {
-                continue;
-            }
-            let pack = if l < 4 { a } else { b };
-            let v = |i: usize| {
-                Vec3::new(
-                    pack.v[i][0][l & 3],
-                    pack.v[i][1][l & 3],
-                    pack.v[i][2][l & 3],
-                )
-            };
-            if let Some(tl) = plane_hit_f64(r, v(0), v(1), v(2), t_max) {
-                mask |= 1 << l;
-                t[l] = tl;
-                t_scaled[l] = tl;
-                det[l] = 1.0;
-            }
-        }
+        let hits = [t.to_array(), t_scaled.to_array(), det.to_array()];
+        let b12 = [(e1 * inv_det).to_array(), (e2 * inv_det).to_array()];
+        return near_pack8_f64(r, [a, b], mask, near, t_max, hits, b12);
     }
     if mask == 0 {
         return None;
     }
     Some(PackHits8 {
         mask,
+        t: t.to_array(),
+        t_scaled: t_scaled.to_array(),
+        det: det.to_array(),
+        b1: (e1 * inv_det).to_array(),
+        b2: (e2 * inv_det).to_array(),
+    })
+}
+
+/// [`intersect_pack8_k`]'s lanes `near` (positive distance within the f32 error bound) decided
+/// by [`plane_hit_f64`](super::plane_hit_f64), added to the lanes `mask` already hit; `None`
+/// if no lane is hit after all.
+#[cold]
+#[inline(never)]
+fn near_pack8_f64(
+    r: &TriRay,
+    packs: [&TriPack4; 2],
+    mask: u32,
+    near: u32,
+    t_max: f32,
+    mut hits: [[f32; 8]; 3],
+    b12: [[f32; 8]; 2],
+) -> Option<PackHits8> {
+    let mask = mask | near_lanes_f64(r, &packs, near, t_max, &mut hits);
+    let [t, t_scaled, det] = hits;
+    let [b1, b2] = b12;
+    (mask != 0).then_some(PackHits8 {
+        mask,
         t,
         t_scaled,
         det,
-        b1: (e1 * inv_det).to_array(),
-        b2: (e2 * inv_det).to_array(),
+        b1,
+        b2,
     })
 }
 

@@ -33,6 +33,7 @@ use super::maps::{
     precompute_irradiance,
 };
 use super::trace::{MapKind, TraceCounts};
+use super::walls::Walls;
 use crate::binfile::{AtomicWrite, Reader, Truncated, fnv1a};
 use crate::render_scene::RenderScene;
 pub use crate::render_scene::hash::{PHOTON_KEY_VERSION as KEY_VERSION, photon_key as cache_key};
@@ -375,7 +376,7 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
         memory += tree.memory_bytes();
         *radius = r;
         let mut map = PhotonMap::new(tree, k as usize, r, kernel);
-        map.mark_walls(&scene.geometry);
+        map.mark_walls(Walls::of(scene, None));
         Ok(Some(map))
     };
     let caustic_kernel = match p.caustic_cone {

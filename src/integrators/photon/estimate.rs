@@ -50,7 +50,6 @@ use glam::Vec3;
 
 use super::radius_field::RadiusField;
 use super::walls::{self, Walls};
-use crate::render_scene::Geometry;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 use crate::spatial::{HasPosition, HashGrid, KdTree, KnnHeap, Photon};
 
@@ -133,20 +132,22 @@ struct Landing {
     normal: Vec3,
     /// Power per channel (W).
     power: Vec3,
-    /// The photon's wall mark ([`PhotonMap::mark_walls`]).
-    near_wall: bool,
+    /// The largest estimate radius (scene units) for which the photon is known to have no
+    /// wall within reach ([`walls::near_wall`]): estimates of a larger radius test it by a ray.
+    /// 0 for a photon marked near a wall.
+    clear: f32,
 }
 
 impl Landing {
-    /// Decodes `ph`, whose wall mark is `near_wall`.
+    /// Decodes `ph`, known clear of walls for estimates of radius up to `clear`.
     #[inline]
-    fn new(ph: &Photon, near_wall: bool) -> Self {
+    fn new(ph: &Photon, clear: f32) -> Self {
         Self {
             position: ph.position().to_array(),
             wi: -ph.direction(),
             normal: ph.normal(),
             power: ph.power(),
-            near_wall,
+            clear,
         }
     }
 }
@@ -205,14 +206,14 @@ impl PhotonMap {
     /// Marks each photon near which a surface of `geometry` rises above its tangent plane within
     /// reach of an estimate of the largest radius ([`walls::near_wall`], one BVH region query per
     /// photon, in parallel): estimates trace wall-test rays only for marked photons. Deterministic.
-    pub fn mark_walls(&mut self, geometry: &Geometry) {
+    pub fn mark_walls(&mut self, walls: Walls<'_>) {
         use rayon::prelude::*;
         let radius = self.max_radius;
         self.near_wall = self
             .tree
             .items()
             .par_iter()
-            .map(|ph| walls::near_wall(geometry, ph.position(), ph.normal(), radius))
+            .map(|ph| walls::near_wall(&walls, ph.position(), ph.normal(), radius))
             .collect();
         self.wall_radius = radius;
     }
@@ -240,13 +241,34 @@ impl PhotonMap {
     /// field's largest radius). With a field that does not depend on this map's photons (a
     /// pilot map's), each estimate is the plain density estimate over a fixed disc: its mean is
     /// the radiance averaged over the disc (Knaus & Zwicker 2011).
-    pub fn set_pass_lookup(&mut self, shrink: f32, field: Arc<RadiusField>) {
+    ///
+    /// The wall marks are made again for the pass's disc: a photon marked for the largest
+    /// radius is tested again at twice the pass's radius where it lies, `2 · shrink · R(p)`
+    /// (one BVH region query each); an estimate whose disc is larger than the radius a
+    /// photon's mark was made for tests that photon by a ray ([`walls::needs_ray`]).
+    pub fn set_pass_lookup(&mut self, shrink: f32, field: Arc<RadiusField>, walls: Walls<'_>) {
+        use rayon::prelude::*;
         self.set_shrink(shrink);
         // Grids whose cells are the disc's diameter at the field's typical radius, then 2×, 4×
         // … up to its largest, so that every estimate finds a grid where its disc overlaps at
         // most 8 cells. The photons are decoded once for all of them.
+        let (wall_radius, shrink) = (self.wall_radius, self.shrink);
         let landings: Vec<Landing> = (0..self.tree.len())
-            .map(|i| Landing::new(&self.tree.items()[i], self.marked(i as u32)))
+            .into_par_iter()
+            .map(|i| {
+                let ph = &self.tree.items()[i];
+                if !self.marked(i as u32) {
+                    return Landing::new(ph, wall_radius);
+                }
+                let (p, n) = (ph.position(), ph.normal());
+                let radius = (2.0 * shrink * field.radius(p)).min(wall_radius);
+                let clear = if walls::near_wall(&walls, p, n, radius) {
+                    0.0
+                } else {
+                    radius
+                };
+                Landing::new(ph, clear)
+            })
             .collect();
         let mut grids = Vec::new();
         let mut cell = 2.0 * self.shrink * field.typical();
@@ -470,15 +492,13 @@ impl PhotonMap {
         let mut sum = Vec3::ZERO;
         let mut found = 0;
         let mut sight = Sight::new(walls, p, ng);
-        // Marks made for a smaller disc than this one do not hold: every photon is tested.
-        let unmarked = r > self.wall_radius;
         let mut add = |ph: &Landing, dist2: f32| {
             found += 1;
             if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, ng)
                 && !sight.separated(
                     Vec3::from_array(ph.position),
                     ph.normal,
-                    ph.near_wall || unmarked,
+                    r > ph.clear,
                 )
             {
                 sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), r);
@@ -494,7 +514,12 @@ impl PhotonMap {
             let photons = self.tree.items();
             self.tree.within(q, r * r, |n| {
                 let ph = &photons[n.index as usize];
-                add(&Landing::new(ph, self.marked(n.index)), n.dist2);
+                let clear = if self.marked(n.index) {
+                    0.0
+                } else {
+                    self.wall_radius
+                };
+                add(&Landing::new(ph, clear), n.dist2);
             });
         }
         let area = std::f32::consts::PI * r * r * self.kernel.normalisation();
@@ -646,7 +671,7 @@ impl IrradianceCache {
                 IrradiancePoint {
                     photon: Photon::new(p, -n, n, e),
                     radius,
-                    near_wall: walls::near_wall(walls.geometry(), p, n, max_radius),
+                    near_wall: walls::near_wall(&walls, p, n, max_radius),
                 }
             })
             .collect();
@@ -710,6 +735,7 @@ impl IrradianceCache {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render_scene::Geometry;
     use crate::sampling::Rng;
 
     fn flat_map(n: usize, k: usize, kernel: Kernel, seed: u64) -> PhotonMap {

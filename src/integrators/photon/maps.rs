@@ -18,7 +18,7 @@ use super::estimate::{IrradianceCache, Kernel, PhotonMap};
 use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon_into};
 use super::volume::{VolumeMap, VolumePhoton};
 use super::walls::Walls;
-use crate::render_scene::{Geometry, RenderScene};
+use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
 use crate::sampling::rng::mix64;
 use crate::spatial::{KdTree, Photon};
@@ -531,7 +531,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
-            &scene.geometry,
+            Walls::of(scene, None),
             photons,
             MapKind::Caustic,
             p.caustic_gather,
@@ -571,7 +571,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
-            &scene.geometry,
+            Walls::of(scene, None),
             photons,
             MapKind::Global,
             p.gather,
@@ -644,7 +644,7 @@ pub(super) fn precompute_irradiance(
 /// Builds the kd-tree of one map's photons, or says why there is none.
 #[allow(clippy::too_many_arguments)]
 fn finish_map(
-    geometry: &Geometry,
+    walls: Walls<'_>,
     photons: Vec<Photon>,
     kind: MapKind,
     k: u32,
@@ -672,7 +672,7 @@ fn finish_map(
     *memory += tree.memory_bytes();
     *radius = r;
     let mut map = PhotonMap::new(tree, k as usize, r, kernel);
-    map.mark_walls(geometry);
+    map.mark_walls(walls);
     *build_time += t.elapsed();
     Some(map)
 }

@@ -95,10 +95,14 @@ impl<'a> Walls<'a> {
     /// Whether a surface of object `object` can be a wall (opaque, not the query's own).
     #[inline]
     fn can_block(&self, object: u32) -> bool {
-        Some(object) != self.object
-            && self
-                .scene
-                .is_none_or(|s| s.objects.get(object as usize).is_none() || s.is_opaque(object))
+        Some(object) != self.object && self.can_block_any(object)
+    }
+
+    /// Whether a surface of object `object` can be a wall to some query point (opaque).
+    #[inline]
+    fn can_block_any(&self, object: u32) -> bool {
+        self.scene
+            .is_none_or(|s| s.objects.get(object as usize).is_none() || s.is_opaque(object))
     }
 }
 
@@ -110,6 +114,11 @@ const REL_TOLERANCE: f32 = 64.0 * f32::EPSILON;
 /// query's or the photon's normal (either orientation: within ~26°) is not a wall (see the
 /// module docs); the irradiance cache's "same surface" cosine.
 pub const PARALLEL_COSINE: f32 = 0.9;
+
+/// A query point's surface whose unit normal has a cosine at most this with a photon's normal
+/// (either orientation) never reads it (the estimate's normal test takes `n_p·n_q > 0.1`; a
+/// little below, for the rounding of normals).
+const QUERY_COSINE: f32 = 0.099;
 
 /// Most crossings of parallel surfaces a segment walks through before it is taken as
 /// unblocked (the receiver's own facets and objects lying on it: a few).
@@ -131,44 +140,119 @@ pub fn reach(p: Vec3, radius: f32) -> f32 {
     1.25 * radius + 12.0 * tolerance(p)
 }
 
-/// True when some primitive within [`reach`]`(p, radius)` of `p` rises more than
-/// [`tolerance`] above the plane through `p` of unit normal `n` (conservatively for ellipsoids,
-/// discs and cylinders: by their boxes). The photon map's per-photon mark: a photon without it
-/// cannot be hidden by a wall from a query point on or above its plane (module docs).
+/// True when some primitive that can be a wall ([`Walls`]: opaque; every object counts, the
+/// query's being unknown here) lies within [`reach`]`(p, radius)` of `p`, rises more than
+/// [`tolerance`] above the plane through `p` of unit normal `n`, and is not parallel to that
+/// plane (a crossing whose normal is within ~26° of the photon's is never a wall,
+/// [`separated`]); conservatively for ellipsoids, discs and cylinders (by their boxes). The
+/// photon map's per-photon mark: a photon without it cannot be hidden by a wall from a query
+/// point on or above its plane (module docs).
 #[must_use]
-pub fn near_wall(geometry: &Geometry, p: Vec3, n: Vec3, radius: f32) -> bool {
+pub fn near_wall(walls: &Walls<'_>, p: Vec3, n: Vec3, radius: f32) -> bool {
+    let geometry = walls.geometry;
     let tol = tolerance(p);
     let reach = reach(p, radius);
     let reach2 = reach * reach;
     let meets = |b: &Aabb| distance2(b, p) <= reach2 && height(b, p, n) > tol;
     geometry.bvh.any_leaf_in(meets, |first, count| {
         (first..first + count).any(|slot| match geometry.slots.get(slot as usize) {
-            Some(&prim) => rises(geometry, prim, p, n, tol, &meets),
+            Some(&prim) => {
+                walls.can_block_any(geometry.object_of(prim))
+                    && rises(geometry, prim, p, n, tol, reach, &meets)
+                    && geometry.triangles.get(prim.index()).is_none_or(|t| {
+                        prim.kind() != PrimKind::Triangle
+                            || has_far_side(geometry, p, n, t, tol, reach, radius)
+                    })
+            }
             None => true,
         })
     })
 }
 
-/// Whether primitive `prim` rises more than `tol` above the plane through `p` (normal `n`)
-/// within the ball `meets` tests.
+/// Whether a triangle `w` standing near the photon at `p` (unit normal `n`) can separate it from
+/// some query point of an estimate of radius up to `radius`: a segment crosses `w` only if its
+/// two (lifted) ends lie on opposite sides of `w`'s plane, so some surface within `reach` of
+/// `p` that could hold such a query point must reach beyond that plane from `p`'s side. The
+/// walls of a closed room are thereby no walls to the photons inside it (the floor, the other
+/// walls all lie on the room's side of each), while a divider with floor on both sides is.
+/// A query surface must face the photon (`|n_Q·n| > 0.1`, the estimate's normal test,
+/// [`landing_cosine`](super::estimate)); each end's lift (at most `h = 12 τ + radius/4`) moves
+/// it across the plane by at most `h |n·n_w|`. True (a wall) whenever in doubt: `p` within that
+/// of the plane, or a primitive other than a triangle reaching beyond it by its box.
+fn has_far_side(
+    geometry: &Geometry,
+    p: Vec3,
+    n: Vec3,
+    w: &[Vec3; 3],
+    tol: f32,
+    reach: f32,
+    radius: f32,
+) -> bool {
+    let nw = (w[1] - w[0]).cross(w[2] - w[0]).normalize_or_zero();
+    if nw == Vec3::ZERO {
+        return true;
+    }
+    let h = 12.0 * tol + 0.25 * radius;
+    let side = (p - w[0]).dot(nw);
+    if side.abs() <= tol + h * n.dot(nw).abs() {
+        return true;
+    }
+    // Signed distance beyond the plane, seen from p's side (positive: beyond).
+    let nw = if side > 0.0 { -nw } else { nw };
+    let beyond = |v: Vec3| (v - w[0]).dot(nw);
+    let reach2 = reach * reach;
+    // A box reaches beyond when its farthest corner does (by more than τ, less any lift).
+    let meets = |b: &Aabb| {
+        distance2(b, p) <= reach2
+            && ((b.min - w[0]) * nw).max((b.max - w[0]) * nw).element_sum() > tol - h
+    };
+    geometry.bvh.any_leaf_in(meets, |first, count| {
+        (first..first + count).any(|slot| {
+            let Some(&prim) = geometry.slots.get(slot as usize) else {
+                return true;
+            };
+            match prim.kind() {
+                PrimKind::Triangle => geometry.triangles.get(prim.index()).is_none_or(|t| {
+                    let nq = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+                    let faces = nq.dot(n).abs() > QUERY_COSINE;
+                    let lift = h * nq.dot(nw).abs();
+                    faces
+                        && t.iter().any(|&v| beyond(v) > tol - lift)
+                        && meets(&Aabb::from_points(t))
+                }),
+                // Their leaf's box met the test: conservatively beyond.
+                PrimKind::Sphere | PrimKind::Ellipsoid | PrimKind::Quadric => true,
+            }
+        })
+    })
+}
+
+/// Whether primitive `prim` can stand across the plane through `p` (unit normal `n`) within
+/// `reach` of `p`: it rises more than `tol` above the plane, inside the ball `meets` tests,
+/// with a part whose normal is more than ~26° from `±n` ([`PARALLEL_COSINE`], with a margin
+/// for the rounding of the hit's normal).
 fn rises(
     geometry: &Geometry,
     prim: PrimRef,
     p: Vec3,
     n: Vec3,
     tol: f32,
+    reach: f32,
     meets: &impl Fn(&Aabb) -> bool,
 ) -> bool {
+    let across = PARALLEL_COSINE + 1e-3;
     match prim.kind() {
         PrimKind::Triangle => geometry.triangles.get(prim.index()).is_none_or(|t| {
-            t.iter().any(|&v| (v - p).dot(n) > tol) && meets(&Aabb::from_points(t))
+            let normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+            normal.dot(n).abs() <= across
+                && t.iter().any(|&v| (v - p).dot(n) > tol)
+                && meets(&Aabb::from_points(t))
         }),
+        // The sphere's points whose normal u has |u·n| ≤ 0.9 lie at heights c + r u·n above
+        // the plane, the highest at c + 0.9 r; a sphere is within reach when its surface is.
         PrimKind::Sphere => geometry.spheres.get(prim.index()).is_none_or(|s| {
-            let b = Aabb {
-                min: s.center - Vec3::splat(s.radius),
-                max: s.center + Vec3::splat(s.radius),
-            };
-            (s.center - p).dot(n) + s.radius > tol && meets(&b)
+            (s.center - p).dot(n) + across * s.radius > tol
+                && s.center.distance(p) - s.radius <= reach
         }),
         // Alone in their leaves: the leaf's box is theirs, and it met the ball above the plane.
         PrimKind::Ellipsoid | PrimKind::Quadric => true,
@@ -287,7 +371,7 @@ mod tests {
     /// Whether an estimate at `q` (normal `nq`) leaves out the photon at `p` (normal `np`):
     /// the estimate's own two steps, the mark (radius 5 cm) and the ray.
     fn hides(g: &Geometry, q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> bool {
-        needs_ray(q, nq, p, np, near_wall(g, p, np, 0.05))
+        needs_ray(q, nq, p, np, near_wall(&Walls::every_surface(g), p, np, 0.05))
             && separated(&Walls::every_surface(g), q, nq, p, np)
     }
 
@@ -315,7 +399,10 @@ mod tests {
         let g = rooms(false).build();
         for x in [-0.04f32, -0.01, 0.0, 0.01, 0.04] {
             let p = Vec3::new(x, 0.0, 0.5);
-            assert!(!near_wall(&g, p, Vec3::Y, 0.05), "{x}");
+            assert!(
+                !near_wall(&Walls::every_surface(&g), p, Vec3::Y, 0.05),
+                "{x}"
+            );
             assert!(!needs_ray(
                 Vec3::new(0.0, 0.0, 0.49),
                 Vec3::Y,
@@ -326,8 +413,18 @@ mod tests {
         }
         // Beside the divider, photons are marked.
         let g = rooms(true).build();
-        assert!(near_wall(&g, Vec3::new(0.03, 0.0, 0.5), Vec3::Y, 0.05));
-        assert!(!near_wall(&g, Vec3::new(0.1, 0.0, 0.5), Vec3::Y, 0.05));
+        assert!(near_wall(
+            &Walls::every_surface(&g),
+            Vec3::new(0.03, 0.0, 0.5),
+            Vec3::Y,
+            0.05
+        ));
+        assert!(!near_wall(
+            &Walls::every_surface(&g),
+            Vec3::new(0.1, 0.0, 0.5),
+            Vec3::Y,
+            0.05
+        ));
     }
 
     /// A ball of radius `r` resting on the rooms' floor (without divider) at the origin.
