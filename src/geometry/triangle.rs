@@ -207,7 +207,11 @@ pub fn plane_hit_f64(r: &TriRay, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Op
     let kx = (r.kz + 1) % 3;
     let ky = (kx + 1) % 3;
     let perm = |p: [f32; 3]| DVec3::new(p[kx].into(), p[ky].into(), p[r.kz].into());
-    let (a, b, c) = (perm(p0.to_array()), perm(p1.to_array()), perm(p2.to_array()));
+    let (a, b, c) = (
+        perm(p0.to_array()),
+        perm(p1.to_array()),
+        perm(p2.to_array()),
+    );
     let o = perm(r.origin);
     let d = DVec3::new(-f64::from(r.sx), -f64::from(r.sy), 1.0);
     let n = (b - a).cross(c - a);
@@ -436,7 +440,11 @@ fn near_pack_f64(
     t_max: f32,
     mut hits: PackHits,
 ) -> Option<PackHits> {
-    let mut ts = [hits.t.to_array(), hits.t_scaled.to_array(), hits.det.to_array()];
+    let mut ts = [
+        hits.t.to_array(),
+        hits.t_scaled.to_array(),
+        hits.det.to_array(),
+    ];
     hits.mask |= near_lanes_f64(r, &[pack], near, t_max, &mut ts);
     [hits.t, hits.t_scaled, hits.det] = ts.map(Vec4::from_array);
     (hits.mask != 0).then_some(hits)
@@ -751,13 +759,21 @@ mod tests {
             if -s > own {
                 checked += 1;
                 within_pbrt_band += usize::from(-s < 1e-5 * f64::from(extent));
-                assert!(hit.is_some(), "{i}: gap {s:e} (own bound {own:e}), extent {extent}");
+                assert!(
+                    hit.is_some(),
+                    "{i}: gap {s:e} (own bound {own:e}), extent {extent}"
+                );
             } else {
                 missed_below += usize::from(hit.is_none());
             }
         }
-        assert!(checked > 2000 && within_pbrt_band > 600, "{checked} {within_pbrt_band}");
-        eprintln!("{checked} rays checked ({within_pbrt_band} within 1e-5 of the extent); {missed_below} missed within the origin's own bound");
+        assert!(
+            checked > 2000 && within_pbrt_band > 600,
+            "{checked} {within_pbrt_band}"
+        );
+        eprintln!(
+            "{checked} rays checked ({within_pbrt_band} within 1e-5 of the extent); {missed_below} missed within the origin's own bound"
+        );
     }
 
     #[test]

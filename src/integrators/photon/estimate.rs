@@ -495,11 +495,7 @@ impl PhotonMap {
         let mut add = |ph: &Landing, dist2: f32| {
             found += 1;
             if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, ng)
-                && !sight.separated(
-                    Vec3::from_array(ph.position),
-                    ph.normal,
-                    r > ph.clear,
-                )
+                && !sight.separated(Vec3::from_array(ph.position), ph.normal, r > ph.clear)
             {
                 sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), r);
             }
@@ -559,11 +555,14 @@ impl<'g> Sight<'g> {
     /// True when a wall separates the accepted photon at `p` (unit normal `np`, wall mark
     /// `near_wall`) from the query point; a ray is traced only when
     /// [`walls::needs_ray`] says one is needed.
-    #[inline]
+    #[inline(always)]
     fn separated(&mut self, p: Vec3, np: Vec3, near_wall: bool) -> bool {
-        if !walls::needs_ray(self.q, self.nq, p, np, near_wall) {
-            return false;
-        }
+        walls::needs_ray(self.q, self.nq, p, np, near_wall) && self.traced(p, np)
+    }
+
+    /// [`Sight::separated`]'s ray, out of line (most photons need none).
+    #[inline(never)]
+    fn traced(&mut self, p: Vec3, np: Vec3) -> bool {
         self.rays += 1;
         let hidden = walls::separated(&self.walls, self.q, self.nq, p, np);
         self.hidden += u32::from(hidden);

@@ -371,8 +371,13 @@ mod tests {
     /// Whether an estimate at `q` (normal `nq`) leaves out the photon at `p` (normal `np`):
     /// the estimate's own two steps, the mark (radius 5 cm) and the ray.
     fn hides(g: &Geometry, q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> bool {
-        needs_ray(q, nq, p, np, near_wall(&Walls::every_surface(g), p, np, 0.05))
-            && separated(&Walls::every_surface(g), q, nq, p, np)
+        needs_ray(
+            q,
+            nq,
+            p,
+            np,
+            near_wall(&Walls::every_surface(g), p, np, 0.05),
+        ) && separated(&Walls::every_surface(g), q, nq, p, np)
     }
 
     #[test]
@@ -425,6 +430,77 @@ mod tests {
             Vec3::Y,
             0.05
         ));
+    }
+
+    #[test]
+    fn the_walls_of_a_closed_room_mark_no_floor_photon_a_divider_does() {
+        // The rooms' floor with the box's four walls standing on its edges: photons 1 mm to
+        // 3 cm from a wall or in a corner are not marked (nothing lies beyond a wall of the
+        // room); with the divider, photons beside it are (the floor runs on beyond it).
+        let walls = |b: &mut GeometryBuilder| {
+            let c = Vec3::new;
+            for w in [
+                [
+                    c(-2.0, 0.0, -1.0),
+                    c(2.0, 0.0, -1.0),
+                    c(2.0, 2.0, -1.0),
+                    c(-2.0, 2.0, -1.0),
+                ],
+                [
+                    c(-2.0, 0.0, 1.0),
+                    c(2.0, 0.0, 1.0),
+                    c(2.0, 2.0, 1.0),
+                    c(-2.0, 2.0, 1.0),
+                ],
+                [
+                    c(-2.0, 0.0, -1.0),
+                    c(-2.0, 0.0, 1.0),
+                    c(-2.0, 2.0, 1.0),
+                    c(-2.0, 2.0, -1.0),
+                ],
+                [
+                    c(2.0, 0.0, -1.0),
+                    c(2.0, 0.0, 1.0),
+                    c(2.0, 2.0, 1.0),
+                    c(2.0, 2.0, -1.0),
+                ],
+            ] {
+                quad(b, w);
+            }
+        };
+        let mut room = rooms(false);
+        walls(&mut room);
+        let room = room.build();
+        let mut divided = rooms(true);
+        walls(&mut divided);
+        let divided = divided.build();
+        for gap in [1e-3f32, 0.01, 0.03] {
+            for p in [
+                Vec3::new(0.5, 0.0, -1.0 + gap),
+                Vec3::new(-2.0 + gap, 0.0, 0.3),
+                Vec3::new(2.0 - gap, 0.0, 1.0 - gap),
+            ] {
+                assert!(
+                    !near_wall(&Walls::every_surface(&room), p, Vec3::Y, 0.05),
+                    "{p}"
+                );
+            }
+            let beside = Vec3::new(gap, 0.0, 0.3);
+            assert!(near_wall(
+                &Walls::every_surface(&divided),
+                beside,
+                Vec3::Y,
+                0.05
+            ));
+            // A photon on a wall near the floor: the floor is no wall to it either.
+            let on_wall = Vec3::new(0.5, gap, -1.0);
+            assert!(!near_wall(
+                &Walls::every_surface(&room),
+                on_wall,
+                Vec3::Z,
+                0.05
+            ));
+        }
     }
 
     /// A ball of radius `r` resting on the rooms' floor (without divider) at the origin.
