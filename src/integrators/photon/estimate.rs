@@ -207,8 +207,12 @@ impl PhotonMap {
     /// reach of an estimate of the largest radius ([`walls::near_wall`], one BVH region query per
     /// photon, in parallel): estimates trace wall-test rays only for marked photons. Deterministic.
     pub fn mark_walls(&mut self, walls: Walls<'_>) {
+        self.mark_walls_within(walls, self.max_radius);
+    }
+
+    /// [`PhotonMap::mark_walls`] for estimates of radius up to `radius` (scene units).
+    fn mark_walls_within(&mut self, walls: Walls<'_>, radius: f32) {
         use rayon::prelude::*;
-        let radius = self.max_radius;
         self.near_wall = self
             .tree
             .items()
@@ -252,7 +256,14 @@ impl PhotonMap {
         // Grids whose cells are the disc's diameter at the field's typical radius, then 2×, 4×
         // … up to its largest, so that every estimate finds a grid where its disc overlaps at
         // most 8 cells. The photons are decoded once for all of them.
-        let (wall_radius, shrink) = (self.wall_radius, self.shrink);
+        let shrink = self.shrink;
+        // Discs where the pilot found no photon take the pilot's largest radius, which can
+        // exceed this map's: marks are then made again for the widest disc.
+        let widest = shrink * field.fallback();
+        if widest > self.wall_radius {
+            self.mark_walls_within(walls, widest);
+        }
+        let wall_radius = self.wall_radius;
         let landings: Vec<Landing> = (0..self.tree.len())
             .into_par_iter()
             .map(|i| {
