@@ -254,9 +254,9 @@ pub(super) fn near_lanes_f64<const N: usize>(
         };
         if let Some(t) = plane_hit_f64(r, v(0), v(1), v(2), t_max) {
             found |= 1 << l;
-            hits[0][l] = t;
-            hits[1][l] = t;
-            hits[2][l] = 1.0;
+            for (lane, value) in hits.iter_mut().zip([t, t, 1.0]) {
+                lane[l] = value;
+            }
         }
     }
     found
