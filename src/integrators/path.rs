@@ -420,7 +420,9 @@ impl<'a> PathTracer<'a> {
                             }
                         }
                         l.add(class, beta * params.background);
-                        if let Some(e) = scene.escape_record(&ray) {
+                        if O::ACTIVE
+                            && let Some(e) = scene.escape_record(&ray)
+                        {
                             cx.observer.hit(node, scene, &e.hit, &e.sp, "light");
                         }
                         break;
@@ -577,7 +579,7 @@ impl<'a> PathTracer<'a> {
                             },
                             parent: node,
                             depth: depth + 1,
-                            medium: medium.after(scene, v, dir),
+                            medium: medium.after_in::<VOLUMETRIC>(scene, v, dir),
                             splits: splits + 1,
                         };
                         // Russian roulette is not applied at a split vertex (optional per vertex,
@@ -650,7 +652,7 @@ impl<'a> PathTracer<'a> {
                     (false, false) => RayKind::Scatter,
                 };
                 parent = node;
-                medium = medium.after(scene, v, s.wi);
+                medium = medium.after_in::<VOLUMETRIC>(scene, v, s.wi);
                 let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
                 ray = Ray::new(origin, s.wi);
             }
@@ -698,12 +700,8 @@ impl PathTracer<'_> {
         else {
             return Vec3::ZERO;
         };
-        let w = if ls.delta || !may_scatter {
-            1.0
-        } else {
-            power_heuristic(ls.pdf * pmf, at.pdf(ls.wi))
-        };
         let transmittance = match through {
+            // Scenes without media past diffuse depth 0 (the common case): visible or not.
             None if blocked => Vec3::ZERO,
             None => Vec3::ONE,
             // Volumetric scenes: the media's transmittance along the shadow ray, through
@@ -729,9 +727,21 @@ impl PathTracer<'_> {
         let c = if blocked {
             Vec3::ZERO
         } else {
-            // |cos θ|: a light seen through a transmitting non-delta lobe (rough glass) lies
-            // below the shading normal, where the signed cosine would subtract its light.
-            f * (at.frame().ns.dot(ls.wi).abs() * w / (ls.pdf * pmf)) * ls.radiance * transmittance
+            // MIS-weighted (the BSDF's pdf only for visible lights). |cos θ|: a light seen
+            // through a transmitting non-delta lobe (rough glass) lies below the shading
+            // normal, where the signed cosine would subtract its light.
+            let w = if ls.delta || !may_scatter {
+                1.0
+            } else {
+                power_heuristic(ls.pdf * pmf, at.pdf(ls.wi))
+            };
+            let c = f * (at.frame().ns.dot(ls.wi).abs() * w / (ls.pdf * pmf)) * ls.radiance;
+            // Without `through` the transmittance is 1: the same bytes without the product.
+            if through.is_some() {
+                c * transmittance
+            } else {
+                c
+            }
         };
         if O::ACTIVE {
             let record = ShadowRecord {
