@@ -353,6 +353,7 @@ impl<'a> PathTracer<'a> {
                             origin: ray.origin,
                             dir: ray.dir / len,
                             t_max: t_hit,
+                            mean_free_path: 1.0 / m.sigma_t().min_element(),
                         });
                         if let Some(seg) = &seg {
                             let c = self.equiangular_direct(seg, m, medium, cx);
