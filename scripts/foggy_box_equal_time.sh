@@ -71,7 +71,8 @@ done
 REF1=$REF_DIR/mitsuba_${ref_spp}_101.exr
 REF2=$REF_DIR/mitsuba_${ref_spp}_102.exr
 
-echo "caustic $(git rev-parse --short HEAD 2>/dev/null || echo '?'), Mitsuba $("$PY" -c 'import mitsuba; print(mitsuba.__version__)'); $(nproc) CPUs:$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"
+if [ -n "${CAUSTIC_BIN:-}" ]; then who_c="caustic binary $caustic"; else who_c="caustic $(git rev-parse --short HEAD 2>/dev/null || echo '?')"; fi
+echo "$who_c, Mitsuba $("$PY" -c 'import mitsuba; print(mitsuba.__version__)'); $(nproc) CPUs:$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"
 echo "load before: $(cut -d' ' -f1-3 /proc/loadavg); budget $budget CPU s per render, 2 threads, ${W}×${H}"
 declare -A rmse
 for who in caustic mitsuba; do

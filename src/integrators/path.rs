@@ -94,7 +94,8 @@ pub struct PathTracer<'a> {
     lights: LightGuide,
     pixel_spread: f32,
     specular_splits: u32,
-    /// Equiangular next-event estimation along medium segments ([`PathTracer::with_equiangular`]).
+    /// Equiangular next-event estimation along medium segments ([`PathTracer::with_equiangular`]):
+    /// on, and the scene has a light with a centre to aim at.
     equiangular: bool,
 }
 
@@ -160,17 +161,26 @@ impl<'a> PathTracer<'a> {
             lights: LightGuide::learn(scene),
             pixel_spread: scene.pixel_spread(),
             specular_splits: 0,
-            equiangular: true,
+            equiangular: scene
+                .lights
+                .iter()
+                .any(|l| equiangular::equiangular_center(l).is_some()),
         }
     }
 
     /// The same tracer with (`true`, the default) or without equiangular next-event estimation
     /// along medium segments (Kulla & Fajardo 2012; `path/equiangular.rs`). Without it, medium
     /// points are found by free-flight sampling alone, as before it existed: the tests measure
-    /// its variance against that.
+    /// its variance against that. A scene without a point, spot or sphere light never uses it
+    /// (it draws no numbers for it either: such scenes render as before).
     #[must_use]
     pub fn with_equiangular(mut self, on: bool) -> Self {
-        self.equiangular = on;
+        self.equiangular = on
+            && self
+                .scene
+                .lights
+                .iter()
+                .any(|l| equiangular::equiangular_center(l).is_some());
         self
     }
 
