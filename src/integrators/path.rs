@@ -20,6 +20,9 @@ use crate::render_scene::{
 };
 use crate::shading::{BsdfAt, TransportMode};
 
+mod equiangular;
+use equiangular::MediumSegment;
+
 /// Bounces after which Russian roulette may end a path.
 const ROULETTE_DEPTH: u32 = 3;
 
@@ -91,6 +94,9 @@ pub struct PathTracer<'a> {
     lights: LightGuide,
     pixel_spread: f32,
     specular_splits: u32,
+    /// Equiangular next-event estimation along medium segments ([`PathTracer::with_equiangular`]):
+    /// on, and the scene has a light with a centre to aim at.
+    equiangular: bool,
 }
 
 /// Most branches waiting while one is followed ([`PathTracer::with_specular_splits`]); with
@@ -155,7 +161,27 @@ impl<'a> PathTracer<'a> {
             lights: LightGuide::learn(scene),
             pixel_spread: scene.pixel_spread(),
             specular_splits: 0,
+            equiangular: scene
+                .lights
+                .iter()
+                .any(|l| equiangular::equiangular_center(l).is_some()),
         }
+    }
+
+    /// The same tracer with (`true`, the default) or without equiangular next-event estimation
+    /// along medium segments (Kulla & Fajardo 2012; `path/equiangular.rs`). Without it, medium
+    /// points are found by free-flight sampling alone, as before it existed: the tests measure
+    /// its variance against that. A scene without a point, spot or sphere light never uses it
+    /// (it draws no numbers for it either: such scenes render as before).
+    #[must_use]
+    pub fn with_equiangular(mut self, on: bool) -> Self {
+        self.equiangular = on
+            && self
+                .scene
+                .lights
+                .iter()
+                .any(|l| equiangular::equiangular_center(l).is_some());
+        self
     }
 
     /// The same tracer splitting camera paths at their first `n` specular vertices: where a
@@ -325,6 +351,24 @@ impl<'a> PathTracer<'a> {
                                 cx.observer.note(node, &text);
                             }
                         }
+                        // Equiangular next-event estimation along the segment, where a vertex
+                        // sampled on it may scatter (path/equiangular.rs); the free-flight
+                        // vertex's estimate below is MIS-weighted against it.
+                        let seg = (self.equiangular
+                            && !background_only
+                            && depth < params.max_depth
+                            && diffuse_bounces < params.diffuse_depth
+                            && m.scatters())
+                        .then(|| MediumSegment {
+                            origin: ray.origin,
+                            dir: ray.dir / len,
+                            t_max: t_hit,
+                            mean_free_path: 1.0 / m.sigma_t().min_element(),
+                        });
+                        if let Some(seg) = &seg {
+                            let c = self.equiangular_direct(seg, m, medium, cx);
+                            l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
+                        }
                         match m.sample_distance(t_hit, cx.sampler.next_2d()) {
                             FreeFlight::Pass { weight } => beta *= weight,
                             FreeFlight::Scatter { t, weight } => {
@@ -344,9 +388,12 @@ impl<'a> PathTracer<'a> {
                                 if !background_only
                                     && let Some((index, pmf)) = self.lights.choose(p, || u_light)
                                 {
-                                    let c = self.direct_in_medium(
+                                    let mut c = self.direct_in_medium(
                                         p, d_in, m, medium, index, pmf, u_point, cx,
                                     );
+                                    if let Some(seg) = &seg {
+                                        c *= self.free_flight_weight(seg, m, t, index, pmf);
+                                    }
                                     l.add(
                                         LightPath::classify(diffuse_bounces + 1, false),
                                         beta * c,
