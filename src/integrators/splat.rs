@@ -306,7 +306,11 @@ mod tests {
             let bits = (u64::from(r.next_u32()) << 32 | u64::from(r.next_u32())) >> 12;
             let m = f64::from_bits(0x3ff0_0000_0000_0000 | bits);
             let e = (r.next_u32() % 71) as i32 - 41;
-            let sign = if r.next_u32().is_multiple_of(2) { 1.0 } else { -1.0 };
+            let sign = if r.next_u32().is_multiple_of(2) {
+                1.0
+            } else {
+                -1.0
+            };
             values.push(sign * m * 2f64.powi(e));
         }
         // Around ±9e18 at 2⁶⁴ (the conversion's switch), every low mantissa bit set.
