@@ -597,30 +597,33 @@ fn the_preview_shows_the_denoised_image_on_a_toggle_as_render_denoise_writes_it(
     assert!(preview.status()["denoised_spp"].is_null());
     // `d` turns it on: the page shows the denoised image of every sample, which is the PNG
     // `render --denoise` writes for the same flags (the same two halves, split at sample 8).
-    browser.key("d");
-    let denoised = wait_for("the denoised image", long, || {
-        Some(browser.canvas()).filter(|c| c.spp == 16 && layer() == "denoised")
-    });
-    let status = preview.status();
-    assert_eq!(status["denoise"], true, "{status}");
-    assert_eq!(status["denoised_spp"], 16, "{status}");
+    // The page is read until it shows that image: a canvas read while the page is between two
+    // images (the layer switched, the new picture not drawn yet) is not a verdict.
     let pinned: Vec<&str> = flags.iter().copied().chain(["--exposure", "1"]).collect();
     let reference = dir.path().join("denoised.png");
     let with_denoise: Vec<&str> = pinned.iter().copied().chain(["--denoise"]).collect();
     let (ok, err) = render(&scene, &with_denoise, &reference);
     assert!(ok, "{err}");
-    assert_eq!(
-        denoised.rgb,
-        png_rgb(&reference),
-        "the page's denoised image is render --denoise's"
+    let expected = png_rgb(&reference);
+    browser.key("d");
+    let denoised = wait_for(
+        "the denoised image, equal to render --denoise's",
+        long,
+        || {
+            Some(browser.canvas())
+                .filter(|c| c.spp == 16 && layer() == "denoised" && c.rgb == expected)
+        },
     );
+    let status = preview.status();
+    assert_eq!(status["denoise"], true, "{status}");
+    assert_eq!(status["denoised_spp"], 16, "{status}");
     assert_ne!(denoised.rgb, noisy.rgb, "denoising changed the image");
     // The button turns it off again: the noisy image, as `render` writes it.
-    browser.click("#denoise");
-    let back = wait_for("the noisy image again", long, || {
-        Some(browser.canvas()).filter(|c| layer() == "beauty" && c.spp == 16)
-    });
     assert!(render(&scene, &pinned, &reference).0);
-    assert_eq!(back.rgb, png_rgb(&reference), "the noisy image is render's");
+    let expected = png_rgb(&reference);
+    browser.click("#denoise");
+    wait_for("the noisy image again, equal to render's", long, || {
+        Some(browser.canvas()).filter(|c| layer() == "beauty" && c.spp == 16 && c.rgb == expected)
+    });
     assert_eq!(preview.status()["denoise"], false);
 }
