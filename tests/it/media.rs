@@ -224,28 +224,7 @@ fn estimate_with(
     ray: Ray,
     n: u32,
 ) -> (glam::DVec3, glam::DVec3, glam::DVec3) {
-    use caustic::integrators::{Context, Counters, NoTrace};
-    let p = &scene.params;
-    let mut sampler = caustic::sampling::Sampler::new(p.sampler, p.seed, n);
-    let mut counters = Counters::default();
-    let (mut sum, mut sq) = (glam::DVec3::ZERO, glam::DVec3::ZERO);
-    for i in 0..n {
-        sampler.start_pixel_sample(0, 0, i);
-        let _ = sampler.pixel_2d();
-        let l = tracer
-            .li(
-                ray,
-                &mut Context::new(&mut sampler, &mut counters, &mut NoTrace),
-            )
-            .total()
-            .as_dvec3();
-        assert!(l.is_finite(), "sample {i}: {l}");
-        sum += l;
-        sq += l * l;
-    }
-    let mean = sum / f64::from(n);
-    let var = (sq / f64::from(n) - mean * mean).max(glam::DVec3::ZERO);
-    (mean, (var / f64::from(n)).sqrt(), var)
+    crate::common::estimate_by(scene, n, |cx| tracer.li(ray, cx).total().as_dvec3())
 }
 
 /// Single scattering along `ray` from the origin along +z through an infinite medium of
