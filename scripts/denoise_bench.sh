@@ -8,6 +8,9 @@
 #   scripts/denoise_bench.sh [BIN] [OUT]      BIN: caustic binary (default target/release/caustic)
 #   LOW=16 HIGH=256 THREADS=2 VENV=target/denoise-venv scripts/denoise_bench.sh
 #
+# Pictures (PNG, linear at EXPOSURE, default 1) of every image go to OUT/<image>.png, and 4×
+# enlarged 48×48 crops around the caustic's hot spot to OUT/crop_<image>.png
+# (scripts/denoise_gallery.sh puts them in docs/images for docs/gallery.md).
 # The render and denoise times are printed by caustic ("denoised in … s"); time them on an idle
 # machine.
 set -euo pipefail
@@ -28,6 +31,11 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$bin" render "$scene" --spp "$low" --threads "$threads" --denoise \
     --layers albedo,normal,depth,caustic -o "$out/low.exr"
-"$bin" render "$scene" --spp "$high" --threads "$threads" --layers caustic -o "$out/high.exr"
+# KEEP_HIGH=1: an OUT/high.exr already there is used (the noisy render does not depend on the
+# denoiser).
+if [ -z "${KEEP_HIGH:-}" ] || [ ! -f "$out/high.exr" ]; then
+    "$bin" render "$scene" --spp "$high" --threads "$threads" --layers caustic -o "$out/high.exr"
+fi
 "$venv/bin/python" "$here/denoise_bench.py" --low "$out/low.exr" --high "$out/high.exr" \
-    --reference "$reference" --oidn-out "$out/oidn.exr" --json "$out/figures.json"
+    --reference "$reference" --oidn-out "$out/oidn.exr" --json "$out/figures.json" \
+    --pictures "$out/" --crop "$out/crop_" --exposure "${EXPOSURE:-1}"

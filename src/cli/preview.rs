@@ -3,6 +3,7 @@
 //! (docs/preview.md). Takes every flag of `render`; the page's save writes what `render -o`
 //! would for the samples taken so far.
 
+mod denoising;
 mod frame;
 mod http;
 mod save;
@@ -79,6 +80,8 @@ pub struct Settings {
     pub quiet: bool,
     /// `--stats`.
     pub stats: bool,
+    /// `--denoise`: the page starts with the denoised image on (its toggle).
+    pub denoise: bool,
     /// What the save writes.
     pub save: SaveSettings,
 }
@@ -134,6 +137,7 @@ impl Settings {
             shard,
             quiet: args.quiet,
             stats: args.stats,
+            denoise: args.denoise,
             save: SaveSettings {
                 output,
                 part,

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use super::DenoiseParams;
 use super::fast_exp::exp_neg;
 use super::input::{Guide, HalfBuffers};
-use super::planes::box_rows;
+use super::planes::{box_filter, box_rows};
 
 /// Rows per work item: a fixed split (not by thread count), so any thread count gives the same
 /// bytes.
@@ -39,7 +39,7 @@ pub struct Candidates {
 }
 
 /// One layer's halves divided by the albedo (plus ε), as planes: `c[half][channel]`, and the
-/// variances divided by its square.
+/// variances divided by its square, box-filtered.
 #[derive(Debug, Clone)]
 pub struct LayerPlanes {
     c: [[Vec<f32>; 3]; 2],
@@ -47,9 +47,19 @@ pub struct LayerPlanes {
 }
 
 impl LayerPlanes {
-    /// The planes of `layer` divided by `demodulate` (per channel).
+    /// The planes of `layer` divided by `demodulate` (per channel), for a `w`-wide image. The
+    /// variances are box-filtered over `(2·variance_radius + 1)²` pixels (0: as they are): a
+    /// pixel's variance from a few samples is itself very noisy — with two samples that agree
+    /// by chance (both zero, say) it is 0, and the colour distance would then refuse every
+    /// neighbour — so it is prefiltered, as Rousselle, Knaus and Zwicker (2012) and Bitterli et
+    /// al. (2016) prefilter theirs.
     #[must_use]
-    pub fn new(layer: &HalfBuffers, demodulate: &[Vec<f32>; 3]) -> Self {
+    pub fn new(
+        layer: &HalfBuffers,
+        demodulate: &[Vec<f32>; 3],
+        w: usize,
+        variance_radius: usize,
+    ) -> Self {
         let plane = |values: &[glam::Vec3], ch: usize, power: i32| -> Vec<f32> {
             values
                 .iter()
@@ -59,9 +69,17 @@ impl LayerPlanes {
         };
         let half =
             |values: &[glam::Vec3], power| std::array::from_fn(|ch| plane(values, ch, power));
+        let h = layer.mean[0].len() / w.max(1);
+        let smooth = |plane: Vec<f32>| {
+            if variance_radius == 0 || w == 0 {
+                plane
+            } else {
+                box_filter(&plane, w, h, variance_radius)
+            }
+        };
         Self {
             c: std::array::from_fn(|h| half(&layer.mean[h], 1)),
-            v: std::array::from_fn(|h| half(&layer.variance[h], 2)),
+            v: std::array::from_fn(|hf| half(&layer.variance[hf], 2).map(smooth)),
         }
     }
 }

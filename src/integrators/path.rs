@@ -21,6 +21,9 @@ use crate::render_scene::{
 };
 use crate::shading::{BsdfAt, TransportMode};
 
+mod equiangular;
+use equiangular::MediumSegment;
+
 /// Bounces after which Russian roulette may end a path.
 const ROULETTE_DEPTH: u32 = 3;
 
@@ -92,6 +95,9 @@ pub struct PathTracer<'a> {
     lights: LightGuide,
     pixel_spread: f32,
     specular_splits: u32,
+    /// Equiangular next-event estimation along medium segments ([`PathTracer::with_equiangular`]):
+    /// on, and the scene has a light with a centre to aim at.
+    equiangular: bool,
 }
 
 /// Most branches waiting while one is followed ([`PathTracer::with_specular_splits`]); with
@@ -156,7 +162,27 @@ impl<'a> PathTracer<'a> {
             lights: LightGuide::learn(scene),
             pixel_spread: scene.pixel_spread(),
             specular_splits: 0,
+            equiangular: scene
+                .lights
+                .iter()
+                .any(|l| equiangular::equiangular_center(l).is_some()),
         }
+    }
+
+    /// The same tracer with (`true`, the default) or without equiangular next-event estimation
+    /// along medium segments (Kulla & Fajardo 2012; `path/equiangular.rs`). Without it, medium
+    /// points are found by free-flight sampling alone, as before it existed: the tests measure
+    /// its variance against that. A scene without a point, spot or sphere light never uses it
+    /// (it draws no numbers for it either: such scenes render as before).
+    #[must_use]
+    pub fn with_equiangular(mut self, on: bool) -> Self {
+        self.equiangular = on
+            && self
+                .scene
+                .lights
+                .iter()
+                .any(|l| equiangular::equiangular_center(l).is_some());
+        self
     }
 
     /// The same tracer splitting camera paths at their first `n` specular vertices: where a
@@ -326,6 +352,24 @@ impl<'a> PathTracer<'a> {
                                 cx.observer.note(node, &text);
                             }
                         }
+                        // Equiangular next-event estimation along the segment, where a vertex
+                        // sampled on it may scatter (path/equiangular.rs); the free-flight
+                        // vertex's estimate below is MIS-weighted against it.
+                        let seg = (self.equiangular
+                            && !background_only
+                            && depth < params.max_depth
+                            && diffuse_bounces < params.diffuse_depth
+                            && m.scatters())
+                        .then(|| MediumSegment {
+                            origin: ray.origin,
+                            dir: ray.dir / len,
+                            t_max: t_hit,
+                            mean_free_path: 1.0 / m.sigma_t().min_element(),
+                        });
+                        if let Some(seg) = &seg {
+                            let c = self.equiangular_direct(seg, m, medium, cx);
+                            l.add(LightPath::classify(diffuse_bounces + 1, false), beta * c);
+                        }
                         match m.sample_distance(t_hit, cx.sampler.next_2d()) {
                             FreeFlight::Pass { weight } => beta *= weight,
                             FreeFlight::Scatter { t, weight } => {
@@ -345,9 +389,12 @@ impl<'a> PathTracer<'a> {
                                 if !background_only
                                     && let Some((index, pmf)) = self.lights.choose(p, || u_light)
                                 {
-                                    let c = self.direct_in_medium(
+                                    let mut c = self.direct_in_medium(
                                         p, d_in, m, medium, index, pmf, u_point, cx,
                                     );
+                                    if let Some(seg) = &seg {
+                                        c *= self.free_flight_weight(seg, m, t, index, pmf);
+                                    }
                                     l.add(
                                         LightPath::classify(diffuse_bounces + 1, false),
                                         beta * c,
@@ -421,7 +468,9 @@ impl<'a> PathTracer<'a> {
                             }
                         }
                         l.add(class, beta * params.background);
-                        if let Some(e) = scene.escape_record(&ray) {
+                        if O::ACTIVE
+                            && let Some(e) = scene.escape_record(&ray)
+                        {
                             cx.observer.hit(node, scene, &e.hit, &e.sp, "light");
                         }
                         break;
@@ -579,7 +628,7 @@ impl<'a> PathTracer<'a> {
                             },
                             parent: node,
                             depth: depth + 1,
-                            medium: medium.after(scene, v, dir),
+                            medium: medium.after_in::<VOLUMETRIC>(scene, v, dir),
                             splits: splits + 1,
                         };
                         // Russian roulette is not applied at a split vertex (optional per vertex,
@@ -652,7 +701,7 @@ impl<'a> PathTracer<'a> {
                     (false, false) => RayKind::Scatter,
                 };
                 parent = node;
-                medium = medium.after(scene, v, s.wi);
+                medium = medium.after_in::<VOLUMETRIC>(scene, v, s.wi);
                 let origin = offset_ray_origin(sp.p, sp.p_error, fr.ng, s.wi);
                 ray = Ray::new(origin, s.wi);
             }
@@ -700,12 +749,8 @@ impl PathTracer<'_> {
         else {
             return Vec3::ZERO;
         };
-        let w = if ls.delta || !may_scatter {
-            1.0
-        } else {
-            power_heuristic(ls.pdf * pmf, at.pdf(ls.wi))
-        };
         let transmittance = match through {
+            // Scenes without media past diffuse depth 0 (the common case): visible or not.
             None if blocked => Vec3::ZERO,
             None => Vec3::ONE,
             // Volumetric scenes: the media's transmittance along the shadow ray, through
@@ -731,9 +776,21 @@ impl PathTracer<'_> {
         let c = if blocked {
             Vec3::ZERO
         } else {
-            // |cos θ|: a light seen through a transmitting non-delta lobe (rough glass) lies
-            // below the shading normal, where the signed cosine would subtract its light.
-            f * (at.frame().ns.dot(ls.wi).abs() * w / (ls.pdf * pmf)) * ls.radiance * transmittance
+            // MIS-weighted (the BSDF's pdf only for visible lights). |cos θ|: a light seen
+            // through a transmitting non-delta lobe (rough glass) lies below the shading
+            // normal, where the signed cosine would subtract its light.
+            let w = if ls.delta || !may_scatter {
+                1.0
+            } else {
+                power_heuristic(ls.pdf * pmf, at.pdf(ls.wi))
+            };
+            let c = f * (at.frame().ns.dot(ls.wi).abs() * w / (ls.pdf * pmf)) * ls.radiance;
+            // Without `through` the transmittance is 1: the same bytes without the product.
+            if through.is_some() {
+                c * transmittance
+            } else {
+                c
+            }
         };
         if O::ACTIVE {
             let record = ShadowRecord {

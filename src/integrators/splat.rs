@@ -45,6 +45,32 @@ pub fn to_fixed(v: f64, scale: f64) -> i128 {
     }
 }
 
+/// `v · 2^k` rounded to the nearest integer (ties away from zero), exactly as
+/// [`to_fixed`]`(v, 2^k)` computes it, for finite `v` with `|v · 2^k| < 2¹²⁶` (the film's
+/// samples below its wide-sum limit), without the float-to-`i128` conversion (a library
+/// routine) for magnitudes of 2⁶³ and more.
+#[inline]
+#[must_use]
+pub fn to_fixed_exp2(v: f64, k: i32) -> i128 {
+    // 2^k exactly (k is small), so the product is exact.
+    let x = v * f64::from_bits(((1023 + k) as u64) << 52);
+    if x.abs() < 9.0e18 {
+        x.round() as i64 as i128
+    } else {
+        // |x| ≥ 9e18 is an integer: split its magnitude at 2⁶⁴ into a high word (< 2⁶², as
+        // |x| < 2¹²⁶) and a low word in [0, 2⁶⁴), both exact (the low word is a multiple of
+        // x's unit in the last place and below 2⁶⁴, so it has at most 53 significant bits).
+        let a = x.abs();
+        let hi = (a * TWO_POW_MINUS_64).floor();
+        let lo = a - hi * SUM_SCALE;
+        let magnitude = (i128::from(hi as u64) << 64) + i128::from(lo as u64);
+        if x < 0.0 { -magnitude } else { magnitude }
+    }
+}
+
+/// 2⁻⁶⁴.
+const TWO_POW_MINUS_64: f64 = 1.0 / SUM_SCALE;
+
 /// The two's-complement halves of a fixed-point value: (low word, high word).
 #[inline]
 fn halves(f: i128) -> (u64, u64) {
@@ -246,6 +272,65 @@ mod tests {
     use crate::render::PixelSums;
     use crate::sampling::Rng;
     use rayon::prelude::*;
+
+    /// The shift-built conversion against the float one it replaces on the film's main path:
+    /// random magnitudes over 2⁻⁴⁰ … 2³⁰, exact ties at both scales, subnormals, zeros, and the
+    /// extremes of the range.
+    #[test]
+    fn exp2_conversion_equals_the_float_one() {
+        let mut r = Rng::new(41, 3);
+        let mut values = vec![
+            0.0,
+            -0.0,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+            5e-324,
+            -5e-324,
+            1e-310,
+            2f64.powi(30) - 1.0,
+            -(2f64.powi(30) - 1.0),
+            1.0,
+            0.5,
+            0.49,
+            0.51,
+        ];
+        for k in [32, 64] {
+            // v · 2^k = n + 1/2 exactly: ties, either sign, and their neighbours.
+            for n in [0.0, 1.0, 2.0, 7.0, 1e6, 12345.0] {
+                let t = (n + 0.5) / 2f64.powi(k);
+                values.extend([t, -t, t.next_up(), t.next_down(), -t.next_up()]);
+            }
+        }
+        for _ in 0..400_000 {
+            // Full 53-bit mantissas in [1, 2) (the low bits matter for exactness), any sign.
+            let bits = (u64::from(r.next_u32()) << 32 | u64::from(r.next_u32())) >> 12;
+            let m = f64::from_bits(0x3ff0_0000_0000_0000 | bits);
+            let e = (r.next_u32() % 71) as i32 - 41;
+            let sign = if r.next_u32().is_multiple_of(2) {
+                1.0
+            } else {
+                -1.0
+            };
+            values.push(sign * m * 2f64.powi(e));
+        }
+        // Around ±9e18 at 2⁶⁴ (the conversion's switch), every low mantissa bit set.
+        for t in [0.4878, 0.49, 0.4999, 0.5, 0.75] {
+            let v = f64::from_bits(f64::to_bits(t) | 0xfff);
+            values.extend([v, -v, v.next_up(), -v.next_down()]);
+        }
+        for v in values {
+            for k in [32, 64] {
+                if (v * 2f64.powi(k)).abs() >= 2f64.powi(126) {
+                    continue;
+                }
+                assert_eq!(
+                    to_fixed_exp2(v, k),
+                    to_fixed(v, 2f64.powi(k)),
+                    "{v:e} · 2^{k}"
+                );
+            }
+        }
+    }
 
     /// Random splats over a 7 × 5 film, many on the same pixels, of both signs and a wide range
     /// of magnitudes (low-word carries and borrows happen).

@@ -86,14 +86,16 @@ impl AutoExposure {
             .iter()
             .map(|p| clean(p.x).max(clean(p.y)).max(clean(p.z)))
             .collect();
-        brightest.sort_unstable_by(f32::total_cmp);
-        // At most `allowed` pixels may be at or above white: the one just below them sets it.
+        let lit = brightest.iter().any(|&b| b > 0.0);
+        // At most `allowed` pixels may be at or above white: the one just below them sets it
+        // (an order statistic: a selection, not a sort, finds it).
         let allowed = (n as f64 * MAX_CLIPPED_FRACTION).floor() as usize;
         let p99 = n
             .checked_sub(allowed + 1)
-            .and_then(|i| brightest.get(i).copied())
-            .unwrap_or(0.0);
-        let lit = brightest.last().is_some_and(|&b| b > 0.0);
+            .filter(|&i| i < brightest.len())
+            .map_or(0.0, |i| {
+                *brightest.select_nth_unstable_by(i, f32::total_cmp).1
+            });
         let key_exposure = if lit && log_average > 0.0 {
             KEY / log_average
         } else {

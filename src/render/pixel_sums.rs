@@ -18,13 +18,17 @@ use glam::{DVec3, Vec3};
 use super::Film;
 use super::wide_sum::WideSum;
 use crate::binfile::{Reader, fnv1a};
-use crate::integrators::splat::{SUM_SCALE as SCALE, SplatBuffer, to_fixed as fixed};
+use crate::integrators::splat::{SUM_SCALE as SCALE, SplatBuffer, to_fixed_exp2};
 
 // The fixed-point scale of the sums (`SCALE`, shared with the splat buffer): samples are rounded
 // to multiples of 2⁻⁶⁴ (about 5.4e-20) before summing, so even a light of a microwatt keeps 11
 // significant digits.
 /// Fixed-point scale of the sums of squares: 2⁻³² resolution.
 const SCALE_SQ: f64 = 4_294_967_296.0;
+/// log₂ of [`SCALE`] (the integrators' `SUM_SCALE`, 2⁶⁴).
+const SCALE_EXP: i32 = 64;
+/// log₂ of [`SCALE_SQ`].
+const SCALE_SQ_EXP: i32 = 32;
 /// Sample channels of at least this magnitude (2³⁰ ≈ 1.07e9) go to the wide sums: below it,
 /// 2³² samples sum to less than 2¹²⁷ at both fixed-point scales.
 pub const MAIN_LIMIT: f64 = 1_073_741_824.0;
@@ -112,7 +116,7 @@ impl PixelSums {
     }
 
     /// Adds one finite radiance sample to pixel `index` (row-major).
-    #[inline]
+    #[inline(always)]
     pub fn add(&mut self, index: usize, l: Vec3) {
         let l = l.as_dvec3();
         if l.abs().max_element() < MAIN_LIMIT {
@@ -126,11 +130,18 @@ impl PixelSums {
     }
 
     /// Adds sample channel value `v` (magnitude below [`MAIN_LIMIT`]) to channel `c` of pixel
-    /// `index`'s 128-bit sums.
+    /// `index`'s 128-bit sums. The same integers as [`to_fixed`](crate::integrators::splat::to_fixed) at both scales, computed
+    /// with integer shifts ([`to_fixed_exp2`]). The additions cannot overflow: each adds less
+    /// than 2⁹⁴ (sums) or 2⁹² (squares), and a pixel holds fewer than 2³² samples, so a sum of
+    /// samples stays below 2¹²⁶; they wrap rather than test for it.
     #[inline(always)]
     fn add_main(&mut self, index: usize, c: usize, v: f64) {
-        self.sums[index][c] = self.sums[index][c].saturating_add(fixed(v, SCALE));
-        self.squares[index][c] = self.squares[index][c].saturating_add(fixed(v * v, SCALE_SQ));
+        let (s, q) = (
+            to_fixed_exp2(v, SCALE_EXP),
+            to_fixed_exp2(v * v, SCALE_SQ_EXP),
+        );
+        self.sums[index][c] = self.sums[index][c].wrapping_add(s);
+        self.squares[index][c] = self.squares[index][c].wrapping_add(q);
     }
 
     /// [`PixelSums::add`] for a sample with a channel of magnitude [`MAIN_LIMIT`] or more: such
@@ -462,6 +473,13 @@ impl PixelSums {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrators::splat::to_fixed as fixed;
+
+    #[test]
+    fn scale_exponents_match_the_scales() {
+        assert_eq!(SCALE, 2f64.powi(SCALE_EXP));
+        assert_eq!(SCALE_SQ, 2f64.powi(SCALE_SQ_EXP));
+    }
 
     #[test]
     fn fixed_point_conversion_equals_the_plain_i128_cast_on_both_paths() {

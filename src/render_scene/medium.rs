@@ -205,16 +205,33 @@ impl Medium {
     #[inline]
     #[must_use]
     pub fn after(self, scene: &RenderScene, v: &SurfaceHit, wi: Vec3) -> Self {
-        // `v.sp.ng` is the object's outward geometric normal.
-        let entering = wi.dot(v.sp.ng) < 0.0;
         if scene.volumetric {
-            return self.crossed(scene, v.material, entering);
+            self.after_in::<true>(scene, v, wi)
+        } else {
+            self.after_in::<false>(scene, v, wi)
+        }
+    }
+
+    /// [`Medium::after`] where the scene's [`RenderScene::volumetric`] is known when compiling
+    /// (`VOLUMETRIC`): the path tracer's loop, one copy per kind of scene, so that scenes
+    /// without media test for it nowhere.
+    #[inline(always)]
+    #[must_use]
+    pub fn after_in<const VOLUMETRIC: bool>(
+        self,
+        scene: &RenderScene,
+        v: &SurfaceHit,
+        wi: Vec3,
+    ) -> Self {
+        debug_assert_eq!(VOLUMETRIC, scene.volumetric);
+        // `v.sp.ng` is the object's outward geometric normal.
+        if VOLUMETRIC {
+            return self.crossed(scene, v.material, wi.dot(v.sp.ng) < 0.0);
         }
         let absorption = scene.materials[v.material as usize].absorption;
         if absorption.is_clear() {
-            return self;
-        }
-        if entering {
+            self
+        } else if wi.dot(v.sp.ng) < 0.0 {
             Self {
                 absorption,
                 ..Self::OUTSIDE

@@ -69,6 +69,20 @@ impl HomogeneousMedium {
         transmittance(self.sigma_t(), distance)
     }
 
+    /// The density (per metre) with which [`Self::sample_distance`] places a scattering event
+    /// `t` metres along a segment longer than `t`: `p(t) = ⅓ Σ_c σt,c exp(−σt,c t)` (module
+    /// docs); what multiple importance sampling weighs another distance sampler against
+    /// (equiangular sampling, `integrators::path`). 0 for a medium that does not scatter.
+    #[inline]
+    #[must_use]
+    pub fn scatter_pdf(&self, t: f32) -> f32 {
+        if !self.scatters() {
+            return 0.0;
+        }
+        let st = self.sigma_t();
+        (st * transmittance(st, t)).element_sum() / 3.0
+    }
+
     /// Draws the next scattering event along a segment `t_max` metres long (infinite for a ray
     /// that escapes) from two uniform numbers: `u.0` chooses the channel, `u.1` the distance
     /// (module docs). A medium that does not scatter only passes, weighted by its
@@ -175,6 +189,37 @@ mod tests {
                 "{c}: {scatter} vs {want_scatter}"
             );
         }
+    }
+
+    #[test]
+    fn scatter_pdf_is_the_density_of_sampled_events() {
+        // The fraction of 400 000 draws scattering in [t0, t1) against ∫ p(t) dt over it,
+        // p's integral in closed form: ⅓ Σ_c (e^{−σt,c t0} − e^{−σt,c t1}).
+        let m = medium(Vec3::new(0.1, 0.5, 0.0), Vec3::new(0.9, 0.2, 1.5));
+        let st = m.sigma_t();
+        let (t0, t1) = (0.3f32, 0.8f32);
+        let n = 400_000;
+        let mut rng = Rng::new(11, 0);
+        let mut inside = 0u32;
+        for _ in 0..n {
+            if let FreeFlight::Scatter { t, .. } = m.sample_distance(2.0, rng.next_2d())
+                && (t0..t1).contains(&t)
+            {
+                inside += 1;
+            }
+        }
+        let want = (0..3)
+            .map(|c| ((-st[c] * t0).exp() - (-st[c] * t1).exp()) / 3.0)
+            .sum::<f32>();
+        let got = inside as f32 / n as f32;
+        assert!((got - want).abs() < 0.003, "{got} vs {want}");
+        // And p itself against that integral by the midpoint rule.
+        let steps = 10_000;
+        let h = (t1 - t0) / steps as f32;
+        let integral: f32 = (0..steps)
+            .map(|i| m.scatter_pdf(t0 + (i as f32 + 0.5) * h) * h)
+            .sum();
+        assert!((integral - want).abs() < 1e-4, "{integral} vs {want}");
     }
 
     #[test]

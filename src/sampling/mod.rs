@@ -4,6 +4,7 @@ pub mod alias;
 #[cfg(test)]
 pub(crate) mod chi2;
 pub mod distribution;
+pub mod equiangular;
 pub mod rng;
 pub mod sampler;
 pub mod sobol;

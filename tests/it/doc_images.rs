@@ -47,6 +47,34 @@ const SCRIPT_MADE: &[(&str, &str)] = &[
     ("foggy_box.png", "scripts/media_images.sh"),
     ("volume_caustic.png", "scripts/media_images.sh"),
     ("fog_window.png", "scripts/media_images.sh"),
+    ("denoise_cbox_noisy.png", "scripts/denoise_gallery.sh"),
+    ("denoise_cbox_denoised.png", "scripts/denoise_gallery.sh"),
+    ("denoise_cbox_oidn.png", "scripts/denoise_gallery.sh"),
+    ("denoise_cbox_reference.png", "scripts/denoise_gallery.sh"),
+    ("denoise_cbox_crop_noisy.png", "scripts/denoise_gallery.sh"),
+    (
+        "denoise_cbox_crop_denoised.png",
+        "scripts/denoise_gallery.sh",
+    ),
+    ("denoise_cbox_crop_oidn.png", "scripts/denoise_gallery.sh"),
+    (
+        "denoise_cbox_crop_reference.png",
+        "scripts/denoise_gallery.sh",
+    ),
+    ("denoise_bath_noisy.png", "scripts/denoise_gallery.sh"),
+    ("denoise_bath_denoised.png", "scripts/denoise_gallery.sh"),
+    ("denoise_bath_oidn.png", "scripts/denoise_gallery.sh"),
+    ("denoise_bath_reference.png", "scripts/denoise_gallery.sh"),
+    ("denoise_bath_crop_noisy.png", "scripts/denoise_gallery.sh"),
+    (
+        "denoise_bath_crop_denoised.png",
+        "scripts/denoise_gallery.sh",
+    ),
+    ("denoise_bath_crop_oidn.png", "scripts/denoise_gallery.sh"),
+    (
+        "denoise_bath_crop_reference.png",
+        "scripts/denoise_gallery.sh",
+    ),
 ];
 
 /// Largest fraction of the sampled pixels that may differ by more than one 8-bit step.

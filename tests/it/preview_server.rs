@@ -214,12 +214,18 @@ fn only_the_pages_own_origin_changes_the_preview_and_status_hides_the_scenes_fol
     ] {
         assert_eq!(post("/save", origin).0, 403, "{origin}");
         assert_eq!(post("/pause?on=1", origin).0, 403, "{origin}");
+        assert_eq!(post("/denoise?on=1", origin).0, 403, "{origin}");
     }
     assert!(
         !dir.path().join("out.png").exists(),
         "a cross-origin save wrote the image"
     );
     assert_eq!(server.status().0["paused"], false);
+    assert_eq!(
+        server.status().0["denoise"],
+        false,
+        "a cross-origin denoise toggle"
+    );
     // DNS rebinding: a page whose own name now resolves to 127.0.0.1 can read nothing.
     let rebound = server
         .exchange(format!("GET /status HTTP/1.1\r\nHost: evil.example:{port}\r\n\r\n").as_bytes());
@@ -234,6 +240,13 @@ fn only_the_pages_own_origin_changes_the_preview_and_status_hides_the_scenes_fol
         std::thread::sleep(Duration::from_millis(20));
     }
     assert_eq!(post("/pause?on=0", &page).0, 200);
+    assert_eq!(post("/denoise?on=1", &page).0, 200);
+    let asked = Instant::now();
+    while server.status().0["denoise"] != true {
+        assert!(asked.elapsed() < Duration::from_secs(5), "denoising not on");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert_eq!(post("/denoise?on=0", &page).0, 200);
     let (code, body) = post("/save", &format!("Origin: http://localhost:{port}\r\n"));
     assert_eq!(code, 200, "{body}");
     assert!(body.contains("\"ok\":true"), "{body}");

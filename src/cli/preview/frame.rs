@@ -1,5 +1,8 @@
-//! What the page shows of a render after a pass: the current estimate of each layer, and the
-//! noise figure computed from the film's per-pixel variance.
+//! What the page shows of a render after a pass: the current estimate of each layer, the
+//! denoised image when the page's toggle asks for it, and the noise figure computed from the
+//! film's per-pixel variance.
+
+use std::sync::Arc;
 
 use glam::Vec3;
 
@@ -17,17 +20,21 @@ pub enum View {
     /// noise left in the pixel, in radiance units (the `variance` layer, square-rooted so that
     /// exposure scales it like the image).
     StdError,
+    /// The denoised image (`--denoise`'s, docs/denoise.md), when the page's toggle is on and
+    /// one has been made ([`Frame::denoised`]).
+    Denoised,
 }
 
 impl View {
     /// Every view, in the page's order.
-    pub const ALL: [View; 6] = [
+    pub const ALL: [View; 7] = [
         View::Beauty,
         View::Part(LightPath::Specular),
         View::Part(LightPath::Direct),
         View::Part(LightPath::Caustic),
         View::Part(LightPath::Indirect),
         View::StdError,
+        View::Denoised,
     ];
 
     /// The name the page asks for (`/image.png?layer=NAME`).
@@ -36,6 +43,7 @@ impl View {
             View::Beauty => "beauty",
             View::Part(p) => p.name(),
             View::StdError => "variance",
+            View::Denoised => "denoised",
         }
     }
 
@@ -76,11 +84,24 @@ pub fn noise(sums: &PixelSums) -> Option<Noise> {
     })
 }
 
+/// A denoised image of the render and the samples per pixel it was made from (it is made
+/// less often than passes end, so it can be older than the frame it rides in).
+#[derive(Debug, Clone)]
+pub struct Denoised {
+    /// The denoised image.
+    pub film: Arc<Film>,
+    /// Samples per pixel it was made from.
+    pub spp: u32,
+}
+
 /// The images of one moment of a render, in [`View::ALL`] order.
 #[derive(Debug, Clone)]
 pub struct Frame {
-    /// One film per view (a view the render did not keep is black).
+    /// One film per view of the sums (every view but [`View::Denoised`]; a view the render did
+    /// not keep is black).
     pub views: Vec<Film>,
+    /// The latest denoised image of this render, if the toggle is on and one was made.
+    pub denoised: Option<Denoised>,
     /// Samples per pixel in it.
     pub spp: u32,
     /// The render it is of ([`super::state::Status::generation`]).
@@ -88,36 +109,53 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// The frame of `sums` (and the per-light-path `parts`, in [`LightPath::ALL`] order).
-    pub fn new(sums: &PixelSums, parts: Option<&[PixelSums]>, spp: u32, generation: u64) -> Self {
+    /// The frame of `sums` (and the per-light-path `parts`, in [`LightPath::ALL`] order), with
+    /// the render's latest denoised image if any.
+    pub fn new(
+        sums: &PixelSums,
+        parts: Option<&[PixelSums]>,
+        spp: u32,
+        generation: u64,
+        denoised: Option<Denoised>,
+    ) -> Self {
         let views = View::ALL
             .iter()
-            .map(|v| match v {
-                View::Beauty => sums.to_film(),
-                View::Part(p) => parts
-                    .and_then(|parts| parts.get(*p as usize))
-                    .map_or_else(|| Film::new(sums.width, sums.height), PixelSums::to_film),
+            .filter_map(|v| match v {
+                View::Beauty => Some(sums.to_film()),
+                View::Part(p) => Some(
+                    parts
+                        .and_then(|parts| parts.get(*p as usize))
+                        .map_or_else(|| Film::new(sums.width, sums.height), PixelSums::to_film),
+                ),
                 View::StdError => {
                     let mut film = Film::new(sums.width, sums.height);
                     for (i, px) in film.pixels.iter_mut().enumerate() {
                         let n = sums.count(i).max(1) as f32;
                         *px = (sums.variance(i) / n).max(Vec3::ZERO).powf(0.5);
                     }
-                    film
+                    Some(film)
                 }
+                View::Denoised => None,
             })
             .collect();
         Self {
             views,
+            denoised,
             spp,
             generation,
         }
     }
 
-    /// The film of `view`.
-    pub fn view(&self, view: View) -> &Film {
-        let i = View::ALL.iter().position(|v| *v == view).unwrap_or(0);
-        &self.views[i]
+    /// The film of `view` and the samples per pixel it holds; `None` for
+    /// [`View::Denoised`] while no denoised image has been made.
+    pub fn view(&self, view: View) -> Option<(&Film, u32)> {
+        match view {
+            View::Denoised => self.denoised.as_ref().map(|d| (d.film.as_ref(), d.spp)),
+            View::Beauty | View::Part(_) | View::StdError => {
+                let i = View::ALL.iter().position(|v| *v == view)?;
+                self.views.get(i).map(|f| (f, self.spp))
+            }
+        }
     }
 }
 
@@ -140,10 +178,13 @@ mod tests {
         assert!((n.rms - 2.5f64.sqrt()).abs() < 1e-9, "{n:?}");
         assert!((n.mean - 2.0).abs() < 1e-9, "{n:?}");
         // The standard-error view holds √(s²/n) per pixel.
-        let f = Frame::new(&sums, None, 2, 1);
-        assert!((f.view(View::StdError).pixels[0].x - 1.0).abs() < 1e-6);
-        assert!((f.view(View::StdError).pixels[1].x - 2.0).abs() < 1e-6);
-        assert_eq!(f.view(View::Beauty).pixels[1], Vec3::splat(2.0));
+        let f = Frame::new(&sums, None, 2, 1, None);
+        let film = |v| f.view(v).expect("a view of the sums").0;
+        assert!((film(View::StdError).pixels[0].x - 1.0).abs() < 1e-6);
+        assert!((film(View::StdError).pixels[1].x - 2.0).abs() < 1e-6);
+        assert_eq!(film(View::Beauty).pixels[1], Vec3::splat(2.0));
+        // No denoised image was made: none is shown (the server answers 503).
+        assert!(f.view(View::Denoised).is_none());
         // One sample somewhere: no variance yet.
         let mut one = PixelSums::new(1, 1);
         one.add(0, Vec3::ONE);

@@ -1,9 +1,10 @@
 //! The preview's HTTP side, on 127.0.0.1: the page, its status poll, the current image of a
-//! layer at an exposure as PNG, and the pause and save buttons. Each connection gets its own
-//! thread (at most [`MAX_CONNECTIONS`] at once), one request ([`http`]) and `Connection:
-//! close`, so no client can hold up another or the render. Every request must name this server
-//! in its `Host` (which stops DNS rebinding), and the requests that change state (`POST`) must
-//! come from the page's own origin (which stops other web pages): docs/preview.md.
+//! layer at an exposure as PNG (or the denoised image), and the pause, denoise and save
+//! buttons. Each connection gets its own thread (at most [`MAX_CONNECTIONS`] at once), one
+//! request ([`http`]) and `Connection: close`, so no client can hold up another or the render.
+//! Every request must name this server in its `Host` (which stops DNS rebinding), and the
+//! requests that change state (`POST`) must come from the page's own origin (which stops other
+//! web pages): docs/preview.md.
 
 use std::io::Cursor;
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -191,6 +192,12 @@ fn handle(
             let _ = to_render.send(Msg::Pause(on));
             text(stream, 200, if on { "paused" } else { "resumed" });
         }
+        (Method::Post, "/denoise") => {
+            let on = query(url, "on") != Some("0");
+            // The render thread says in the status when it has taken it (between passes).
+            let _ = to_render.send(Msg::Denoise(on));
+            text(stream, 200, if on { "denoising" } else { "not denoising" });
+        }
         // Saving waits for the end of a pass; this connection has its own thread, so the
         // page's polls go on meanwhile.
         (Method::Post, "/save") => save(stream, shared, to_render),
@@ -199,7 +206,8 @@ fn handle(
 }
 
 /// `/image.png?layer=NAME&exposure=X`: the current estimate of a layer, exposure-scaled and
-/// sRGB-encoded as `render` writes PNGs.
+/// sRGB-encoded as `render` writes PNGs; `layer=denoised` the latest denoised image (503 until
+/// one exists). `X-Caustic-Spp` says how many samples per pixel the image holds.
 fn image(stream: &mut TcpStream, url: &str, shared: &Shared) {
     let Some(frame) = shared.frame() else {
         return text(stream, 503, "no image yet: the first pass has not finished");
@@ -211,14 +219,21 @@ fn image(stream: &mut TcpStream, url: &str, shared: &Shared) {
         .and_then(|e| e.parse::<f32>().ok())
         .filter(|e| e.is_finite() && *e >= 0.0)
         .unwrap_or_else(|| shared.status().exposure);
+    let Some((film, spp)) = frame.view(view) else {
+        return text(
+            stream,
+            503,
+            "no denoised image yet: turn denoising on (POST /denoise) and wait for two samples per pixel",
+        );
+    };
     let mut png = Cursor::new(Vec::new());
-    match to_srgb8(frame.view(view), exposure).write_to(&mut png, image::ImageFormat::Png) {
+    match to_srgb8(film, exposure).write_to(&mut png, image::ImageFormat::Png) {
         Ok(()) => http::respond(
             stream,
             200,
             "image/png",
             &[
-                ("X-Caustic-Spp", frame.spp.to_string()),
+                ("X-Caustic-Spp", spp.to_string()),
                 ("X-Caustic-Generation", frame.generation.to_string()),
             ],
             &png.into_inner(),

@@ -4,7 +4,8 @@
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;
-use std::sync::atomic::Ordering;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
@@ -14,6 +15,7 @@ use caustic::render::{RenderError, RenderJob, RenderOptions};
 use caustic::render_scene::IntegratorKind;
 
 use super::Settings;
+use super::denoising::Denoising;
 use super::frame::{Frame, noise};
 use super::save::save;
 use super::state::{Msg, Phase, Shared};
@@ -44,6 +46,10 @@ struct Session<'a> {
     /// The assets of the last scene that loaded (watched also while the scene is broken).
     assets: BTreeSet<PathBuf>,
     paused: bool,
+    /// The denoised image's toggle and what it keeps of the current render.
+    denoising: Denoising,
+    /// The current render's cancel flag (the feature tracing of a denoised image stops on it).
+    cancel: Option<Arc<AtomicBool>>,
 }
 
 /// Runs the render thread until Ctrl-C.
@@ -55,7 +61,10 @@ pub fn run(settings: &Settings, shared: &Shared, rx: &Receiver<Msg>, watch: &mut
         watch,
         assets: BTreeSet::new(),
         paused: false,
+        denoising: Denoising::default(),
+        cancel: None,
     };
+    session.denoise(settings.denoise);
     while !shared.quit.load(Ordering::SeqCst) {
         let next = session.load_and_render();
         if matches!(next, Next::Quit) {
@@ -101,12 +110,15 @@ impl Session<'_> {
             threads: self.settings.threads,
             region: self.settings.region,
             progress: false,
-            cancel: Some(cancel),
+            cancel: Some(Arc::clone(&cancel)),
             photon_cache: self.settings.photon_cache.clone(),
             samples,
             light_paths: true,
         };
         self.begin(&prepared);
+        self.cancel = Some(cancel);
+        self.denoising.restart();
+        self.publish_denoise_state();
         let job = match RenderJob::new(&prepared.render_scene, &options) {
             Ok(job) => job,
             Err(e) => return self.failed(crate::error_text(&e.into())),
@@ -142,6 +154,7 @@ impl Session<'_> {
                 Ok(Msg::Changed) => return self.settle(),
                 Ok(Msg::Quit) | Err(_) => return Next::Quit,
                 Ok(Msg::Pause(p)) => self.pause(p),
+                Ok(Msg::Denoise(on)) => self.denoise(on),
                 Ok(Msg::Save(reply)) => {
                     let _ = reply.send(Err(
                         "not saved: the scene has errors (see above); fix them first".into(),
@@ -161,6 +174,7 @@ impl Session<'_> {
                 Err(RecvTimeoutError::Disconnected) | Ok(Msg::Quit) => return Next::Quit,
                 Ok(Msg::Changed) => {}
                 Ok(Msg::Pause(p)) => self.pause(p),
+                Ok(Msg::Denoise(on)) => self.denoise(on),
                 Ok(Msg::Save(reply)) => {
                     let _ = reply.send(Err(
                         "not saved: the scene changed and its render restarts".into()
@@ -173,6 +187,22 @@ impl Session<'_> {
     fn pause(&mut self, paused: bool) {
         self.paused = paused;
         self.shared.status().paused = paused;
+    }
+
+    /// Turns the denoised image on or off (it is made after the next pass, or at once when the
+    /// render is idle and has the sums for it).
+    fn denoise(&mut self, on: bool) {
+        self.denoising.set(on);
+        self.publish_denoise_state();
+    }
+
+    /// The toggle, the denoised image's samples and the note, into the status.
+    fn publish_denoise_state(&self) {
+        let d = &self.denoising;
+        let mut s = self.shared.status();
+        s.denoise = d.on;
+        s.denoised_spp = d.image.as_ref().map(|i| i.spp);
+        s.denoise_note.clone_from(&d.note);
     }
 
     /// Resets the figures for a new render of `prepared` (before its photons are traced).
@@ -249,6 +279,10 @@ impl Session<'_> {
                     Msg::Changed => return self.settle(),
                     Msg::Quit => return Next::Quit,
                     Msg::Pause(p) => self.pause(p),
+                    Msg::Denoise(on) => {
+                        self.denoise(on);
+                        self.denoising.after_pass(&job, first, goal);
+                    }
                     Msg::Save(reply) => {
                         let _ = reply.send(save(settings, prepared, &job, first, start));
                     }
@@ -256,10 +290,17 @@ impl Session<'_> {
                 continue;
             }
             if idle {
+                // Paused or done: the denoised image of every sample, once.
+                if self.make_denoised(prepared, &job, (first, goal), true) {
+                    self.publish(&job, job.samples_done() - first, render_time);
+                }
                 continue;
             }
             let t = Instant::now();
-            match job.render_pass(pass) {
+            // Every render stops a pass at its middle sample index, where `render --denoise`
+            // splits the samples in two halves, and keeps the sums there ([`Denoising`]).
+            let this_pass = Denoising::cap_pass(pass, job.samples_done(), first, goal);
+            match job.render_pass(this_pass) {
                 Ok(()) => {}
                 // Raised by a change (whose message is on its way) or by Ctrl-C.
                 Err(RenderError::Cancelled) => {
@@ -275,6 +316,8 @@ impl Session<'_> {
             }
             render_time += t.elapsed();
             let taken = job.samples_done() - first;
+            self.denoising.after_pass(&job, first, goal);
+            self.make_denoised(prepared, &job, (first, goal), job.samples_done() == goal);
             self.publish(&job, taken, render_time);
             if let Some((path, every)) = &settings.checkpoint
                 && last_checkpoint.elapsed() >= *every
@@ -307,10 +350,31 @@ impl Session<'_> {
         }
     }
 
+    /// Makes the denoised image if it is due ([`Denoising::make_if_due`]); `true` when it did.
+    fn make_denoised(
+        &mut self,
+        prepared: &Prepared,
+        job: &RenderJob<'_>,
+        span: (u32, u32),
+        idle: bool,
+    ) -> bool {
+        let cancel = self.cancel.clone();
+        let made =
+            self.denoising
+                .make_if_due(prepared, job, span, idle, self.settings, cancel.as_deref());
+        self.publish_denoise_state();
+        made
+    }
+
     /// Publishes the estimate after a pass and its figures.
     fn publish(&self, job: &RenderJob<'_>, taken: u32, render_time: Duration) {
         let generation = self.shared.status().generation;
-        let frame = Frame::new(job.sums(), job.parts(), taken, generation);
+        let denoised = self
+            .denoising
+            .on
+            .then(|| self.denoising.image.clone())
+            .flatten();
+        let frame = Frame::new(job.sums(), job.parts(), taken, generation, denoised);
         let n = noise(job.sums()).map(|n| (n.rms, n.mean));
         {
             let mut s = self.shared.status();

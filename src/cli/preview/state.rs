@@ -67,6 +67,12 @@ pub struct Status {
     pub exposure: f32,
     /// Whether the render waits between passes.
     pub paused: bool,
+    /// Whether the denoised image is asked for (the page's toggle, `--denoise`).
+    pub denoise: bool,
+    /// Samples per pixel of the denoised image on hand (`/image.png?layer=denoised`), if any.
+    pub denoised_spp: Option<u32>,
+    /// Why there is no denoised image yet, or why denoising failed.
+    pub denoise_note: Option<String>,
     /// The diagnostics of a scene that does not load, as the command line prints them.
     pub error: Option<String>,
     /// The photon-map summary of the current render, if it traces photons.
@@ -101,6 +107,9 @@ impl Status {
             "height": self.height,
             "exposure": self.exposure,
             "paused": self.paused,
+            "denoise": self.denoise,
+            "denoised_spp": self.denoised_spp,
+            "denoise_note": self.denoise_note,
             "error": self.error,
             "photons": self.photons,
             "message": self.message,
@@ -116,6 +125,8 @@ pub enum Msg {
     Changed,
     /// Stop (or resume) taking samples between passes.
     Pause(bool),
+    /// Show (or stop showing) the denoised image: denoise after passes (docs/preview.md).
+    Denoise(bool),
     /// Save the image so far as `render -o` would; the reply is the message to show.
     Save(std::sync::mpsc::Sender<Result<String, String>>),
     /// End the render thread (Ctrl-C).
@@ -153,6 +164,9 @@ impl Shared {
                 height: 0,
                 exposure: 1.0,
                 paused: false,
+                denoise: false,
+                denoised_spp: None,
+                denoise_note: None,
                 error: None,
                 photons: None,
                 message: None,
@@ -218,5 +232,7 @@ mod tests {
         assert_eq!(v["noise"], 0.01);
         assert_eq!(v["photons"], serde_json::Value::Null);
         assert_eq!(v["phase"], "loading");
+        assert_eq!(v["denoise"], false);
+        assert_eq!(v["denoised_spp"], serde_json::Value::Null);
     }
 }

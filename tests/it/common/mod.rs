@@ -81,8 +81,22 @@ pub fn estimate_along(
     ray: caustic::geometry::Ray,
     n: u32,
 ) -> (glam::DVec3, glam::DVec3) {
-    use caustic::integrators::{Context, Counters, Integrator, NoTrace};
-    let integrator = Integrator::prepare(scene);
+    let integrator = caustic::integrators::Integrator::prepare(scene);
+    let (mean, se, _) = estimate_by(scene, n, |cx| integrator.li(ray, cx).as_dvec3());
+    (mean, se)
+}
+
+/// Mean, standard error of the mean and per-sample variance of `n` estimates `li` makes from
+/// the renderer's own streams (the scene's sampler and seed, sample indices 0..n of pixel
+/// (0, 0)); every sample must be finite.
+pub fn estimate_by(
+    scene: &caustic::render_scene::RenderScene,
+    n: u32,
+    mut li: impl FnMut(
+        &mut caustic::integrators::Context<'_, caustic::integrators::NoTrace>,
+    ) -> glam::DVec3,
+) -> (glam::DVec3, glam::DVec3, glam::DVec3) {
+    use caustic::integrators::{Context, Counters, NoTrace};
     let p = &scene.params;
     let mut sampler = caustic::sampling::Sampler::new(p.sampler, p.seed, n);
     let mut counters = Counters::default();
@@ -90,17 +104,12 @@ pub fn estimate_along(
     for i in 0..n {
         sampler.start_pixel_sample(0, 0, i);
         let _ = sampler.pixel_2d();
-        let l = integrator
-            .li(
-                ray,
-                &mut Context::new(&mut sampler, &mut counters, &mut NoTrace),
-            )
-            .as_dvec3();
+        let l = li(&mut Context::new(&mut sampler, &mut counters, &mut NoTrace));
         assert!(l.is_finite(), "sample {i}: {l}");
         sum += l;
         sq += l * l;
     }
     let mean = sum / f64::from(n);
     let var = (sq / f64::from(n) - mean * mean).max(glam::DVec3::ZERO);
-    (mean, (var / f64::from(n)).sqrt())
+    (mean, (var / f64::from(n)).sqrt(), var)
 }
