@@ -26,7 +26,8 @@
 //!   stand across the receiver: the photon is rejected. Nor is a surface that lets light
 //!   through (the water line on a pool's wall: the photons above it arrived through the
 //!   water, and what differs across it is a blur like any shadow edge's), nor one of the query
-//!   point's own object (the bumps of a lumpy mesh between two of its points) a wall
+//!   point's own body (the bumps of a lumpy mesh between two of its points; a mesh's material
+//!   groups, such as a toy boat's hull and cabin, are one body) a wall
 //!   ([`Walls`]).
 //! - **Where a ray is traced.** Every segment of an estimate of radius `r` around photon `p`
 //!   lies in the ball of radius [`reach`] around `p`, and when `q` is not below `p`'s tangent
@@ -54,7 +55,7 @@ use crate::render_scene::{Geometry, RenderScene};
 
 /// What can be a wall for one estimate: the scene's surfaces except those that let light
 /// through (glass, water: the photons beyond them arrived through them, and what differs
-/// across them is a blur like any shadow edge's) and except the query point's own object (its
+/// across them is a blur like any shadow edge's) and except the query point's own body (its
 /// bumps, creases and curvature are the receiver, not a wall across it).
 #[derive(Debug, Clone, Copy)]
 pub struct Walls<'a> {
@@ -92,10 +93,16 @@ impl<'a> Walls<'a> {
         self.geometry
     }
 
-    /// Whether a surface of object `object` can be a wall (opaque, not the query's own).
+    /// Whether a surface of object `object` can be a wall (opaque, not of the query's own
+    /// body: a mesh's material groups are one surface, [`RenderScene::body_of`]).
     #[inline]
     fn can_block(&self, object: u32) -> bool {
-        Some(object) != self.object && self.can_block_any(object)
+        let own = match (self.object, self.scene) {
+            (Some(q), Some(s)) => s.body_of(q) == s.body_of(object),
+            (Some(q), None) => q == object,
+            (None, _) => false,
+        };
+        !own && self.can_block_any(object)
     }
 
     /// Whether a surface of object `object` can be a wall to some query point (opaque).
