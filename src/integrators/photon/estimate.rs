@@ -458,7 +458,7 @@ impl PhotonMap {
             let r = r2.sqrt();
             let photons = self.tree.items();
             let mut sum = Vec3::ZERO;
-            let mut sight = Sight::new(walls, p, ng);
+            let mut sight = Sight::new(walls, p, ng, r);
             for n in heap.iter() {
                 if Some(n.index) == skip || (self.shrink < 1.0 && n.dist2 >= r2) {
                     continue;
@@ -500,23 +500,22 @@ impl PhotonMap {
     ) -> Estimate {
         let r = self.shrink * pass.field.radius(p);
         let q = p.to_array();
-        let mut sum = Vec3::ZERO;
-        let mut found = 0;
-        let mut sight = Sight::new(walls, p, ng);
-        let mut add = |ph: &Landing, dist2: f32| {
-            found += 1;
-            if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, ng)
-                && !sight.separated(Vec3::from_array(ph.position), ph.normal, r > ph.clear)
-            {
-                sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), r);
-            }
+        let mut disc = Disc {
+            sum: Vec3::ZERO,
+            found: 0,
+            sight: Sight::new(walls, p, ng, r),
+            ng,
+            r,
+            kernel: self.kernel,
         };
         // The finest grid whose cells are at least the disc's diameter (at most 8 cells to
         // visit); a disc wider than the widest grid's cells is found through the kd-tree. Both
         // find exactly the photons within r.
         if let Some(grid) = pass.grids.iter().find(|g| g.cell_size() >= 2.0 * r) {
             let photons = grid.items();
-            grid.within(q, r, |n| add(&photons[n.index as usize], n.dist2));
+            grid.within(q, r, |n| {
+                disc.add(&photons[n.index as usize], n.dist2, &value);
+            });
         } else {
             let photons = self.tree.items();
             self.tree.within(q, r * r, |n| {
@@ -526,9 +525,12 @@ impl PhotonMap {
                 } else {
                     self.wall_radius
                 };
-                add(&Landing::new(ph, clear), n.dist2);
+                disc.add(&Landing::new(ph, clear), n.dist2, &value);
             });
         }
+        let Disc {
+            sum, found, sight, ..
+        } = disc;
         let area = std::f32::consts::PI * r * r * self.kernel.normalisation();
         Estimate {
             radiance: if found > 0 { sum / area } else { Vec3::ZERO },
@@ -541,23 +543,56 @@ impl PhotonMap {
     }
 }
 
+/// One progressive estimate's running sum over the photons of its disc
+/// ([`PhotonMap::gather_within`]).
+struct Disc<'g> {
+    sum: Vec3,
+    found: usize,
+    sight: Sight<'g>,
+    ng: Vec3,
+    r: f32,
+    kernel: Kernel,
+}
+
+impl Disc<'_> {
+    /// Adds the photon `ph` at squared distance `dist2` from the query point, if the side and
+    /// wall tests accept it. Inlined into both searches' loops.
+    #[inline(always)]
+    fn add(&mut self, ph: &Landing, dist2: f32, value: &impl Fn(Vec3, Vec3, f32) -> Vec3) {
+        self.found += 1;
+        if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, self.ng)
+            && !self
+                .sight
+                .separated(Vec3::from_array(ph.position), ph.normal, self.r > ph.clear)
+        {
+            self.sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), self.r);
+        }
+    }
+}
+
 /// The wall test of one estimate at query point `q` (unit geometric normal `nq` on the side
 /// of `ωo`), counting the rays it traces and the photons it hides.
 struct Sight<'g> {
     walls: Walls<'g>,
     q: Vec3,
     nq: Vec3,
+    /// A lower bound of [`walls::tolerance`] at every point within the estimate's radius of
+    /// `q`: an unmarked photon no higher than this above `q`'s side of its plane needs no ray
+    /// (the first of [`walls::needs_ray`]'s tests, decided without the photon's own bound).
+    tolerance_floor: f32,
     rays: u32,
     hidden: u32,
 }
 
 impl<'g> Sight<'g> {
+    /// The wall test of an estimate of radius `r` (scene units) around `q`.
     #[inline]
-    fn new(walls: Walls<'g>, q: Vec3, nq: Vec3) -> Self {
+    fn new(walls: Walls<'g>, q: Vec3, nq: Vec3, r: f32) -> Self {
         Self {
             walls,
             q,
             nq,
+            tolerance_floor: walls::tolerance_floor(q, r),
             rays: 0,
             hidden: 0,
         }
@@ -568,12 +603,17 @@ impl<'g> Sight<'g> {
     /// [`walls::needs_ray`] says one is needed.
     #[inline(always)]
     fn separated(&mut self, p: Vec3, np: Vec3, near_wall: bool) -> bool {
-        walls::needs_ray(self.q, self.nq, p, np, near_wall) && self.traced(p, np)
+        (near_wall || (p - self.q).dot(np) > self.tolerance_floor) && self.traced(p, np, near_wall)
     }
 
-    /// [`Sight::separated`]'s ray, out of line (most photons need none).
+    /// [`Sight::separated`] past its first test, out of line (most photons never get here):
+    /// [`walls::needs_ray`]'s exact tests, then the ray.
+    #[cold]
     #[inline(never)]
-    fn traced(&mut self, p: Vec3, np: Vec3) -> bool {
+    fn traced(&mut self, p: Vec3, np: Vec3, near_wall: bool) -> bool {
+        if !walls::needs_ray(self.q, self.nq, p, np, near_wall) {
+            return false;
+        }
         self.rays += 1;
         let hidden = walls::separated(&self.walls, self.q, self.nq, p, np);
         self.hidden += u32::from(hidden);

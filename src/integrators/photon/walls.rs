@@ -139,6 +139,15 @@ pub fn tolerance(p: Vec3) -> f32 {
     REL_TOLERANCE * (1.0 + p.abs().max_element())
 }
 
+/// A lower bound of [`tolerance`] at every point within distance `r` of `q` (the bound of a
+/// point whose largest coordinate is `r` smaller, less a part in 10⁴ for its own rounding): one
+/// product per estimate instead of one per photon.
+#[inline]
+#[must_use]
+pub fn tolerance_floor(q: Vec3, r: f32) -> f32 {
+    0.9999 * REL_TOLERANCE * (1.0 + (q.abs().max_element() - r).max(0.0))
+}
+
 /// Radius of the ball around a photon at `p` holding every segment of an estimate of radius up
 /// to `radius` (each end is lifted by at most `11 τ + radius / 4`).
 #[inline]
