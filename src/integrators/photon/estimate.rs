@@ -513,9 +513,15 @@ impl PhotonMap {
         // find exactly the photons within r.
         if let Some(grid) = pass.grids.iter().find(|g| g.cell_size() >= 2.0 * r) {
             let photons = grid.items();
-            grid.within(q, r, |n| {
-                disc.add(&photons[n.index as usize], n.dist2, &value);
-            });
+            grid.within(
+                q,
+                r,
+                GridDisc {
+                    disc: &mut disc,
+                    photons,
+                    value: &value,
+                },
+            );
         } else {
             let photons = self.tree.items();
             self.tree.within(q, r * r, |n| {
@@ -567,6 +573,22 @@ impl Disc<'_> {
         {
             self.sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), self.r);
         }
+    }
+}
+
+/// [`Disc::add`] for each photon a grid search finds, inlined into the search's loop
+/// ([`crate::spatial::Visit`]).
+struct GridDisc<'a, 'g, F> {
+    disc: &'a mut Disc<'g>,
+    photons: &'a [Landing],
+    value: &'a F,
+}
+
+impl<F: Fn(Vec3, Vec3, f32) -> Vec3> crate::spatial::Visit for GridDisc<'_, '_, F> {
+    #[inline(always)]
+    fn visit(&mut self, n: crate::spatial::Neighbor) {
+        self.disc
+            .add(&self.photons[n.index as usize], n.dist2, self.value);
     }
 }
 
