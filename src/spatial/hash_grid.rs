@@ -380,7 +380,7 @@ mod tests {
 
     fn query(grid: &HashGrid<[f32; 3]>, q: [f32; 3], r: f32) -> Vec<u32> {
         let mut v = Vec::new();
-        grid.within(q, r, |n| {
+        grid.within(q, r, |n: Neighbor| {
             assert!((n.dist2 - distance2(q, grid.items()[n.index as usize])).abs() == 0.0);
             v.push(n.index);
         });
@@ -532,7 +532,7 @@ mod tests {
             .collect();
         let grid = HashGrid::build(pts.clone(), 1.0).expect("grid");
         let mut seen = Vec::new();
-        grid.within([0.5, 0.1, 0.5], 0.7, |n| {
+        grid.within([0.5, 0.1, 0.5], 0.7, |n: Neighbor| {
             seen.push(grid.items()[n.index as usize]);
         });
         let expected: Vec<[f32; 3]> = pts
@@ -543,7 +543,7 @@ mod tests {
             .collect();
         assert_eq!(seen, expected);
         let mut only_first = Vec::new();
-        grid.within([0.1, 0.1, 0.5], 0.5, |n| only_first.push(n.index));
+        grid.within([0.1, 0.1, 0.5], 0.5, |n: Neighbor| only_first.push(n.index));
         assert_eq!(only_first.len(), 21);
     }
 
