@@ -20,7 +20,11 @@
 #        (user + system, /usr/bin/time) of one `golden check scenes/` at those settings, and
 #        of each scene's check alone. Writes OUT/cost.tsv.
 #
-# Environment: N (200), NP (40), W (40), H (30), SPP (16), INTEGRATORS ("default path"),
+# A stopped `false` run keeps its progress in OUT/false/INTEGRATOR/SCENE/progress ("checks
+# alarms" after each check); FIRST=k resumes it at check k (seed 1000+k) with the golden already
+# there, and its row then counts checks k…N only.
+#
+# Environment: N (200), NP (40), W (40), H (30), SPP (16), INTEGRATORS ("default path"), FIRST (1),
 # SCENES_ONLY (a space-separated list of scene paths instead of all), THREADS (passed as
 # --threads), CASES (power cases in order: "colour sun ior ripple8 ripple6 ripple5 red light").
 # Summarize with: scripts/golden_calibration.sh BIN OUT summary (rates with 95 % Wilson
@@ -37,6 +41,7 @@ H=${H:-30}
 SPP=${SPP:-16}
 INTEGRATORS=${INTEGRATORS:-default path}
 THREADS=${THREADS:-}
+FIRST=${FIRST:-1}
 CASES=${CASES:-colour sun ior ripple8 ripple6 ripple5 red light}
 THREAD_FLAGS=()
 if [ -n "$THREADS" ]; then THREAD_FLAGS=(--threads "$THREADS"); fi
@@ -63,13 +68,15 @@ false_alarms() {
             dir="$OUT/false/$integ/$name"
             mkdir -p "$dir"
             # shellcheck disable=SC2046
-            if ! "$BIN" golden update "$scene" -o "$dir" --width "$W" --height "$H" --spp "$SPP" \
+            if [ "$FIRST" -gt 1 ] && [ -f "$dir/$name.golden" ]; then
+                : # resuming: the golden is there
+            elif ! "$BIN" golden update "$scene" -o "$dir" --width "$W" --height "$H" --spp "$SPP" \
                 $(flags_for "$integ") "${THREAD_FLAGS[@]}" -q >"$dir/update.txt" 2>&1; then
                 echo "update failed: $scene ($integ)" >&2
                 continue
             fi
             alarms=0
-            for i in $(seq 1 "$N"); do
+            for i in $(seq "$FIRST" "$N"); do
                 "$BIN" golden check "$scene" --golden "$dir" --seed $((1000 + i)) -q \
                     "${THREAD_FLAGS[@]}" --error-dir "$dir/errors" >"$dir/check.txt" 2>&1
                 rc=$?
@@ -79,8 +86,9 @@ false_alarms() {
                 elif [ $rc -ne 0 ]; then
                     echo "check failed ($rc): $scene ($integ) seed $((1000 + i))" >&2
                 fi
+                echo "$((i - FIRST + 1)) $alarms" >"$dir/progress"
             done
-            printf 'false\t%s\t%s\t%d\t%d\t%s\n' "$integ" "$name" "$alarms" "$N" "$SPP" >>"$OUT/false.tsv"
+            printf 'false\t%s\t%s\t%d\t%d\t%s\n' "$integ" "$name" "$alarms" "$((N - FIRST + 1))" "$SPP" >>"$OUT/false.tsv"
             echo "false alarms: $integ $name $alarms / $N"
         done
     done

@@ -219,6 +219,8 @@ struct Rendered {
     meta: GoldenMeta,
     /// The settings hash as if rendered with `hash_seed` instead of its own seed.
     hash_at_seed: u64,
+    /// How its noise falls with more samples per pixel (for `--detect`).
+    noise: caustic::render::golden::noise_scaling::NoiseScaling,
 }
 
 /// Prepares and renders `path` batch by batch; refuses fewer than 2 samples per pixel (no
@@ -286,6 +288,7 @@ fn render_scene(
         cells: out.cells,
         meta,
         hash_at_seed,
+        noise: out.noise,
     })
 }
 
@@ -299,7 +302,7 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
     let overrides = a.scene.overrides();
     for path in &scenes {
         let mut r = render_scene(path, &overrides, a.block, a.threads, a.quiet, None)?;
-        let mut floor = DetectionFloor::of(&r.batches, &r.cells, a.alpha);
+        let mut floor = DetectionFloor::of(&r.batches, &r.cells, a.alpha).with_noise(r.noise);
         if let Some(target) = a.detect {
             let (w, h) = (r.estimates.width, r.estimates.height);
             let mut search = DetectSearch::new(target, a.alpha, a.detect_limit);
@@ -318,7 +321,8 @@ fn update(a: &UpdateArgs) -> Result<(), Error> {
                 let mut more = overrides.clone();
                 more.render.samples_per_pixel = Some(spp);
                 let next = render_scene(path, &more, a.block, a.threads, a.quiet, None)?;
-                let next_floor = DetectionFloor::of(&next.batches, &next.cells, a.alpha);
+                let next_floor =
+                    DetectionFloor::of(&next.batches, &next.cells, a.alpha).with_noise(next.noise);
                 let (was, now) = (
                     search.reached(&floor, w, h),
                     search.reached(&next_floor, w, h),

@@ -190,6 +190,87 @@ fn every_kind_of_change_is_caught_on_the_pool() {
     eprintln!("power on the pool: {:.1} s", start.elapsed().as_secs_f64());
 }
 
+/// `scenes/water.ron` (the `photon` integrator) with few photons (4 000 caustic, 2 000
+/// global), so that its maps' noise is large and each replication cheap.
+const FEW_PHOTONS: [&str; 2] = ["photons.caustic=4000", "photons.global=2000"];
+
+#[test]
+fn photon_replications_are_capped_at_16_and_stay_calibrated() {
+    // 32 spp of the `photon` integrator: 16 replications of 2 samples each (not 32 of 1), on
+    // golden and check alike. 40 unchanged checks at 16×16 against one golden, α = 0.05 for
+    // the whole check (the structure test runs: 16 batches): the false alarms stay within the
+    // binomial bound, 6 of 40 (more has a chance of 0.3 %).
+    let start = Instant::now();
+    let test = GoldenTest { alpha: 0.05 };
+    let o = common::small(16, 16, 32);
+    let scene = "scenes/water.ron";
+    let golden = render_all(scene, &o, 1, &FEW_PHOTONS);
+    assert_eq!(golden.blocks.samples, vec![2; 16]);
+    assert_eq!(golden.cells.samples, vec![2; 16]);
+    let (mut alarms, mut structure_alarms) = (0, 0);
+    for seed in 2..42 {
+        let now = render_all(scene, &o, seed, &FEW_PHOTONS);
+        let v = test
+            .compare((&golden.blocks, &golden.cells), (&now.blocks, &now.cells))
+            .expect("same shape");
+        let s = v
+            .structure
+            .as_ref()
+            .expect("16 batches: the structure test runs");
+        alarms += u32::from(v.changed());
+        structure_alarms += u32::from(s.changed());
+    }
+    eprintln!(
+        "{scene} (photon, 16 replications of 2 spp): {alarms} of 40 unchanged checks called changed at α 0.05 ({structure_alarms} by the structure test); {:.1} s",
+        start.elapsed().as_secs_f64()
+    );
+    assert!(alarms <= 6, "{alarms} false alarms of 40");
+}
+
+#[test]
+fn the_photon_floor_predicted_from_two_renders_is_the_one_measured_at_a_third() {
+    // The same few-photon water at 32×32 (16 blocks of 8×8 px, the scale `--detect` aims at),
+    // rendered at 16, 64 and 256 spp: 16 replications each, so only the camera samples' part
+    // of the noise falls. The split fitted through the floors at 16 and 64 spp predicts the
+    // floor at 256 within 25 % of the one measured there, where the passes' 1/spp scaling
+    // (the advice before the cap) predicts less than 0.7 of it.
+    use caustic::render::golden::DetectionFloor;
+    use caustic::render::golden::floor::predicted_floor;
+    use caustic::render::golden::noise_scaling::{NoiseScaling, SampleShare, fit_share};
+    let o = |spp| common::small(32, 32, spp);
+    let floor = |spp: u32| {
+        let r = render_all("scenes/water.ron", &o(spp), 1, &FEW_PHOTONS);
+        assert_eq!(r.blocks.batches(), 16);
+        DetectionFloor::of(&r.blocks, &r.cells, 0.01)
+    };
+    let (f16, f64_, f256) = (floor(16), floor(64), floor(256));
+    let m = |f: &DetectionFloor| f.scales[0].median;
+    // Same batch count, blocks and α: the floors' squares are in proportion to the variances.
+    let q = fit_share((16, m(&f16).powi(2)), (64, m(&f64_).powi(2)), 64).expect("a split");
+    let fitted = f64_
+        .clone()
+        .with_noise(NoiseScaling::Replications(Some(SampleShare {
+            blocks: q,
+            cells: q,
+        })));
+    let predicted = predicted_floor(&fitted, 0, 64, 256, 0.005, None);
+    let naive = predicted_floor(&f64_, 0, 64, 256, 0.005, None);
+    eprintln!(
+        "floors over 8×8 px: {:.2} % at 16 spp, {:.2} % at 64, {:.2} % at 256; q at 64 spp {q:.2}; predicted at 256 {:.2} % (1/spp: {:.2} %)",
+        100.0 * m(&f16),
+        100.0 * m(&f64_),
+        100.0 * m(&f256),
+        100.0 * predicted,
+        100.0 * naive
+    );
+    assert!(
+        (predicted / m(&f256) - 1.0).abs() < 0.25,
+        "predicted {predicted}, measured {}",
+        m(&f256)
+    );
+    assert!(naive < 0.7 * m(&f256), "1/spp predicted {naive}");
+}
+
 #[test]
 fn unchanged_cornell_passes_and_three_small_changes_fail_at_every_seed() {
     // Whitted (named), 64×64, 32 spp: 32 batches of one sample index each.

@@ -38,7 +38,14 @@ pub const MAX_BATCHES: u32 = 64;
 /// sample indices whose sizes differ by at most one.
 #[must_use]
 pub fn batch_ranges(spp: u32) -> Vec<std::ops::Range<u32>> {
-    let k = spp.min(MAX_BATCHES);
+    split_ranges(spp, MAX_BATCHES)
+}
+
+/// `min(spp, max)` consecutive ranges of the sample indices `0..spp` whose sizes differ by at
+/// most one (the batches of [`batch_ranges`], the replications of a `photon` render).
+#[must_use]
+pub fn split_ranges(spp: u32, max: u32) -> Vec<std::ops::Range<u32>> {
+    let k = spp.min(max);
     (0..k)
         .map(|j| {
             let at = |j: u32| (u64::from(j) * u64::from(spp) / u64::from(k)) as u32;

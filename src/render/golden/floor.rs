@@ -11,7 +11,8 @@
 //! floor is the median over its lit blocks (black blocks have no relative change), so "caught
 //! in 95 % of checks" holds for at least half the blocks of that size.
 
-use super::batch_means::{BatchBlocks, MAX_BATCHES, scale_spans};
+use super::batch_means::{BatchBlocks, scale_spans};
+use super::noise_scaling::{NoiseScaling, SampleShare, fit_share};
 use super::quantile::student_upper_quantile;
 use crate::integrators::photon::RadiusSchedule;
 
@@ -48,6 +49,9 @@ pub struct DetectionFloor {
     pub cell: u32,
     /// Whether the structure test runs at these samples per pixel (enough batches).
     pub structure_active: bool,
+    /// How the noise falls with more samples per pixel (for the predictions of the
+    /// `--detect` advice): [`NoiseScaling::Passes`] unless set by [`DetectionFloor::with_noise`].
+    pub noise: NoiseScaling,
 }
 
 /// (t* + t₀.₀₅) for a scale of `blocks` blocks at false-alarm rate `alpha` split over
@@ -118,7 +122,15 @@ impl DetectionFloor {
             structure: f64::INFINITY,
             cell: 0,
             structure_active: false,
+            noise: NoiseScaling::Passes,
         }
+    }
+
+    /// This floor with the render's noise scaling (`GoldenRender::noise`), which the
+    /// predictions for other samples per pixel follow.
+    #[must_use]
+    pub fn with_noise(self, noise: NoiseScaling) -> Self {
+        Self { noise, ..self }
     }
 
     /// The scale the `--detect` advice aims at: blocks closest in area to [`DETECT_AREA`] of
@@ -155,8 +167,10 @@ pub fn variance_growth(progressive_alpha: Option<f64>, n: u32) -> f64 {
 }
 
 /// The floor at scale `scale` predicted for `spp` samples per pixel from a golden's `floor`
-/// rendered at `golden_spp`: the standard error scales as √(growth(spp)/spp), and the critical
-/// value follows the batch count `min(spp, MAX_BATCHES)`.
+/// rendered at `golden_spp`: the standard error scales as the square root of the floor's
+/// [`NoiseScaling::variance_ratio`] (1/spp for passes, times the progressive growth when
+/// `progressive_alpha` is given; the maps' part fixed beyond 16 `photon` replications), and
+/// the critical value follows the batch count ([`NoiseScaling::batches`]).
 #[must_use]
 pub fn predicted_floor(
     floor: &DetectionFloor,
@@ -168,21 +182,33 @@ pub fn predicted_floor(
 ) -> f64 {
     let s = &floor.scales[scale];
     let k0 = floor.batches;
-    let k1 = spp.min(MAX_BATCHES) as usize;
+    let k1 = floor.noise.batches(spp) as usize;
     if k0 < 2 || k1 < 2 {
         return f64::INFINITY;
     }
     let n = floor.scales.len();
     let c0 = critical(alpha, n, s.blocks, k0);
     let c1 = critical(alpha, n, s.blocks, k1);
-    let g0 = variance_growth(progressive_alpha, golden_spp) / f64::from(golden_spp);
-    let g1 = variance_growth(progressive_alpha, spp) / f64::from(spp);
-    s.median * c1 / c0 * (g1 / g0).sqrt()
+    s.median * c1 / c0 * variance_ratio(floor, false, golden_spp, spp, progressive_alpha).sqrt()
+}
+
+/// v(spp)/v(golden_spp) of the blocks (`cells`: the structure cells): the floor's noise
+/// scaling, times the progressive growth of passes when `progressive_alpha` is given.
+fn variance_ratio(
+    floor: &DetectionFloor,
+    cells: bool,
+    golden_spp: u32,
+    spp: u32,
+    progressive_alpha: Option<f64>,
+) -> f64 {
+    let growth = variance_growth(progressive_alpha, spp.max(1))
+        / variance_growth(progressive_alpha, golden_spp.max(1));
+    floor.noise.variance_ratio(cells, golden_spp, spp) * growth
 }
 
 /// The structure floor predicted for `spp` samples per pixel from a golden's `floor` rendered
-/// at `golden_spp`: δ scales as the standard error, √(growth(spp)/spp) (its critical value
-/// does not depend on the batch count).
+/// at `golden_spp`: δ scales as the standard error, the square root of the cells'
+/// [`NoiseScaling::variance_ratio`] (its critical value does not depend on the batch count).
 #[must_use]
 pub fn predicted_structure_floor(
     floor: &DetectionFloor,
@@ -190,9 +216,7 @@ pub fn predicted_structure_floor(
     spp: u32,
     progressive_alpha: Option<f64>,
 ) -> f64 {
-    let g0 = variance_growth(progressive_alpha, golden_spp) / f64::from(golden_spp.max(1));
-    let g1 = variance_growth(progressive_alpha, spp) / f64::from(spp.max(1));
-    floor.structure * (g1 / g0).sqrt()
+    floor.structure * variance_ratio(floor, true, golden_spp, spp, progressive_alpha).sqrt()
 }
 
 /// The fewest samples per pixel (at least [`super::structure::MIN_BATCHES`], at most
@@ -269,6 +293,10 @@ pub struct DetectSearch {
     /// Most samples per pixel to try.
     pub limit: u32,
     rounds: usize,
+    /// The previous floor's samples per pixel and its variances (blocks at the detect scale,
+    /// in units of the squared critical value; cells), for the fit of a `photon` golden's
+    /// noise split ([`fit_share`]).
+    previous: Option<(u32, f64, f64)>,
 }
 
 /// What to do after a render in a [`DetectSearch`].
@@ -289,6 +317,7 @@ impl DetectSearch {
             alpha,
             limit,
             rounds: 0,
+            previous: None,
         }
     }
 
@@ -315,16 +344,19 @@ impl DetectSearch {
         self.rounds += 1;
         let scale = floor.detect_scale(width, height);
         let reached = self.reached(floor, width, height);
+        let block_alpha = if floor.cell == 0 {
+            self.alpha
+        } else {
+            0.5 * self.alpha
+        };
+        let fitted = self.fit(floor, scale, spp, block_alpha);
+        let floor = &fitted;
         let blocks = recommend_spp(
             floor,
             scale,
             spp,
             DETECT_AIM * self.target,
-            if floor.cell == 0 {
-                self.alpha
-            } else {
-                0.5 * self.alpha
-            },
+            block_alpha,
             None,
             self.limit,
         );
@@ -338,11 +370,53 @@ impl DetectSearch {
             (Some(a), Some(b)) => Some(a.max(b)),
             _ => None,
         };
+        // Out of reach: passes render at the limit once; `photon` replications, whose maps'
+        // noise more samples do not lower, at most where more buy little (the knee).
+        let knee = floor.noise.knee(blocks.is_some(), spp);
+        let out_of_reach = knee.map_or(self.limit, |k| k.min(self.limit));
         match advice {
-            None if spp >= self.limit => DetectStep::Done,
-            None => DetectStep::Render(self.limit),
+            None if spp >= out_of_reach => DetectStep::Done,
+            None => DetectStep::Render(out_of_reach),
             Some(next) if next == spp || (reached && next > spp) => DetectStep::Done,
             Some(next) => DetectStep::Render(next),
+        }
+    }
+
+    /// `floor` (at `spp`) with a `photon` golden's noise split fitted from it and the previous
+    /// floor given to [`DetectSearch::next`] (unchanged for passes, or without a previous
+    /// floor at other samples per pixel); remembers this floor for the next fit.
+    fn fit(
+        &mut self,
+        floor: &DetectionFloor,
+        scale: usize,
+        spp: u32,
+        alpha: f64,
+    ) -> DetectionFloor {
+        let s = &floor.scales[scale];
+        let k = floor.batches;
+        let blocks = if k >= 2 {
+            (s.median / critical(alpha, floor.scales.len(), s.blocks, k)).powi(2)
+        } else {
+            f64::NAN
+        };
+        let cells = floor.structure.powi(2);
+        let previous = self.previous.replace((spp, blocks, cells));
+        let NoiseScaling::Replications(_) = floor.noise else {
+            return floor.clone();
+        };
+        let Some((p_spp, p_blocks, p_cells)) = previous else {
+            return floor.clone();
+        };
+        let blocks = fit_share((p_spp, p_blocks), (spp, blocks), spp);
+        let cells = fit_share((p_spp, p_cells), (spp, cells), spp);
+        match (blocks, cells) {
+            (None, None) => floor.clone(),
+            (b, c) => floor
+                .clone()
+                .with_noise(NoiseScaling::Replications(Some(SampleShare {
+                    blocks: b.unwrap_or(1.0),
+                    cells: c.unwrap_or(1.0),
+                }))),
         }
     }
 
@@ -415,6 +489,60 @@ mod tests {
         let mut far = DetectSearch::new(1e-9, 0.01, 64);
         assert_eq!(far.next(&f, 2, 4, 4), DetectStep::Render(64));
         assert_eq!(far.next(&f, 64, 4, 4), DetectStep::Done);
+    }
+
+    #[test]
+    fn photon_replications_predict_a_floor_that_stops_falling_and_the_search_stops_there() {
+        // The floor of the first test, as if from a `photon` golden of 32 spp (16 replications
+        // of 2) whose camera samples make q = 0.2 of its noise (the maps 0.8). At 128 spp the
+        // variance is 0.8 + 0.2·32/128 = 0.85 of the golden's (16 replications either way) and
+        // the batch count stays 16: the floor falls by √0.85 only, where passes would halve it.
+        let mut b = BatchBlocks::new(4, 4, 4);
+        b.push_batch(&[DVec3::splat(1.0); 16], 1);
+        b.push_batch(&[DVec3::splat(3.0); 16], 1);
+        let passes = DetectionFloor::of_blocks(&b, 0.01);
+        let share = |q: f64| {
+            NoiseScaling::Replications(Some(SampleShare {
+                blocks: q,
+                cells: q,
+            }))
+        };
+        let f = passes.clone().with_noise(share(0.2));
+        let c = |k: f64| {
+            student_upper_quantile(0.01 / 3.0 / 2.0, 2.0 * (k - 1.0))
+                + student_upper_quantile(0.05, 2.0 * (k - 1.0))
+        };
+        let want = f.scales[0].median * c(16.0) / c(2.0) * 0.85f64.sqrt();
+        assert!((predicted_floor(&f, 0, 32, 128, 0.01, None) - want).abs() < 1e-12);
+        let halved = passes.scales[0].median * c(64.0) / c(2.0) * 0.5;
+        assert!((predicted_floor(&passes, 0, 32, 128, 0.01, None) - halved).abs() < 1e-12);
+        // A reachable target: the fewest spp whose predicted floor reaches it, with the maps'
+        // part fixed: 0.8 + 0.2·32/s ≤ 1.05²·0.8 ⇔ s ≥ 6.4/0.082 = 78.05: 79 spp.
+        let floor_16 = f.scales[0].median * c(16.0) / c(2.0);
+        let reachable = 1.05 * floor_16 * 0.8f64.sqrt();
+        let spp = recommend_spp(&f, 0, 32, reachable, 0.01, None, 1 << 20).unwrap();
+        assert_eq!(spp, 79);
+        assert!(predicted_floor(&f, 0, 32, spp - 1, 0.01, None) > reachable);
+        // Below the maps' part (√0.8 of the floor at 16 replications) no spp reaches: the
+        // passes' search would render at the limit (4096); this one renders at the knee, where
+        // the samples' part is a tenth of the maps' (0.2·32/s ≤ 0.08: 80 spp) ...
+        let target = 0.85 * floor_16 * 0.8f64.sqrt() / DETECT_AIM;
+        let mut search = DetectSearch::new(target, 0.01, 4096);
+        assert_eq!(search.next(&f, 32, 4, 4), DetectStep::Render(80));
+        let mut passes_search = DetectSearch::new(target, 0.01, 4096);
+        assert!(matches!(passes_search.next(&passes, 32, 4, 4), DetectStep::Render(n) if n < 4096));
+        // ... and measures there a floor √0.88 of the first (the same model: σ_M²/16 = 0.8,
+        // σ_P²/80 = 0.08 in units of the 32-spp variance; same batch count in this synthetic
+        // golden). The fit through the two floors finds q = 0.08/0.88 at 80 spp, whose knee is
+        // 80: it stops, out of reach, instead of rendering more.
+        let mut at80 =
+            DetectionFloor::of_blocks(&b, 0.01).with_noise(NoiseScaling::Replications(None));
+        at80.scales[0].median *= 0.88f64.sqrt();
+        assert_eq!(search.next(&at80, 80, 4, 4), DetectStep::Done);
+        // Without the fit (an unmeasured split, taken as all samples) the same floor would ask
+        // for more samples.
+        let mut blind = DetectSearch::new(target, 0.01, 4096);
+        assert!(matches!(blind.next(&at80, 80, 4, 4), DetectStep::Render(n) if n > 80));
     }
 
     #[test]

@@ -16,15 +16,17 @@
 //! pixel and each cell's mean per batch as `f32`), and an FNV-1a checksum.
 //!
 //! The modules: [`batch_means`] (the batches and the test), [`floor`] (the smallest change a
-//! golden catches and the samples per pixel for a requested one), [`structure`] (the pattern
-//! of light within blocks: a randomization test over small cells), [`record`] (rendering a scene
-//! batch by batch), [`report`] (the verdict in words, the settings that changed),
+//! golden catches and the samples per pixel for a requested one), [`noise_scaling`] (how a
+//! golden's noise falls with its samples per pixel; the cap on `photon` replications),
+//! [`structure`] (the pattern of light within blocks: a randomization test over small cells),
+//! [`record`] (rendering a scene batch by batch), [`report`] (the verdict in words, the settings that changed),
 //! [`pixel_variance`] (the older per-pixel-variance block test, valid for estimators whose
 //! pixels err independently, used to compare two estimators' images) and [`quantile`].
 
 pub mod batch_means;
 pub mod combined;
 pub mod floor;
+pub mod noise_scaling;
 pub mod pixel_variance;
 pub mod quantile;
 pub mod record;

@@ -7,9 +7,12 @@
 //! pass reads the same maps, so passes are not independent estimates and their spread would
 //! miss the maps' noise. Its batches are therefore **replications**: batch j is a render of
 //! its own samples with its own seed (so its own maps), and the film is their sum — a render
-//! of the same settings, but not the bytes of a one-seed render.
+//! of the same settings, but not the bytes of a one-seed render. Each replication traces the
+//! full maps, so there are at most [`MAX_REPLICATIONS`] of them, the samples per pixel spread
+//! over them (golden and check alike: both render here; [`super::noise_scaling`]).
 
-use super::batch_means::{BatchBlocks, BatchRecorder, batch_ranges};
+use super::batch_means::{BatchBlocks, BatchRecorder, batch_ranges, split_ranges};
+use super::noise_scaling::{MAX_REPLICATIONS, NoiseScaling};
 use super::structure::{CELL, MAX_CELL_BATCHES, merge_batches};
 use crate::render::{PixelSums, RenderError, RenderJob, RenderOptions, RenderOutput};
 use crate::render_scene::RenderScene;
@@ -29,6 +32,10 @@ pub struct GoldenRender {
     /// noise grows as the radius shrinks, which the samples-per-pixel advice accounts for);
     /// `None` for the others.
     pub progressive_alpha: Option<f64>,
+    /// How the noise falls with the samples per pixel (for the `--detect` advice): passes, or
+    /// `photon` replications (the split of their noise between maps and camera samples is
+    /// measured by the `--detect` search from two renders).
+    pub noise: NoiseScaling,
 }
 
 /// The seed of replication `j` of a render seeded `seed` (`photon` integrator): distinct for
@@ -89,6 +96,7 @@ fn passes(
         batches: recorder.finish(),
         cells: merge_batches(&cells.finish(), MAX_CELL_BATCHES),
         progressive_alpha,
+        noise: NoiseScaling::Passes,
     })
 }
 
@@ -103,7 +111,7 @@ fn replications(
     let mut cells = BatchBlocks::new(w, h, CELL);
     let mut total: Option<RenderOutput> = None;
     let mut result = Ok(());
-    for (j, range) in batch_ranges(spp).into_iter().enumerate() {
+    for (j, range) in split_ranges(spp, MAX_REPLICATIONS).into_iter().enumerate() {
         scene.params.seed = replication_seed(seed, j as u32);
         scene.params.samples_per_pixel = range.end - range.start;
         let out = match RenderJob::new(scene, options).and_then(RenderJob::finish) {
@@ -138,6 +146,7 @@ fn replications(
         batches,
         cells: merge_batches(&cells, MAX_CELL_BATCHES),
         progressive_alpha: None,
+        noise: NoiseScaling::Replications(None),
     })
 }
 

@@ -7,6 +7,7 @@ use serde_json::Value;
 
 use super::batch_means::{BatchVerdict, BlockDiff};
 use super::floor::DetectionFloor;
+use super::noise_scaling::{MAX_REPLICATIONS, NoiseScaling};
 use super::structure::{StructureSkip, StructureVerdict};
 
 /// The scene's settings as sorted `(path, value)` pairs, from its serialized form: every field
@@ -325,10 +326,23 @@ pub fn describe_floor(f: &DetectionFloor) -> String {
         )
     };
     format!(
-        "a change of {} is caught in 95 % of checks (of every channel; median block; {} batches){structure}",
+        "a change of {} is caught in 95 % of checks (of every channel; median block; {} batches){structure}{}",
         parts.join(", "),
-        f.batches
+        f.batches,
+        describe_replications(f)
     )
+}
+
+/// For a `photon` golden: its batches are replications with maps of their own, at most
+/// [`MAX_REPLICATIONS`]; empty for the others.
+fn describe_replications(f: &DetectionFloor) -> String {
+    match f.noise {
+        NoiseScaling::Replications(_) => format!(
+            "; {} replications, each with its own photon maps (at most {MAX_REPLICATIONS}: more samples per pixel are spread over them and lower only the camera samples' noise, more photons the maps')",
+            f.batches
+        ),
+        NoiseScaling::Passes => String::new(),
+    }
 }
 
 #[cfg(test)]
