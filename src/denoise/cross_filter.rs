@@ -59,6 +59,7 @@ impl LayerPlanes {
         demodulate: &[Vec<f32>; 3],
         w: usize,
         variance_radius: usize,
+        guide: Option<&GuidePlanes>,
     ) -> Self {
         let plane = |values: &[glam::Vec3], ch: usize, power: i32| -> Vec<f32> {
             values
@@ -73,6 +74,8 @@ impl LayerPlanes {
         let smooth = |plane: Vec<f32>| {
             if variance_radius == 0 || w == 0 {
                 plane
+            } else if let Some(g) = guide {
+                g.same_surface_mean(&plane, w, h, variance_radius)
             } else {
                 box_filter(&plane, w, h, variance_radius)
             }
@@ -148,6 +151,35 @@ impl GuidePlanes {
             sigma_normal2: params.sigma_normal * params.sigma_normal,
             sigma_depth: params.sigma_depth,
         }
+    }
+
+    /// `plane` (`w × h`) averaged over the `(2r+1)²` window, among the pixels the guide counts
+    /// as the same surface as the centre (feature distance at most 1: a feature weight of at
+    /// least 1/e). The prefilter of a noisy per-pixel variance that does not carry one
+    /// surface's noise across an edge onto another (a noise-free background beside a noisy
+    /// floor).
+    #[must_use]
+    pub fn same_surface_mean(&self, plane: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
+        let mut d = [0.0f32];
+        (0..plane.len())
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let (mut sum, mut count) = (0.0f32, 0.0f32);
+                for yy in y.saturating_sub(r)..=(y + r).min(h - 1) {
+                    for xx in x.saturating_sub(r)..=(x + r).min(w - 1) {
+                        let j = yy * w + xx;
+                        let steps = (x.abs_diff(xx) + y.abs_diff(yy)) as f32;
+                        self.distances(i, j, steps, &mut d);
+                        if d[0] <= 1.0 {
+                            sum += plane[j];
+                            count += 1.0;
+                        }
+                    }
+                }
+                // The centre is at distance 0 from itself: count ≥ 1.
+                sum / count.max(1.0)
+            })
+            .collect()
     }
 
     /// The feature distances of the pixels from `p_at` on to those from `q_at` on, `steps`
