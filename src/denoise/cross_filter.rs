@@ -52,7 +52,8 @@ impl LayerPlanes {
     /// pixel's variance from a few samples is itself very noisy — with two samples that agree
     /// by chance (both zero, say) it is 0, and the colour distance would then refuse every
     /// neighbour — so it is prefiltered, as Rousselle, Knaus and Zwicker (2012) and Bitterli et
-    /// al. (2016) prefilter theirs.
+    /// al. (2016) prefilter theirs. With `guide`, only over the neighbours on the centre's
+    /// surface ([`GuidePlanes::same_surface_mean`]); without, over the whole box.
     #[must_use]
     pub fn new(
         layer: &HalfBuffers,

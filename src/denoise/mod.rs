@@ -24,6 +24,11 @@
 //! (a Wiener gain on the box-averaged residuals of both halves, [`select`]): a caustic's or a
 //! shadow's local mean survives even where no feature marks it.
 //!
+//! Before any filtering, fireflies are rejected by the two halves' independence ([`outliers`]:
+//! a value one half holds and the other half's neighbourhood does not confirm is held to a
+//! bound; Zirr et al. 2018, DeCoro et al. 2010), and at few samples per half the guided light's
+//! per-pixel variance is prefiltered over the neighbours on the same surface.
+//!
 //! The module knows nothing of scenes or renders: plain arrays in, an image out. Every pixel's
 //! arithmetic runs in a fixed order in bands of rows whose split does not depend on the thread
 //! count, so the output is the same bytes for any number of threads.
