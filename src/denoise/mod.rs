@@ -89,7 +89,7 @@ pub struct DenoiseParams {
     /// 2 samples, 0.8 at 4.
     pub variance_max_samples: u32,
     /// Whether the guided light's variance prefilter averages only over the neighbours the
-    /// feature guide counts as the same surface ([`GuidePlanes::same_surface_mean`]) rather
+    /// feature guide counts as the same surface ([`GuidePlanes::same_surface`]) rather
     /// than over the whole box.
     pub variance_same_surface: bool,
     /// The same for the unguided (caustic and specular) light. A smoothed variance spreads a
@@ -153,12 +153,15 @@ pub fn denoise(input: &DenoiseInput, params: &DenoiseParams) -> Result<Vec<Vec3>
     let mut guided_layer = input.guided.clone();
     reject_outliers(&mut guided_layer, &params.outliers, w, h);
     let few = input.half_samples.iter().min().copied().unwrap_or(0) <= params.variance_max_samples;
+    let variance_radius = if few { params.variance_radius } else { 0 };
+    let same_surface = (variance_radius > 0 && params.variance_same_surface)
+        .then(|| guide_planes.same_surface(w, h, variance_radius));
     let guided = LayerPlanes::new(
         &guided_layer,
         albedo,
         w,
-        if few { params.variance_radius } else { 0 },
-        params.variance_same_surface.then_some(&guide_planes),
+        variance_radius,
+        same_surface.as_ref(),
     );
     let shares = input.half_shares();
     let candidates = Candidates {

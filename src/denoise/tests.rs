@@ -311,15 +311,15 @@ fn the_variance_prefilter_stays_on_one_surface() {
     let (w, h) = (6, 4);
     let mut guide = flat_guide(w * h);
     let mut plane = vec![0.0f32; w * h];
-    for i in 0..w * h {
+    for (i, (p, d)) in plane.iter_mut().zip(&mut guide.depth).enumerate() {
         if i % w < 3 {
-            plane[i] = 1.0;
+            *p = 1.0;
         } else {
-            guide.depth[i] = 10.0;
+            *d = 10.0;
         }
     }
     let planes = cross_filter::GuidePlanes::new(&guide, w, &DenoiseParams::default());
-    let got = planes.same_surface_mean(&plane, w, h, 1);
+    let got = planes.same_surface(w, h, 1).mean(&plane);
     assert_eq!(got, plane);
     // A plain box would have mixed them: 2 of the 6 in-image neighbours of (3, 0) are wall.
     assert!((planes::box_filter(&plane, w, h, 1)[3] - 2.0 / 6.0).abs() < 1e-6);
