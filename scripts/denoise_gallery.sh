@@ -3,7 +3,7 @@
 # and the bath (200×150), the noisy default render, caustic's `--denoise` of it, Intel Open Image
 # Denoise's on the same inputs and the reference, whole and as 4× enlarged crops around the
 # caustic's hot spot. Runs scripts/denoise_bench.sh (the box, 16 spp) and
-# scripts/denoise_scenes.sh (the bath, 8 spp; its reference is `--integrator photon` at 64 spp
+# scripts/denoise_scenes.sh (the bath, 8 spp; its reference is `--integrator ppm` at 1284 passes
 # unless REF_DIR holds bath.ref.exr), then copies their pictures into docs/images.
 #
 #   scripts/denoise_gallery.sh [BIN] [OUT]     (OUT default target/denoise-gallery)

@@ -52,13 +52,15 @@ impl LayerPlanes {
     /// pixel's variance from a few samples is itself very noisy — with two samples that agree
     /// by chance (both zero, say) it is 0, and the colour distance would then refuse every
     /// neighbour — so it is prefiltered, as Rousselle, Knaus and Zwicker (2012) and Bitterli et
-    /// al. (2016) prefilter theirs.
+    /// al. (2016) prefilter theirs. With `same_surface` (of that radius), only over the
+    /// neighbours on the centre's surface; without, over the whole box.
     #[must_use]
     pub fn new(
         layer: &HalfBuffers,
         demodulate: &[Vec<f32>; 3],
         w: usize,
         variance_radius: usize,
+        same_surface: Option<&SameSurface>,
     ) -> Self {
         let plane = |values: &[glam::Vec3], ch: usize, power: i32| -> Vec<f32> {
             values
@@ -73,6 +75,8 @@ impl LayerPlanes {
         let smooth = |plane: Vec<f32>| {
             if variance_radius == 0 || w == 0 {
                 plane
+            } else if let Some(g) = same_surface.filter(|g| g.r == variance_radius) {
+                g.mean(&plane)
             } else {
                 box_filter(&plane, w, h, variance_radius)
             }
@@ -150,6 +154,27 @@ impl GuidePlanes {
         }
     }
 
+    /// Which pixels of each `(2r+1)²` window (`w × h` image) the guide counts as the same
+    /// surface as the centre (feature distance at most 1: a feature weight of at least 1/e),
+    /// for averaging noisy per-pixel values over one surface only ([`SameSurface::mean`]).
+    #[must_use]
+    pub fn same_surface(&self, w: usize, h: usize, r: usize) -> SameSurface {
+        let side = 2 * r + 1;
+        let mut mask = vec![false; w * h * side * side];
+        let mut d = [0.0f32];
+        for i in 0..w * h {
+            let (x, y) = (i % w, i / w);
+            for yy in y.saturating_sub(r)..=(y + r).min(h - 1) {
+                for xx in x.saturating_sub(r)..=(x + r).min(w - 1) {
+                    let steps = (x.abs_diff(xx) + y.abs_diff(yy)) as f32;
+                    self.distances(i, yy * w + xx, steps, &mut d);
+                    mask[i * side * side + (yy + r - y) * side + (xx + r - x)] = d[0] <= 1.0;
+                }
+            }
+        }
+        SameSurface { w, h, r, mask }
+    }
+
     /// The feature distances of the pixels from `p_at` on to those from `q_at` on, `steps`
     /// pixels apart (|dx| + |dy|), into `out` (one per pixel).
     fn distances(&self, p_at: usize, q_at: usize, steps: f32, out: &mut [f32]) {
@@ -183,6 +208,43 @@ impl GuidePlanes {
                 out[i] = out[i].max(d);
             }
         }
+    }
+}
+
+/// For every pixel, which pixels of its `(2r+1)²` window are on its surface
+/// ([`GuidePlanes::same_surface`]).
+#[derive(Debug, Clone)]
+pub struct SameSurface {
+    w: usize,
+    h: usize,
+    r: usize,
+    mask: Vec<bool>,
+}
+
+impl SameSurface {
+    /// `plane` (`w × h`) averaged over each pixel's window, among the pixels on its surface:
+    /// the prefilter of a noisy per-pixel variance that does not carry one surface's noise
+    /// across an edge onto another (a noise-free background beside a noisy floor).
+    #[must_use]
+    pub fn mean(&self, plane: &[f32]) -> Vec<f32> {
+        let (w, h, r) = (self.w, self.h, self.r);
+        let side = 2 * r + 1;
+        (0..plane.len())
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let (mut sum, mut count) = (0.0f32, 0.0f32);
+                for yy in y.saturating_sub(r)..=(y + r).min(h - 1) {
+                    for xx in x.saturating_sub(r)..=(x + r).min(w - 1) {
+                        if self.mask[i * side * side + (yy + r - y) * side + (xx + r - x)] {
+                            sum += plane[yy * w + xx];
+                            count += 1.0;
+                        }
+                    }
+                }
+                // The centre is at distance 0 from itself: count ≥ 1.
+                sum / count.max(1.0)
+            })
+            .collect()
     }
 }
 

@@ -24,6 +24,11 @@
 //! (a Wiener gain on the box-averaged residuals of both halves, [`select`]): a caustic's or a
 //! shadow's local mean survives even where no feature marks it.
 //!
+//! Before any filtering, fireflies are rejected by the two halves' independence ([`outliers`]:
+//! a value one half holds and the other half's neighbourhood does not confirm is held to a
+//! bound; Zirr et al. 2018, DeCoro et al. 2010), and at few samples per half the guided light's
+//! per-pixel variance is prefiltered over the neighbours on the same surface.
+//!
 //! The module knows nothing of scenes or renders: plain arrays in, an image out. Every pixel's
 //! arithmetic runs in a fixed order in bands of rows whose split does not depend on the thread
 //! count, so the output is the same bytes for any number of threads.
@@ -32,6 +37,7 @@ pub mod cross_filter;
 pub mod error;
 pub mod fast_exp;
 pub mod input;
+pub mod outliers;
 pub mod planes;
 pub mod select;
 
@@ -44,6 +50,7 @@ pub use error::DenoiseError;
 pub use input::{DenoiseInput, Guide, HalfBuffers};
 
 use cross_filter::{Candidates, GuidePlanes, LayerPlanes, cross_filter};
+use outliers::{OutlierParams, reject_outliers};
 use select::select;
 
 /// The denoiser's settings; [`DenoiseParams::default`] is what `--denoise` uses.
@@ -68,13 +75,23 @@ pub struct DenoiseParams {
     pub sigma_depth: f32,
     /// Radius of the box filter that smooths the error estimates before the per-pixel choice.
     pub select_radius: usize,
-    /// Radius of the box filter that prefilters each half's per-pixel variance of the guided
-    /// light before the colour distances use it (0: not prefiltered). At very few samples a
-    /// pixel's variance is itself noisy (two samples that are both 0 give 0, and the colour
-    /// distance then refuses every neighbour): 1 lowers the glass of water's relMSE at 4 spp
-    /// from 0.0149 to 0.0043 but raises the caustic Cornell box's at 16 spp from 0.00196 to
-    /// 0.00205 (docs/denoise.md), so it is off by default.
+    /// Radius of the window that prefilters each half's per-pixel variance of the guided
+    /// light before the colour distances use it, when the halves have at most
+    /// `variance_max_samples` samples (0: never prefiltered). From a few samples a pixel's
+    /// variance is itself very noisy (two samples that are both 0 give 0, and the colour
+    /// distance then refuses every neighbour). With 1 (and `variance_same_surface`) the glass
+    /// of water's relMSE at 4 spp falls from 0.0083 to 0.0044 and the pool's rises from 0.0131
+    /// to 0.0141 (docs/denoise.md); on the caustic Cornell box at 16 spp (8 samples a half)
+    /// a plain 3×3 box raised it from 0.00196 to 0.00205, hence the sample limit.
     pub variance_radius: usize,
+    /// The variance prefilter runs only when a half has at most this many samples: the
+    /// relative spread of a variance estimated from `n` samples is about `√(2/(n−1))`, 1.4 at
+    /// 2 samples, 0.8 at 4.
+    pub variance_max_samples: u32,
+    /// Whether the guided light's variance prefilter averages only over the neighbours the
+    /// feature guide counts as the same surface ([`GuidePlanes::same_surface`]) rather
+    /// than over the whole box.
+    pub variance_same_surface: bool,
     /// The same for the unguided (caustic and specular) light. A smoothed variance spreads a
     /// caustic's noise onto the dark beside it, whose pixels then average across the caustic's
     /// edge (with 1 for both layers the glass of water's caustic lost a further 8 % of its mean).
@@ -85,6 +102,9 @@ pub struct DenoiseParams {
     /// Added to the albedo before the light is divided by it (keeps black surfaces and
     /// emitters, of albedo 0, filtered as plain radiance).
     pub albedo_epsilon: f32,
+    /// Firefly rejection before the filter, each half held to what the other confirms
+    /// ([`outliers`]).
+    pub outliers: OutlierParams,
 }
 
 impl Default for DenoiseParams {
@@ -99,10 +119,17 @@ impl Default for DenoiseParams {
             sigma_normal: 0.2,
             sigma_depth: 0.02,
             select_radius: 2,
-            variance_radius: 0,
+            variance_radius: 1,
+            variance_max_samples: 3,
+            variance_same_surface: true,
             unguided_variance_radius: 0,
             residual_radius: 4,
             albedo_epsilon: 0.01,
+            outliers: OutlierParams {
+                factor: 4.0,
+                window: 3,
+                floor: 0.05,
+            },
         }
     }
 }
@@ -123,7 +150,19 @@ pub fn denoise(input: &DenoiseInput, params: &DenoiseParams) -> Result<Vec<Vec3>
     let (w, h) = (input.width, input.height);
     let guide_planes = GuidePlanes::new(guide, w, params);
     let albedo = &guide_planes.demodulate;
-    let guided = LayerPlanes::new(&input.guided, albedo, w, params.variance_radius);
+    let mut guided_layer = input.guided.clone();
+    reject_outliers(&mut guided_layer, &params.outliers, w, h);
+    let few = input.half_samples.iter().min().copied().unwrap_or(0) <= params.variance_max_samples;
+    let variance_radius = if few { params.variance_radius } else { 0 };
+    let same_surface = (variance_radius > 0 && params.variance_same_surface)
+        .then(|| guide_planes.same_surface(w, h, variance_radius));
+    let guided = LayerPlanes::new(
+        &guided_layer,
+        albedo,
+        w,
+        variance_radius,
+        same_surface.as_ref(),
+    );
     let shares = input.half_shares();
     let candidates = Candidates {
         k: params.guided_k,
@@ -131,9 +170,12 @@ pub fn denoise(input: &DenoiseInput, params: &DenoiseParams) -> Result<Vec<Vec3>
         patch: params.patch,
     };
     let filtered = cross_filter(&guided, Some(&guide_planes), &candidates, w, h);
-    let mut out = select(&input.guided, &filtered, albedo, shares, params, w, h);
+    let mut out = select(&guided_layer, &filtered, albedo, shares, params, w, h);
     if let Some(unguided) = &input.unguided {
-        let planes = LayerPlanes::new(unguided, albedo, w, params.unguided_variance_radius);
+        let mut unguided = unguided.clone();
+        reject_outliers(&mut unguided, &params.outliers, w, h);
+        let unguided = &unguided;
+        let planes = LayerPlanes::new(unguided, albedo, w, params.unguided_variance_radius, None);
         let candidates = Candidates {
             k: params.unguided_k,
             radius: params.unguided_radius,

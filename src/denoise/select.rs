@@ -79,6 +79,7 @@ fn restore_structure(
     h: usize,
 ) -> Vec<Vec3> {
     let [ma, mb] = &layer.mean;
+    let [va, vb] = &layer.variance;
     for ch in 0..3 {
         let ra: Vec<f32> = (0..out.len()).map(|i| ma[i][ch] - out[i][ch]).collect();
         let rb: Vec<f32> = (0..out.len()).map(|i| mb[i][ch] - out[i][ch]).collect();
@@ -91,7 +92,15 @@ fn restore_structure(
             let m2 = mean * mean;
             if m2 > 0.0 {
                 let gain = ((a * b).max(0.0) / m2).min(1.0);
-                o[ch] += gain * mean;
+                // Never beyond the pixel's own halves and their noise (two standard
+                // deviations), unless the filter already was: the box average reaches across
+                // edges, and a noise-free pixel (halves equal, no variance) beside a smoothed
+                // edge must not take the edge's residual.
+                let (pa, pb) = (ma[i][ch], mb[i][ch]);
+                let noise = 2.0 * va[i][ch].max(vb[i][ch]).sqrt();
+                let (lo, hi) = (pa.min(pb) - noise, pa.max(pb) + noise);
+                let restored = o[ch] + gain * mean;
+                o[ch] = restored.clamp(o[ch].min(lo), o[ch].max(hi));
             }
         }
     }

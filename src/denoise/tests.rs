@@ -262,3 +262,65 @@ fn bad_inputs_are_refused_with_a_clear_error() {
     one_half.half_samples = [4, 0];
     assert!(refuse(&one_half).contains("at least 2 samples per pixel"));
 }
+
+/// The bath's firefly, synthetic: a noisy flat 0.3 (5 % noise) with one sample of 119 in half
+/// A at one pixel. The denoised image stays near 0.3 there and around (without the rejection,
+/// the filter spreads it: the pixel alone would be (119 + 0.3) / 2 ≈ 60 and its neighbours
+/// take shares of it).
+#[test]
+fn a_firefly_in_one_half_is_removed_not_smeared() {
+    let (w, h) = (25, 21);
+    let mut input = noisy_input(w, h, &|_, _| Vec3::splat(0.3), 0.05);
+    let c = 10 * w + 12;
+    input.guided.mean[0][c] = Vec3::new(119.0, 110.0, 100.0);
+    input.guided.variance[0][c] = Vec3::splat(119.0 * 119.0 / 8.0);
+    let out = run(&input, 2);
+    let worst = out
+        .iter()
+        .map(|p| (*p - Vec3::splat(0.3)).abs().max_element())
+        .fold(0.0f32, f32::max);
+    // The rejection holds the half at 4 × 0.3: the pixel at most (1.2 + 0.3) / 2 + noise.
+    assert!(worst < 0.5, "worst deviation {worst}: the firefly was kept");
+}
+
+/// A real one-pixel highlight, in both halves (a lamp's image): kept at the pixel (the
+/// rejection leaves it alone and the colour distance keeps its neighbours out).
+#[test]
+fn a_one_pixel_highlight_in_both_halves_is_kept() {
+    let (w, h) = (25, 21);
+    let mut input = noisy_input(w, h, &|_, _| Vec3::splat(0.3), 0.05);
+    let c = 10 * w + 12;
+    for half in 0..2 {
+        input.guided.mean[half][c] = Vec3::splat(50.0 + half as f32);
+        input.guided.variance[half][c] = Vec3::splat(0.5);
+    }
+    let out = run(&input, 2);
+    assert!(
+        (out[c] - Vec3::splat(50.5)).abs().max_element() < 0.05 * 50.5,
+        "{}",
+        out[c]
+    );
+}
+
+/// The variance prefilter of few-sample renders averages over one surface only: on a 6×4 image
+/// whose left half is a wall at depth 2 (variance 1 everywhere) and right half a background at
+/// depth 10 (variance 0), no background pixel takes any of the wall's variance, and each wall
+/// pixel is the mean over its in-image 3×3 neighbours on the wall (all 1).
+#[test]
+fn the_variance_prefilter_stays_on_one_surface() {
+    let (w, h) = (6, 4);
+    let mut guide = flat_guide(w * h);
+    let mut plane = vec![0.0f32; w * h];
+    for (i, (p, d)) in plane.iter_mut().zip(&mut guide.depth).enumerate() {
+        if i % w < 3 {
+            *p = 1.0;
+        } else {
+            *d = 10.0;
+        }
+    }
+    let planes = cross_filter::GuidePlanes::new(&guide, w, &DenoiseParams::default());
+    let got = planes.same_surface(w, h, 1).mean(&plane);
+    assert_eq!(got, plane);
+    // A plain box would have mixed them: 2 of the 6 in-image neighbours of (3, 0) are wall.
+    assert!((planes::box_filter(&plane, w, h, 1)[3] - 2.0 / 6.0).abs() < 1e-6);
+}
