@@ -1,0 +1,702 @@
+//! `caustic render`'s library half: a render request with its flags already parsed
+//! ([`RenderRequest`]) taken through its phases — the scene prepared with the request's
+//! overrides ([`RenderRequest::prepare`]), the render job started with the sample range of a
+//! shard or `--samples` ([`PreparedRender::start`]: photon maps or the photon cache), the passes
+//! under a time budget, target error, adaptive plan or checkpoints, the features and the
+//! denoiser of `--denoise`, and the output written as an image, an image with layers or a
+//! mergeable `.part` film ([`StartedRender::finish`]). The outcome ([`RenderedImage`]) holds the
+//! film and says, in the command's words, what was rendered. The binary parses the flags, wires
+//! Ctrl-C to the cancel flag and prints.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use super::{Prepared, SceneOverrides, prepare};
+use crate::denoise::DenoiseParams;
+use crate::error::Error;
+use crate::farm::part_meta::settings_hash;
+use crate::farm::{PartMeta, Shard};
+use crate::render::adaptive::AdaptivePlan;
+use crate::render::auto_exposure::{AutoExposure, resolve, tonemap_for};
+use crate::render::denoised::{FirstHalf, denoise_render};
+use crate::render::error_estimate::ErrorEstimate;
+use crate::render::output::{OutputFormat, write_image};
+use crate::render::passes::{CheckpointPlan, PassPlan, render_in_passes};
+use crate::render::tonemap::{Display, Tonemap};
+use crate::render::{
+    Features, Film, Layer, LayerExtras, PixelSums, Region, RenderError, RenderJob, RenderOptions,
+    RenderOutput, write_with_extras, write_with_layers,
+};
+use crate::settings::{IntegratorKind, SamplerKind};
+
+/// Samples per pixel a render under a time budget or a target error may reach when the
+/// samples per pixel are not stated (they then only cap it).
+pub const BUDGET_SPP_CAP: u32 = 1 << 20;
+
+/// Why a render request is refused, or what stopped it; each text names the flag (or scene
+/// field) and what is valid. Converted into [`Error::Usage`] (and [`Error::Interrupted`]).
+#[derive(Debug, thiserror::Error)]
+pub enum RenderRefusal {
+    /// `--shard` with an output that is not a `.part` film.
+    #[error(
+        "--shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
+        .0.display()
+    )]
+    ShardNeedsPart(PathBuf),
+    /// `--shard` malformed, or more shards than samples per pixel.
+    #[error(transparent)]
+    Shard(#[from] crate::farm::shard::ShardError),
+    /// `render.adaptive` with an output or flag that splits the samples (named).
+    #[error(
+        "--adaptive (render.adaptive) cannot be used with {0}: an adaptive render decides each pixel's samples from all its earlier ones, so it cannot be split into sample ranges and merged; render without --adaptive, or render the whole image adaptively"
+    )]
+    AdaptiveSplit(&'static str),
+    /// `--samples START..END` beyond the render's samples per pixel.
+    #[error(
+        "--samples {start}..{end}: the render has {spp} samples per pixel, so END must be at most {spp}"
+    )]
+    SamplesBeyond {
+        /// First sample index asked for.
+        start: u32,
+        /// One past the last sample index asked for.
+        end: u32,
+        /// The render's samples per pixel.
+        spp: u32,
+    },
+    /// `--denoise` of a render that takes fewer than 2 samples per pixel.
+    #[error(
+        "--denoise needs at least 2 samples per pixel (it compares two halves of them); this render takes {0}"
+    )]
+    DenoiseTooFewSamples(u32),
+    /// The denoiser refused the render's buffers.
+    #[error(transparent)]
+    Denoise(#[from] crate::render::denoised::DenoiseRenderError),
+    /// Ctrl-C (or SIGTERM): no image written; the text says what the checkpoint kept.
+    #[error("{0}")]
+    Interrupted(String),
+}
+
+impl From<RenderRefusal> for Error {
+    fn from(e: RenderRefusal) -> Self {
+        match e {
+            RenderRefusal::Interrupted(text) => Error::Interrupted(text),
+            other => Error::Usage(other.to_string()),
+        }
+    }
+}
+
+/// Whether `path` asks for the mergeable film (`.part`).
+#[must_use]
+pub fn is_part(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("part"))
+}
+
+/// Whether `path` is a linear EXR image (no exposure applies).
+fn is_exr(path: &Path) -> bool {
+    matches!(OutputFormat::for_path(path), Ok(OutputFormat::Exr))
+}
+
+/// The shard of `--shard` (`None` without it), after checking that the output is one caustic
+/// writes and that a shard writes a `.part` film (`render` and `preview` share the rule).
+///
+/// # Errors
+/// [`RenderRefusal::ShardNeedsPart`], an unknown output extension, or a malformed shard.
+pub fn output_shard(output: &Path, shard: Option<&str>) -> Result<Option<Shard>, Error> {
+    if !is_part(output) {
+        if shard.is_some() {
+            return Err(RenderRefusal::ShardNeedsPart(output.to_path_buf()).into());
+        }
+        OutputFormat::for_path(output)?;
+    }
+    Ok(shard
+        .map(Shard::parse)
+        .transpose()
+        .map_err(RenderRefusal::from)?)
+}
+
+/// A render as `caustic render` asks for it, every flag parsed and checked on its own.
+#[derive(Debug, Clone)]
+pub struct RenderRequest {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// The command line's overrides of the scene.
+    pub overrides: SceneOverrides,
+    /// The output: `.png`, `.exr`, or `.part` for the mergeable film of per-pixel sums.
+    pub output: PathBuf,
+    /// Worker threads (`None`: all cores).
+    pub threads: Option<usize>,
+    /// The crop to render (`None`: the whole image).
+    pub region: Option<Region>,
+    /// Render in passes for this long, then write (`--time`).
+    pub time: Option<Duration>,
+    /// Where the image so far is saved between passes (`--checkpoint`).
+    pub checkpoint: Option<PathBuf>,
+    /// Time between checkpoints (zero: after every pass).
+    pub checkpoint_every: Duration,
+    /// The folder of the photon cache (`--photon-cache`).
+    pub photon_cache: Option<PathBuf>,
+    /// The shard of the samples to render (`--shard`).
+    pub shard: Option<Shard>,
+    /// The sample indices to render (`--samples`); takes precedence over `shard`.
+    pub samples: Option<Range<u32>>,
+    /// The layers to write besides the image, each once.
+    pub layers: Vec<Layer>,
+    /// Denoise the image (`--denoise`).
+    pub denoise: bool,
+    /// Linear exposure for 8-bit images (`--exposure`; `render.exposure`).
+    pub exposure: Option<f32>,
+    /// Stop once the estimated relMSE is at most this (`--target-error`).
+    pub target_error: Option<f32>,
+    /// Adaptive sampling (`--adaptive`).
+    pub adaptive: bool,
+    /// Draw progress bars on the terminal.
+    pub progress: bool,
+}
+
+impl RenderRequest {
+    /// The overrides the render compiles with: the command line's, the flags that are scene
+    /// fields (`render.exposure`, `render.target_error`, `render.adaptive`), and, for a render
+    /// that a budget or a target stops, [`BUDGET_SPP_CAP`] samples per pixel unless stated.
+    fn overrides(&self) -> SceneOverrides {
+        let mut overrides = self.overrides.clone();
+        if let Some(x) = self.exposure {
+            overrides.sets.push(format!("render.exposure={x:?}"));
+        }
+        if let Some(x) = self.target_error {
+            overrides.sets.push(format!("render.target_error={x:?}"));
+        }
+        if self.adaptive {
+            overrides.sets.push("render.adaptive=true".into());
+        }
+        // A budget or a target decides when to stop; the sample count only caps it.
+        if (self.time.is_some() || self.target_error.is_some())
+            && overrides.render.samples_per_pixel.is_none()
+        {
+            overrides.render.samples_per_pixel = Some(BUDGET_SPP_CAP);
+        }
+        overrides
+    }
+
+    /// Reads, overrides, validates and compiles the scene (again with [`BUDGET_SPP_CAP`] when
+    /// the scene's own `render.target_error` decides when to stop), and refuses adaptive
+    /// sampling with a split of the samples.
+    ///
+    /// # Errors
+    /// The scene's errors; [`RenderRefusal::AdaptiveSplit`].
+    pub fn prepare(&self) -> Result<PreparedRender<'_>, Error> {
+        let mut overrides = self.overrides();
+        let mut prepared = prepare(&self.scene, &overrides)?;
+        let target_error = prepared.scene.render.target_error;
+        if target_error.is_some() && overrides.render.samples_per_pixel.is_none() {
+            // The scene's own `render.target_error`: compiled again with the cap (rare).
+            overrides.render.samples_per_pixel = Some(BUDGET_SPP_CAP);
+            prepared = prepare(&self.scene, &overrides)?;
+        }
+        let adaptive = prepared.scene.render.with_defaults().adaptive == Some(true);
+        if adaptive
+            && let Some(why) = [
+                (is_part(&self.output), "a `.part` output"),
+                (self.samples.is_some(), "--samples"),
+                (self.shard.is_some(), "--shard"),
+                (self.denoise, "--denoise"),
+            ]
+            .iter()
+            .find_map(|&(refused, name)| refused.then_some(name))
+        {
+            return Err(RenderRefusal::AdaptiveSplit(why).into());
+        }
+        Ok(PreparedRender {
+            request: self,
+            prepared,
+            target_error,
+            adaptive,
+        })
+    }
+}
+
+/// A request whose scene is compiled: [`PreparedRender::start`] begins rendering it.
+#[derive(Debug)]
+pub struct PreparedRender<'q> {
+    request: &'q RenderRequest,
+    /// The compiled scene, its warnings and figures.
+    pub prepared: Prepared,
+    target_error: Option<f32>,
+    adaptive: bool,
+}
+
+impl<'q> PreparedRender<'q> {
+    /// Resolves the sample range (of `--samples`, else of the shard), and starts the render job
+    /// (photon maps traced or read from the cache); `cancel` is the flag the render polls.
+    ///
+    /// # Errors
+    /// [`RenderRefusal::SamplesBeyond`], a shard with more parts than samples,
+    /// [`RenderRefusal::DenoiseTooFewSamples`]; [`RenderRefusal::Interrupted`] when cancelled
+    /// while tracing photons; the job's errors.
+    pub fn start(&self, cancel: Arc<AtomicBool>) -> Result<StartedRender<'_, 'q>, Error> {
+        let request = self.request;
+        let prepared = &self.prepared;
+        // `None`: automatic, chosen from the finished film (`auto_exposure`).
+        let stated_exposure = prepared.scene.render.exposure;
+        let exposure = prepared.render_scene.params.exposure;
+        let tonemap = tonemap_for(stated_exposure, prepared.scene.render.tonemap);
+        let spp = prepared.render_scene.params.samples_per_pixel;
+        let samples = match &request.samples {
+            Some(r) if r.end > spp => {
+                return Err(RenderRefusal::SamplesBeyond {
+                    start: r.start,
+                    end: r.end,
+                    spp,
+                }
+                .into());
+            }
+            Some(r) => Some(r.clone()),
+            None => request
+                .shard
+                .map(|s| s.samples(spp))
+                .transpose()
+                .map_err(RenderRefusal::from)?,
+        };
+        let options = RenderOptions {
+            threads: request.threads,
+            region: request.region,
+            progress: request.progress && request.time.is_none(),
+            cancel: Some(cancel),
+            photon_cache: request.photon_cache.clone(),
+            samples: samples.clone(),
+            light_paths: request.denoise
+                || request.layers.iter().any(|l| matches!(l, Layer::Part(_))),
+        };
+        let taken = samples.clone().unwrap_or(0..spp);
+        // `--denoise`: the samples below `split` are the first half-buffer.
+        let split = taken.start + (taken.end - taken.start) / 2;
+        if request.denoise && split == taken.start {
+            return Err(RenderRefusal::DenoiseTooFewSamples(taken.end - taken.start).into());
+        }
+        let job = match RenderJob::new(&prepared.render_scene, &options) {
+            // Ctrl-C during photon tracing.
+            Err(RenderError::Cancelled) => {
+                return Err(RenderRefusal::Interrupted("interrupted: no image written".into()).into());
+            }
+            other => other?,
+        };
+        Ok(StartedRender {
+            prepared: self,
+            job,
+            options,
+            display: Display { exposure, tonemap },
+            stated_exposure,
+            tonemap,
+            spp,
+            samples,
+            taken,
+            split,
+        })
+    }
+}
+
+/// A render job started: its photon maps are ready; [`StartedRender::finish`] renders.
+pub struct StartedRender<'p, 'q> {
+    prepared: &'p PreparedRender<'q>,
+    job: RenderJob<'p>,
+    options: RenderOptions,
+    display: Display,
+    stated_exposure: Option<f32>,
+    tonemap: Tonemap,
+    spp: u32,
+    samples: Option<Range<u32>>,
+    taken: Range<u32>,
+    split: u32,
+}
+
+/// What a render did on the way, as it happens, for the command to print.
+#[derive(Debug)]
+pub enum RenderNote {
+    /// The features (albedo, normal, depth) were traced in this time.
+    FeaturesTraced(Duration),
+    /// The image was denoised in this time.
+    Denoised(Duration),
+    /// The checkpoint file could not be removed after the final image was written.
+    CheckpointKept(PathBuf, std::io::Error),
+}
+
+impl<'p> StartedRender<'p, '_> {
+    /// Why the default estimator was chosen (`None` when the scene or the command line named
+    /// the integrator), e.g. `path: no specular caster, no photon pass`.
+    #[must_use]
+    pub fn default_estimator(&self) -> Option<String> {
+        let p = &self.prepared.prepared.render_scene.params;
+        p.default_estimator
+            .as_ref()
+            .map(|why| why.describe(p.integrator))
+    }
+
+    /// The photon maps' summary line, for an integrator that keeps photon maps.
+    #[must_use]
+    pub fn photon_maps_summary(&self) -> Option<String> {
+        self.job
+            .integrator()
+            .photon_maps()
+            .map(|m| m.summary.to_string())
+    }
+
+    /// The `--photon-cache` folder when the integrator keeps no photon maps to cache (the
+    /// cache is then ignored).
+    #[must_use]
+    pub fn ignored_photon_cache(&self) -> Option<&Path> {
+        self.prepared
+            .request
+            .photon_cache
+            .as_deref()
+            .filter(|_| self.job.integrator().photon_maps().is_none())
+    }
+
+    /// The integrator rendering.
+    #[must_use]
+    pub fn integrator(&self) -> IntegratorKind {
+        self.prepared.prepared.render_scene.params.integrator
+    }
+
+    /// Renders (the first half apart for `--denoise`), traces the features and denoises when
+    /// asked, and writes the output: the `.part` film with its [`PartMeta`], the image with its
+    /// layers and features, or the image; then removes the checkpoint. `note` hears of each
+    /// step that took time as it ends.
+    ///
+    /// # Errors
+    /// [`RenderRefusal::Interrupted`] when the cancel flag was raised (no output written; the
+    /// text names the checkpoint kept); the render's, denoiser's and writers' errors.
+    pub fn finish(
+        mut self,
+        note: &mut dyn FnMut(RenderNote),
+    ) -> Result<RenderedImage, Error> {
+        let request = self.prepared.request;
+        let scene = &self.prepared.prepared.render_scene;
+        let (spp, taken, split) = (self.spp, self.taken.clone(), self.split);
+        let output = &request.output;
+        let plan = PassPlan {
+            checkpoint: request.checkpoint.as_deref().map(|path| CheckpointPlan {
+                path,
+                every: request.checkpoint_every,
+                display: self.display,
+                auto_exposure: self.stated_exposure.is_none(),
+            }),
+            time_budget: request.time,
+            progress: request.progress,
+            target_error: self.prepared.target_error.map(f64::from),
+            adaptive: self
+                .prepared
+                .adaptive
+                .then(|| AdaptivePlan::new(self.prepared.target_error.map(f64::from), spp)),
+        };
+        let first_half = if request.denoise {
+            match self.job.render_pass(split - taken.start) {
+                Err(RenderError::Cancelled) => {
+                    return Err(
+                        RenderRefusal::Interrupted("interrupted: no image written".into()).into(),
+                    );
+                }
+                other => other?,
+            }
+            Some(FirstHalf {
+                sums: self.job.sums().clone(),
+                parts: self.job.parts().map(<[_]>::to_vec),
+            })
+        } else {
+            None
+        };
+        let outcome = render_in_passes(self.job, &plan);
+        let saved = outcome.checkpoint_spp;
+        let interrupted = || {
+            let kept = match (&request.checkpoint, saved) {
+                (Some(cp), Some(n)) => format!(
+                    " to `{}`; `{}` holds the last complete checkpoint ({n} of {spp} samples per pixel)",
+                    output.display(),
+                    cp.display()
+                ),
+                _ => String::new(),
+            };
+            Error::from(RenderRefusal::Interrupted(format!(
+                "interrupted: no image written{kept}"
+            )))
+        };
+        let out = match outcome.result {
+            Err(RenderError::Cancelled) => return Err(interrupted()),
+            other => other?,
+        };
+        let cancel = self.options.cancel.as_deref();
+        // A signal that came after the last tile still means "stop": the output is not written.
+        if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
+            return Err(interrupted());
+        }
+        let trace_features = request.denoise || request.layers.iter().any(|l| l.is_feature());
+        let features = if trace_features {
+            let started = Instant::now();
+            let traced = Features::trace(
+                scene,
+                request.region,
+                taken.clone(),
+                split,
+                request.threads,
+                cancel,
+            );
+            let f = match traced {
+                Err(RenderError::Cancelled) => return Err(interrupted()),
+                other => other?,
+            };
+            note(RenderNote::FeaturesTraced(started.elapsed()));
+            Some(f)
+        } else {
+            None
+        };
+        let denoised = match (&first_half, &features) {
+            (Some(first), Some(f)) => {
+                let started = Instant::now();
+                let film = denoise_render(
+                    &out.sums,
+                    out.parts.as_deref(),
+                    first,
+                    f,
+                    &DenoiseParams::default(),
+                    request.threads,
+                )
+                .map_err(RenderRefusal::from)?;
+                note(RenderNote::Denoised(started.elapsed()));
+                Some(film)
+            }
+            _ => None,
+        };
+        // The display of 8-bit outputs: the stated exposure, else the finished film's own.
+        let (display, auto) = resolve(
+            denoised.as_ref().unwrap_or(&out.film),
+            self.stated_exposure,
+            self.tonemap,
+        );
+        let part = is_part(output);
+        let auto = auto.filter(|_| !part && !is_exr(output));
+        if part {
+            let first_sample = self.samples.as_ref().map_or(0, |r| r.start);
+            let end = first_sample + reached_spp(&out) as u32;
+            let meta = PartMeta {
+                // NaN: automatic (`merge` then chooses it from the merged film).
+                exposure: self.stated_exposure.unwrap_or(f32::NAN),
+                scene: request.scene.display().to_string(),
+                shard: request.shard.map(|s| s.to_string()),
+                seconds: out.stats.elapsed.as_secs_f64(),
+                ..PartMeta::of(
+                    scene,
+                    settings_hash(scene),
+                    first_sample..end,
+                    spp,
+                    request.region,
+                )
+            };
+            out.sums.write(output, &meta.to_text())?;
+        } else if features.is_some() || denoised.is_some() {
+            let extras = LayerExtras {
+                features: features.as_ref(),
+                denoised: denoised.as_ref(),
+            };
+            write_with_extras(
+                &out.sums,
+                out.parts.as_deref(),
+                extras,
+                &request.layers,
+                output,
+                display,
+            )?;
+        } else if !request.layers.is_empty() {
+            write_with_layers(
+                &out.sums,
+                out.parts.as_deref(),
+                &request.layers,
+                output,
+                display,
+            )?;
+        } else {
+            write_image(&out.film, output, display)?;
+        }
+        if let (Some(cp), Some(_)) = (&request.checkpoint, saved)
+            && let Err(e) = std::fs::remove_file(cp)
+        {
+            note(RenderNote::CheckpointKept(cp.clone(), e));
+        }
+        let p = &scene.params;
+        Ok(RenderedImage {
+            output: output.clone(),
+            out,
+            denoised,
+            display,
+            auto_exposure: auto,
+            error: outcome.error,
+            target_error: self.prepared.target_error,
+            adaptive: self.prepared.adaptive,
+            samples: self.samples,
+            spp,
+            integrator: p.integrator,
+            default_estimator: p.default_estimator.is_some(),
+            sampler: p.sampler,
+        })
+    }
+}
+
+/// A finished render, written: the film and what the command says of it.
+#[derive(Debug)]
+pub struct RenderedImage {
+    /// The file written.
+    pub output: PathBuf,
+    /// The render's film, sums and figures.
+    pub out: RenderOutput,
+    /// The denoised image (`--denoise`).
+    pub denoised: Option<Film>,
+    /// The display the 8-bit outputs were written with.
+    pub display: Display,
+    /// The exposure chosen from the film, for an 8-bit output without a stated exposure.
+    pub auto_exposure: Option<AutoExposure>,
+    /// The image's estimated error when the render stopped, and whether it reached the target.
+    pub error: Option<(ErrorEstimate, bool)>,
+    target_error: Option<f32>,
+    adaptive: bool,
+    samples: Option<Range<u32>>,
+    spp: u32,
+    integrator: IntegratorKind,
+    default_estimator: bool,
+    sampler: SamplerKind,
+}
+
+/// Samples per pixel a render output holds.
+fn reached_spp(out: &RenderOutput) -> u64 {
+    out.stats.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1)
+}
+
+impl RenderedImage {
+    /// The image the output shows: the denoised one, else the film.
+    #[must_use]
+    pub fn image(&self) -> &Film {
+        self.denoised.as_ref().unwrap_or(&self.out.film)
+    }
+
+    /// Samples per pixel the render took.
+    #[must_use]
+    pub fn reached_spp(&self) -> u64 {
+        reached_spp(&self.out)
+    }
+
+    /// The summary line: the output, size, samples (and which of the render's a shard or
+    /// `--samples` range took), integrator, sampler, rays and speed.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let (out, spp) = (&self.out, self.spp);
+        let st = &out.stats;
+        let secs = st.elapsed.as_secs_f64();
+        let reached = self.reached_spp();
+        // A shard or `--samples` range says which samples of the render's it took.
+        let range = match &self.samples {
+            Some(r) if reached > 0 => format!(
+                " (samples {}..{} of {spp})",
+                r.start,
+                r.start + reached as u32
+            ),
+            Some(r) => format!(" (none of samples {}..{} of {spp})", r.start, r.end),
+            None => String::new(),
+        };
+        format!(
+            "{}: {}×{}, {} spp{range}, {:?} integrator{}, {:?} sampler, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
+            self.output.display(),
+            out.film.width,
+            out.film.height,
+            reached,
+            self.integrator,
+            if self.default_estimator {
+                " (default)"
+            } else {
+                ""
+            },
+            self.sampler,
+            st.rays,
+            secs,
+            st.rays as f64 / secs.max(1e-9) / 1e6,
+            st.threads,
+            if st.threads == 1 { "" } else { "s" }
+        )
+    }
+
+    /// Whether the target error was reached, and the estimate (a render with a target).
+    #[must_use]
+    pub fn target_error_summary(&self) -> Option<String> {
+        let ((e, reached), target) = (self.error?, self.target_error?);
+        Some(format!(
+            "target error {target}: {} — estimated relMSE {:.5} (its worst 1 % of pixels: {:.4}) at {reached_spp} spp in {secs:.2} s",
+            if reached {
+                "reached"
+            } else {
+                "not reached (the time or samples ran out)"
+            },
+            e.image,
+            e.worst,
+            reached_spp = self.reached_spp(),
+            secs = self.out.stats.elapsed.as_secs_f64(),
+        ))
+    }
+
+    /// What an adaptive render spent (an adaptive render).
+    #[must_use]
+    pub fn adaptive_summary(&self) -> Option<String> {
+        self.adaptive
+            .then(|| adaptive_summary(&self.out.sums, self.target_error))
+    }
+
+    /// What the photon passes did: the progressive integrators' passes and radii, or the
+    /// share of estimates cut short by the largest radius (integrators with photon maps).
+    #[must_use]
+    pub fn photons_summary(&self) -> Option<String> {
+        let st = &self.out.stats;
+        if let Some(pr) = &st.progressive {
+            let t = &pr.totals;
+            Some(format!(
+                "photons: {} passes of fresh maps, {} photons emitted and {} stored in all ({:.2} s), {} estimates; the last pass read {:.3} of each initial radius{}",
+                t.passes,
+                t.emitted,
+                t.stored,
+                t.time.as_secs_f64(),
+                st.photon_estimates,
+                pr.last_shrink,
+                match pr.caustic_radius {
+                    Some((typical, empty)) => format!(
+                        " (caustic map: R = {typical:.4} for a typical photon, {empty:.4} where the pilot map found none)"
+                    ),
+                    None => String::new(),
+                }
+            ))
+        } else if st.photon_estimates > 0 {
+            Some(format!(
+                "photons: {} estimates, {:.1}% cut short by the largest radius (photons.max_radius): those found fewer than the photons they ask for (photons.gather) within it, so they average fewer photons and are noisier; if the image looks blotchy, trace more photons (--photons, --caustic-photons) or raise --max-radius (which blurs more)",
+                st.photon_estimates,
+                100.0 * st.photon_radius_cut as f64 / st.photon_estimates as f64
+            ))
+        } else {
+            None
+        }
+    }
+}
+
+/// What an adaptive render spent: samples per pixel (mean, fewest, most) and the estimated
+/// relMSE of the image and of its worst 1 % of pixels.
+fn adaptive_summary(sums: &PixelSums, target: Option<f32>) -> String {
+    let n = sums.width as usize * sums.height as usize;
+    let counts = (0..n).map(|i| sums.count(i));
+    let total: u64 = counts.clone().map(u64::from).sum();
+    let e = ErrorEstimate::of_sums(sums);
+    format!(
+        "adaptive: {:.2} samples per pixel on average ({} to {}), each pixel until its estimated relMSE is at most {}; estimated relMSE {:.5}, worst 1 % of pixels {:.4}",
+        total as f64 / n.max(1) as f64,
+        counts.clone().min().unwrap_or(0),
+        counts.max().unwrap_or(0),
+        AdaptivePlan::new(target.map(f64::from), 1).pixel_target as f32,
+        e.image,
+        e.worst
+    )
+}
