@@ -8,7 +8,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use super::{Prepared, SceneOverrides, prepare};
-use crate::error::Error;
+use crate::Error;
 use crate::farm::part_meta::settings_hash;
 use crate::farm::plan::{DEFAULT_TIME, resolved_scene, time_plan_spp};
 use crate::render::output::write_atomic;

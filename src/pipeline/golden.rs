@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use super::flags::{FlagError, StatedFlag};
 use super::{SceneOverrides, prepare};
-use crate::error::Error;
+use crate::Error;
 use crate::farm::part_meta::settings_hash;
 use crate::render::RenderOptions;
 use crate::render::golden::floor::{self, DetectSearch, DetectStep, DetectionFloor};

@@ -14,7 +14,7 @@ pub mod render;
 use std::path::Path;
 
 use crate::compile::{CompileStats, compile_with};
-use crate::error::Error;
+use crate::Error;
 use crate::render_scene::RenderScene;
 use crate::scene::load::SourceFile;
 use crate::scene::overrides::apply_overrides;

@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 
 use super::{Prepared, SceneOverrides, prepare};
 use crate::denoise::DenoiseParams;
-use crate::error::Error;
+use crate::Error;
 use crate::farm::part_meta::settings_hash;
 use crate::farm::{PartMeta, Shard};
 use crate::render::adaptive::AdaptivePlan;
