@@ -11,8 +11,8 @@ use std::time::Duration;
 use clap::Args;
 
 use caustic::Error;
-use caustic::pipeline::render::{RenderNote, RenderRequest};
 pub(super) use caustic::pipeline::render::{BUDGET_SPP_CAP, is_part, output_shard};
+use caustic::pipeline::render::{RenderNote, RenderRequest};
 use caustic::render::output::OutputFormat;
 use caustic::render::{Layer, Region};
 

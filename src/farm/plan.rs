@@ -32,9 +32,7 @@ pub enum PlanError {
     #[error("--shards {0}: at most {max} shards in a plan in time", max = u32::MAX / TIME_PLAN_SPP_PER_SHARD)]
     TooManyShards(u32),
     /// More shards than samples per pixel.
-    #[error(
-        "{0}; or give --time without --spp, for shards that render until their time is spent"
-    )]
+    #[error("{0}; or give --time without --spp, for shards that render until their time is spent")]
     Shard(super::shard::ShardError),
     /// The resolved scene cannot be written as RON.
     #[error("cannot write the resolved scene of `{}`: {reason}", from.display())]

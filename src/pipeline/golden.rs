@@ -368,3 +368,109 @@ pub fn check_scene(
     )?;
     Ok((golden, run))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::settings::{IntegratorKind, SamplerKind};
+
+    fn meta(overrides: &[(&str, &str)]) -> GoldenMeta {
+        GoldenMeta {
+            hash: 1,
+            seed: 41,
+            spp: 8,
+            integrator: "Path".into(),
+            sampler: "Sobol".into(),
+            exposure: 1.0,
+            scene: "s.ron".into(),
+            overrides: overrides
+                .iter()
+                .map(|(k, v)| ((*k).to_string(), (*v).to_string()))
+                .collect(),
+            settings: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_check_applies_the_recorded_flags_then_its_own_with_a_fresh_seed() {
+        let mut update = SceneOverrides {
+            sets: vec!["camera.fov_y=35".into()],
+            ..SceneOverrides::default()
+        };
+        for f in [
+            StatedFlag::Width(64),
+            StatedFlag::Spp(16),
+            StatedFlag::Seed(9),
+            StatedFlag::CausticPhotons(500),
+            StatedFlag::Integrator(IntegratorKind::PathPpm),
+            StatedFlag::Sampler(SamplerKind::Independent),
+        ] {
+            update.state(f);
+        }
+        let recorded = record(&update);
+        // As `golden update` wrote them before the flags had one list: the seed left out.
+        let written: Vec<(&str, &str)> = recorded
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.as_str()))
+            .collect();
+        assert_eq!(
+            written,
+            [
+                ("set", "camera.fov_y=35"),
+                ("width", "64"),
+                ("spp", "16"),
+                ("caustic_photons", "500"),
+                ("integrator", "path-ppm"),
+                ("sampler", "independent"),
+            ]
+        );
+        let mut golden = meta(&[]);
+        golden.overrides = recorded;
+        let own = SceneOverrides {
+            sets: vec!["render.max_depth=3".into()],
+            render: crate::scene::schema::RenderSettings {
+                width: Some(32),
+                ..Default::default()
+            },
+            ..SceneOverrides::default()
+        };
+        let o = combined(&golden, &own, Path::new("g")).expect("applies");
+        assert_eq!(o.sets, ["camera.fov_y=35", "render.max_depth=3"]);
+        assert_eq!(o.render.width, Some(32));
+        assert_eq!(o.render.samples_per_pixel, Some(16));
+        assert_eq!(o.render.integrator, Some(IntegratorKind::PathPpm));
+        assert_eq!(o.render.sampler, Some(SamplerKind::Independent));
+        assert_eq!(o.photons.caustic, Some(500));
+        assert_eq!(o.render.seed, Some(42));
+    }
+
+    #[test]
+    fn recorded_flags_that_cannot_apply_name_the_golden_and_the_fix() {
+        let text = |o: &[(&str, &str)]| {
+            combined(
+                &meta(o),
+                &SceneOverrides::default(),
+                Path::new("g/s.golden"),
+            )
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+        };
+        assert_eq!(
+            text(&[("spp", "many")]),
+            Err("error: `g/s.golden`: its recorded flag `spp=many` is malformed; run `caustic golden update` again".into())
+        );
+        assert_eq!(
+            text(&[("integrator", "bdpt")]),
+            Err("error: `g/s.golden`: its recorded flag `integrator=bdpt` names no such choice; run `caustic golden update` again".into())
+        );
+        // `update` never records the seed: a recorded one is as unknown as any other name.
+        for key in ["seed", "tile"] {
+            assert_eq!(
+                text(&[(key, "3")]),
+                Err(format!(
+                    "error: `g/s.golden`: unknown recorded flag `{key}` (written by a newer caustic?); run `caustic golden update` again"
+                ))
+            );
+        }
+    }
+}

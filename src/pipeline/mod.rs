@@ -13,8 +13,8 @@ pub mod render;
 
 use std::path::Path;
 
-use crate::compile::{CompileStats, compile_with};
 use crate::Error;
+use crate::compile::{CompileStats, compile_with};
 use crate::render_scene::RenderScene;
 use crate::scene::load::SourceFile;
 use crate::scene::overrides::apply_overrides;

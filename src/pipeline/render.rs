@@ -15,8 +15,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use super::{Prepared, SceneOverrides, prepare};
-use crate::denoise::DenoiseParams;
 use crate::Error;
+use crate::denoise::DenoiseParams;
 use crate::farm::part_meta::settings_hash;
 use crate::farm::{PartMeta, Shard};
 use crate::render::adaptive::AdaptivePlan;
@@ -280,7 +280,9 @@ impl<'q> PreparedRender<'q> {
         let job = match RenderJob::new(&prepared.render_scene, &options) {
             // Ctrl-C during photon tracing.
             Err(RenderError::Cancelled) => {
-                return Err(RenderRefusal::Interrupted("interrupted: no image written".into()).into());
+                return Err(
+                    RenderRefusal::Interrupted("interrupted: no image written".into()).into(),
+                );
             }
             other => other?,
         };
@@ -369,10 +371,7 @@ impl<'p> StartedRender<'p, '_> {
     /// # Errors
     /// [`RenderRefusal::Interrupted`] when the cancel flag was raised (no output written; the
     /// text names the checkpoint kept); the render's, denoiser's and writers' errors.
-    pub fn finish(
-        mut self,
-        note: &mut dyn FnMut(RenderNote),
-    ) -> Result<RenderedImage, Error> {
+    pub fn finish(mut self, note: &mut dyn FnMut(RenderNote)) -> Result<RenderedImage, Error> {
         let request = self.prepared.request;
         let scene = &self.prepared.prepared.render_scene;
         let (spp, taken, split) = (self.spp, self.taken.clone(), self.split);
