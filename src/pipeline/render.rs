@@ -699,3 +699,95 @@ fn adaptive_summary(sums: &PixelSums, target: Option<f32>) -> String {
         e.worst
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::render;
+    use crate::scene::schema::RenderSettings;
+
+    /// A crate user's render through the request's phases writes the very bytes of the plain
+    /// [`render`] written by [`write_image`], and says so in the command's words.
+    #[test]
+    fn a_request_renders_the_plain_render_and_names_it() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
+        let overrides = SceneOverrides {
+            render: RenderSettings {
+                width: Some(8),
+                height: Some(6),
+                samples_per_pixel: Some(2),
+                integrator: Some(IntegratorKind::Path),
+                ..RenderSettings::default()
+            },
+            ..SceneOverrides::default()
+        };
+        let request = RenderRequest {
+            scene: scene.clone(),
+            overrides: overrides.clone(),
+            output: dir.path().join("a.exr"),
+            threads: Some(1),
+            region: None,
+            time: None,
+            checkpoint: None,
+            checkpoint_every: Duration::ZERO,
+            photon_cache: None,
+            shard: None,
+            samples: None,
+            layers: Vec::new(),
+            denoise: false,
+            exposure: None,
+            target_error: None,
+            adaptive: false,
+            progress: false,
+        };
+        let prepared = request.prepare().expect("prepares");
+        let started = prepared
+            .start(Arc::new(AtomicBool::new(false)))
+            .expect("starts");
+        assert_eq!(started.default_estimator(), None);
+        assert_eq!(started.photon_maps_summary(), None);
+        let done = started
+            .finish(&mut |note| panic!("nothing to note: {note:?}"))
+            .expect("renders");
+        let plain = prepare(&scene, &overrides).expect("prepares");
+        let options = RenderOptions {
+            threads: Some(1),
+            ..RenderOptions::default()
+        };
+        let out = render(&plain.render_scene, &options).expect("renders");
+        let b = dir.path().join("b.exr");
+        write_image(&out.film, &b, plain.render_scene.params.exposure).expect("writes");
+        let read = |p: &Path| std::fs::read(p).expect("read");
+        assert_eq!(read(&request.output), read(&b));
+        assert_eq!(done.reached_spp(), 2);
+        let summary = done.summary();
+        let expected = format!(
+            "{}: 8×6, 2 spp, Path integrator, Sobol sampler, ",
+            request.output.display()
+        );
+        assert!(summary.starts_with(&expected), "{summary}");
+        assert!(summary.ends_with(", 1 thread)"), "{summary}");
+        assert_eq!(done.adaptive_summary(), None);
+        assert_eq!(done.target_error_summary(), None);
+        assert!(done.auto_exposure.is_none(), "EXR output stays linear");
+    }
+
+    #[test]
+    fn refusals_name_the_flag_and_what_is_valid() {
+        let out = Path::new("x.png");
+        let e = output_shard(out, Some("1/2")).expect_err("a shard writes a .part");
+        assert_eq!(
+            e.to_string(),
+            "error: --shard writes the mergeable film: the output `x.png` must end in `.part`, e.g. `-o shard-1.part`"
+        );
+        assert_eq!(e.exit_code(), 2);
+        assert!(is_part(Path::new("s.PART")) && !is_part(out));
+        assert_eq!(
+            output_shard(Path::new("s.part"), Some("2/3")).expect("parses"),
+            Some(Shard { index: 2, count: 3 })
+        );
+        let interrupted = Error::from(RenderRefusal::Interrupted("interrupted".into()));
+        assert_eq!(interrupted.exit_code(), 130);
+    }
+}
