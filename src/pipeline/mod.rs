@@ -1,7 +1,8 @@
 //! The whole front half of a run: read → override → validate → compile, with every diagnostic
 //! located in the file (or attributed to the command line); and, on top of every other layer,
 //! the library halves of the binary's commands, which a program using caustic as a crate can
-//! call: [`render`] (a render request through its phases to the written output), [`golden`]
+//! call: [`render`] (a render request through its phases to the written output, which
+//! [`rendered`] reports), [`golden`]
 //! (golden images rendered, searched for a detection floor, checked), [`farm_plan`] (a farm
 //! plan's scene and its resolved copy), and [`flags`] (the dedicated flags an override set
 //! states, for the records that apply them again).
@@ -10,6 +11,7 @@ pub mod farm_plan;
 pub mod flags;
 pub mod golden;
 pub mod render;
+pub mod rendered;
 
 use std::path::Path;
 
