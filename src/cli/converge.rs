@@ -1,14 +1,10 @@
-//! `caustic converge`: error against time for several integrators. Each integrator renders the
-//! scene progressively, and at 1, 2, 4, 8, … samples per pixel the image so far is compared with
-//! a reference (the film after n samples is bit-identical to a fresh render at n samples, so one
-//! progressive render gives the whole series for the time of its last point). The series
-//! doubles until the integrator's share of `--time` would be overrun. Writes DIR/convergence.csv,
+//! `caustic converge`: error against time for several integrators, each measured by
+//! [`caustic::analysis::convergence::measure`] in its share of `--time`. Writes DIR/convergence.csv,
 //! DIR/convergence.json (machine, settings, points, fitted slopes), DIR/convergence.png and .svg
 //! (RMSE against wall time, log-log) and each integrator's last image as DIR/<name>.exr.
 
-use std::fmt::Write as _;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use clap::{Args, ValueEnum};
@@ -16,15 +12,15 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::json;
 
 use caustic::Error;
-use caustic::analysis::metrics::{ImageError, Reference};
+use caustic::analysis::convergence::{self, Series, csv};
+use caustic::analysis::metrics::Reference;
 use caustic::pipeline::prepare;
 use caustic::render::output::{write_atomic, write_image};
-use caustic::render::{RenderJob, RenderOptions};
 
 use super::compare::figures_json;
 use super::render::parse_duration;
 use caustic::analysis::convergence_plot::{Curve, Plot};
-use caustic::analysis::slope::{fmt_slope, log_log_slope};
+use caustic::analysis::slope::fmt_slope;
 use caustic::settings::IntegratorKind;
 
 use super::{SceneArgs, print_warnings};
@@ -55,40 +51,6 @@ pub struct ConvergeArgs {
     /// No progress bars and no warnings.
     #[arg(short, long)]
     quiet: bool,
-}
-
-/// One measurement: the image after `spp` samples per pixel.
-#[derive(Debug, Clone, Copy)]
-struct Point {
-    spp: u32,
-    /// Render time to reach it (scene loading and comparisons excluded).
-    seconds: f64,
-    error: ImageError,
-}
-
-/// One integrator's series.
-#[derive(Debug, Clone)]
-struct Series {
-    integrator: IntegratorKind,
-    points: Vec<Point>,
-    rays: u64,
-    prepare_seconds: f64,
-}
-
-impl Series {
-    fn name(&self) -> String {
-        self.integrator.cli_name().to_string()
-    }
-
-    /// Slope of RMSE against wall time (log-log).
-    fn time_slope(&self) -> Option<f64> {
-        log_log_slope(self.points.iter().map(|p| (p.seconds, p.error.rmse)))
-    }
-
-    /// Slope of RMSE against samples per pixel (log-log).
-    fn spp_slope(&self) -> Option<f64> {
-        log_log_slope(self.points.iter().map(|p| (f64::from(p.spp), p.error.rmse)))
-    }
 }
 
 /// The machine, for the table: CPU model, logical cores, load average.
@@ -134,7 +96,7 @@ fn progress_bar(show: bool, name: &str, share: Duration) -> ProgressBar {
     bar
 }
 
-/// Renders the series of one integrator.
+/// Prepares the scene with `integrator` and renders its series.
 fn measure(
     args: &ConvergeArgs,
     integrator: IntegratorKind,
@@ -142,7 +104,7 @@ fn measure(
     share: Duration,
     show: bool,
 ) -> Result<(Series, caustic::render::Film, f32), Error> {
-    let t = Instant::now();
+    let started = Instant::now();
     let mut overrides = args.scene.overrides();
     overrides.render.integrator = Some(integrator);
     overrides.render.samples_per_pixel = Some(args.scene.spp.unwrap_or(SPP_CAP));
@@ -150,94 +112,21 @@ fn measure(
     if !args.quiet {
         print_warnings(&prepared.warnings);
     }
-    let params = &prepared.render_scene.params;
-    if (params.width, params.height) != (reference.film.width, reference.film.height) {
-        return Err(Error::Usage(format!(
-            "the reference `{}` is {}×{} but the scene renders {}×{}; give --width {} \
-             --height {} or a reference of the scene's size",
-            reference.path.display(),
-            reference.film.width,
-            reference.film.height,
-            params.width,
-            params.height,
-            reference.film.width,
-            reference.film.height
-        )));
-    }
-    let exposure = params.exposure;
-    let options = RenderOptions {
-        threads: args.threads,
-        ..RenderOptions::default()
-    };
-    let mut job = RenderJob::new(&prepared.render_scene, &options)?;
-    let prepare_seconds = t.elapsed().as_secs_f64();
-    let name = integrator.cli_name();
-    let bar = progress_bar(show, name, share);
-    let cap = job.samples_per_pixel();
-    let mut points = Vec::new();
-    let mut render_time = Duration::ZERO;
-    let mut target = 1u32;
-    loop {
-        let t = Instant::now();
-        job.render_pass(target - job.samples_done())?;
-        render_time += t.elapsed();
-        let film = job.snapshot();
-        let c = reference
-            .compare(&film, Path::new(&name), exposure, None)
-            .map_err(|e| Error::Usage(e.to_string()))?;
-        points.push(Point {
-            spp: target,
-            seconds: render_time.as_secs_f64(),
-            error: c.error,
-        });
-        bar.set_position(render_time.min(share).as_millis() as u64);
-        bar.set_message(format!("{target} spp, rmse {:.5}", c.error.rmse));
-        if target >= cap {
-            break;
-        }
-        let next = target.saturating_mul(2).min(cap);
-        let per_sample = render_time.as_secs_f64() / f64::from(target);
-        if render_time.as_secs_f64() + per_sample * f64::from(next - target) > share.as_secs_f64() {
-            break;
-        }
-        target = next;
-    }
-    bar.finish_and_clear();
-    let out = job.into_output();
-    let series = Series {
+    let bar = progress_bar(show, integrator.cli_name(), share);
+    let (series, film) = convergence::measure(
+        &prepared.render_scene,
         integrator,
-        points,
-        rays: out.stats.rays,
-        prepare_seconds,
-    };
-    Ok((series, out.film, exposure))
-}
-
-fn csv(series: &[Series]) -> String {
-    let mut s = String::from(
-        "integrator,spp,seconds,rmse,rel_mse,mae,bias,max_abs,rmse_red,rmse_green,rmse_blue\n",
-    );
-    for ser in series {
-        for p in &ser.points {
-            let e = &p.error;
-            let _ = writeln!(
-                s,
-                "{},{},{:.6},{:.8},{:.8},{:.8},{:.8},{:.8},{:.8},{:.8},{:.8}",
-                ser.name(),
-                p.spp,
-                p.seconds,
-                e.rmse,
-                e.rel_mse,
-                e.mae,
-                e.mean_bias,
-                e.max_abs,
-                e.channels[0].rmse,
-                e.channels[1].rmse,
-                e.channels[2].rmse
-            );
-        }
-    }
-    s
+        reference,
+        share,
+        args.threads,
+        started,
+        &mut |point, render_time| {
+            bar.set_position(render_time.min(share).as_millis() as u64);
+            bar.set_message(format!("{} spp, rmse {:.5}", point.spp, point.error.rmse));
+        },
+    )?;
+    bar.finish_and_clear();
+    Ok((series, film, prepared.render_scene.params.exposure))
 }
 
 /// Runs the series, writes the table, the JSON and the plots, and prints a summary.

@@ -22,12 +22,6 @@ pub(super) fn listed(flags: &[Vec<Layer>]) -> Vec<Layer> {
     layers
 }
 
-/// Whether any of `layers` is a feature layer (albedo, normal, depth), which the render traces
-/// in a pass of its own.
-pub(super) fn features_needed(layers: &[Layer]) -> bool {
-    layers.iter().any(|l| l.is_feature())
-}
-
 /// Refuses `layers` the output cannot hold, and a layer picture that cannot be written; the
 /// picture files a PNG output will get (none for an EXR output, or without layers).
 ///

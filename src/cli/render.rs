@@ -11,21 +11,13 @@ use std::time::Duration;
 use clap::Args;
 
 use caustic::Error;
-use caustic::farm::part_meta::settings_hash;
-use caustic::farm::{PartMeta, Shard};
-use caustic::pipeline::prepare;
-use caustic::render::auto_exposure::{resolve, tonemap_for};
-use caustic::render::output::{OutputFormat, write_image};
-use caustic::render::passes::{CheckpointPlan, PassPlan, render_in_passes};
-use caustic::render::tonemap::Display;
-use caustic::render::{Layer, Region, RenderError, RenderJob, RenderOptions, write_with_layers};
-use caustic::render::{LayerExtras, write_with_extras};
+pub(super) use caustic::pipeline::render::{BUDGET_SPP_CAP, is_part, output_shard};
+use caustic::pipeline::render::{RenderNote, RenderRequest};
+use caustic::render::output::OutputFormat;
+use caustic::render::{Layer, Region};
 
 use super::same_file::same_file;
 use super::{SceneArgs, count, layers_flag, print_warnings};
-
-/// Samples per pixel a `--time` render may reach when `--spp` is not given.
-pub(super) const BUDGET_SPP_CAP: u32 = 1 << 20;
 
 /// Arguments of `caustic render`.
 #[derive(Args)]
@@ -224,36 +216,6 @@ pub(super) fn default_output(scene: &Path) -> PathBuf {
     PathBuf::from(format!("{stem}.png"))
 }
 
-/// Whether `path` is a linear EXR image (no exposure applies).
-fn is_exr(path: &Path) -> bool {
-    matches!(OutputFormat::for_path(path), Ok(OutputFormat::Exr))
-}
-
-/// The shard of `--shard` (`None` without it), after checking that the output is one caustic
-/// writes and that a shard writes a `.part` film (`render` and `preview` share the rule).
-pub(super) fn output_shard(output: &Path, shard: Option<&str>) -> Result<Option<Shard>, Error> {
-    if !is_part(output) {
-        if shard.is_some() {
-            return Err(Error::Usage(format!(
-                "--shard writes the mergeable film: the output `{}` must end in `.part`, e.g. `-o shard-1.part`",
-                output.display()
-            )));
-        }
-        OutputFormat::for_path(output)?;
-    }
-    shard
-        .map(Shard::parse)
-        .transpose()
-        .map_err(|e| Error::Usage(e.to_string()))
-}
-
-/// Whether `path` asks for the mergeable film (`.part`).
-pub(super) fn is_part(path: &Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("part"))
-}
-
 /// Ctrl-C (and, on unix, SIGTERM/SIGHUP) for `caustic render`: before the render starts it ends
 /// the process at once (nothing has been written yet); from then on it raises the cancel flag
 /// the render polls, so the run can stop cleanly without writing the output.
@@ -287,10 +249,6 @@ impl Interrupt {
     fn start_rendering(&self) -> Arc<AtomicBool> {
         self.rendering.store(true, Ordering::SeqCst);
         Arc::clone(&self.cancel)
-    }
-
-    fn raised(&self) -> bool {
-        self.cancel.load(Ordering::SeqCst)
     }
 }
 
@@ -328,405 +286,109 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             output.display()
         )));
     }
-    let trace_features = args.denoise || layers_flag::features_needed(&layers);
     let pictures = layers_flag::check(&output, &layers, args.checkpoint.as_deref())?;
     let region = args.region.as_deref().map(parse_region).transpose()?;
     let reference = super::max_rmse::load(args.compare.as_deref())?;
     if args.threads == Some(0) {
         return Err(Error::Usage("--threads must be at least 1".into()));
     }
-    let mut overrides = args.scene.overrides();
-    if let Some(x) = args.exposure {
-        overrides.sets.push(format!("render.exposure={x:?}"));
-    }
-    if let Some(x) = args.target_error {
-        overrides.sets.push(format!("render.target_error={x:?}"));
-    }
-    if args.adaptive {
-        overrides.sets.push("render.adaptive=true".into());
-    }
-    // A budget or a target decides when to stop; the sample count only caps it.
-    if (args.time.is_some() || args.target_error.is_some())
-        && overrides.render.samples_per_pixel.is_none()
-    {
-        overrides.render.samples_per_pixel = Some(BUDGET_SPP_CAP);
-    }
-    let mut prepared = prepare(&args.scene.scene, &overrides)?;
-    let target_error = prepared.scene.render.target_error;
-    if target_error.is_some() && overrides.render.samples_per_pixel.is_none() {
-        // The scene's own `render.target_error`: compiled again with the cap (rare).
-        overrides.render.samples_per_pixel = Some(BUDGET_SPP_CAP);
-        prepared = prepare(&args.scene.scene, &overrides)?;
-    }
-    let adaptive = prepared.scene.render.with_defaults().adaptive == Some(true);
-    if adaptive
-        && let Some(why) = [
-            (is_part(&output), "a `.part` output"),
-            (args.samples.is_some(), "--samples"),
-            (args.shard.is_some(), "--shard"),
-            (args.denoise, "--denoise"),
-        ]
-        .iter()
-        .find_map(|&(refused, name)| refused.then_some(name))
-    {
-        return Err(Error::Usage(format!(
-            "--adaptive (render.adaptive) cannot be used with {why}: an adaptive render decides each pixel's samples from all its earlier ones, so it cannot be split into sample ranges and merged; render without --adaptive, or render the whole image adaptively"
-        )));
-    }
-    if !args.quiet {
-        print_warnings(&prepared.warnings);
-    }
-    if args.stats {
-        print_stats(&prepared.stats);
-    }
-    if let Some(reference) = &reference {
-        let p = &prepared.render_scene.params;
-        super::max_rmse::check_size(reference, p.width, p.height, region)?;
-    }
-    // `None`: automatic, chosen from the finished film (`auto_exposure`).
-    let stated_exposure = prepared.scene.render.exposure;
-    let exposure = prepared.render_scene.params.exposure;
-    let tonemap = tonemap_for(stated_exposure, prepared.scene.render.tonemap);
-    let display = Display { exposure, tonemap };
-    let spp = prepared.render_scene.params.samples_per_pixel;
-    let samples = match &args.samples {
-        Some(r) if r.end > spp => {
-            return Err(Error::Usage(format!(
-                "--samples {}..{}: the render has {spp} samples per pixel, so END must be at most {spp}",
-                r.start, r.end
-            )));
-        }
-        Some(r) => Some(r.clone()),
-        None => shard
-            .map(|s| s.samples(spp))
-            .transpose()
-            .map_err(|e| Error::Usage(e.to_string()))?,
-    };
-    let first_sample = samples.as_ref().map_or(0, |r| r.start);
-    let samples_taken = samples.clone();
-    let hash = is_part(&output).then(|| settings_hash(&prepared.render_scene));
-    let terminal = !args.quiet && std::io::stderr().is_terminal();
-    let options = RenderOptions {
+    let request = RenderRequest {
+        scene: args.scene.scene.clone(),
+        overrides: args.scene.overrides(),
+        output,
         threads: args.threads,
         region,
-        progress: terminal && args.time.is_none(),
-        cancel: Some(interrupt.start_rendering()),
+        time: args.time,
+        checkpoint: args.checkpoint.clone(),
+        checkpoint_every: args.checkpoint_every,
         photon_cache: args.photon_cache.clone(),
-        samples: samples_taken,
-        light_paths: args.denoise || layers.iter().any(|l| matches!(l, Layer::Part(_))),
+        shard,
+        samples: args.samples.clone(),
+        layers,
+        denoise: args.denoise,
+        exposure: args.exposure,
+        target_error: args.target_error,
+        adaptive: args.adaptive,
+        progress: !args.quiet && std::io::stderr().is_terminal(),
     };
-    let taken = samples.clone().unwrap_or(0..spp);
-    // `--denoise`: the samples below `split` are the first half-buffer.
-    let split = taken.start + (taken.end - taken.start) / 2;
-    if args.denoise && split == taken.start {
-        return Err(Error::Usage(format!(
-            "--denoise needs at least 2 samples per pixel (it compares two halves of them); this render takes {}",
-            taken.end - taken.start
-        )));
+    let prepared = request.prepare()?;
+    if !args.quiet {
+        print_warnings(&prepared.prepared.warnings);
     }
-    let mut job = match RenderJob::new(&prepared.render_scene, &options) {
-        // Ctrl-C during photon tracing.
-        Err(RenderError::Cancelled) => {
-            return Err(Error::Interrupted("interrupted: no image written".into()));
-        }
-        other => other?,
-    };
-    if !args.quiet
-        && let Some(why) = &prepared.render_scene.params.default_estimator
-    {
+    if args.stats {
+        print_stats(&prepared.prepared.stats);
+    }
+    if let Some(reference) = &reference {
+        let p = &prepared.prepared.render_scene.params;
+        super::max_rmse::check_size(reference, p.width, p.height, region)?;
+    }
+    let started = prepared.start(interrupt.start_rendering())?;
+    if !args.quiet {
         // The scene and the command line named no integrator: which one, and why.
-        eprintln!(
-            "default estimator {}",
-            why.describe(prepared.render_scene.params.integrator)
-        );
-    }
-    let maps = job.integrator().photon_maps();
-    if !args.quiet
-        && let Some(maps) = maps
-    {
-        eprintln!("{}", maps.summary);
-    }
-    if !args.quiet
-        && maps.is_none()
-        && let Some(dir) = &args.photon_cache
-    {
-        eprintln!(
-            "warning: --photon-cache `{}` is ignored: the {:?} integrator keeps no photon maps to cache (only `--integrator photon` does; ppm and path-ppm trace fresh maps every pass)",
-            dir.display(),
-            prepared.render_scene.params.integrator
-        );
-    }
-    let plan = PassPlan {
-        checkpoint: args.checkpoint.as_deref().map(|path| CheckpointPlan {
-            path,
-            every: args.checkpoint_every,
-            display,
-            auto_exposure: stated_exposure.is_none(),
-        }),
-        time_budget: args.time,
-        progress: terminal,
-        target_error: target_error.map(f64::from),
-        adaptive: adaptive.then(|| {
-            caustic::render::adaptive::AdaptivePlan::new(target_error.map(f64::from), spp)
-        }),
-    };
-    let first_half = if args.denoise {
-        match job.render_pass(split - taken.start) {
-            Err(RenderError::Cancelled) => {
-                return Err(Error::Interrupted("interrupted: no image written".into()));
-            }
-            other => other?,
+        if let Some(why) = started.default_estimator() {
+            eprintln!("default estimator {why}");
         }
-        Some(caustic::render::denoised::FirstHalf {
-            sums: job.sums().clone(),
-            parts: job.parts().map(<[_]>::to_vec),
-        })
-    } else {
-        None
-    };
-    let outcome = render_in_passes(job, &plan);
-    let saved = outcome.checkpoint_spp;
-    let error = outcome.error;
-    let interrupted = || {
-        let kept = match (&args.checkpoint, saved) {
-            (Some(cp), Some(n)) => format!(
-                " to `{}`; `{}` holds the last complete checkpoint ({n} of {spp} samples per pixel)",
-                output.display(),
-                cp.display()
-            ),
-            _ => String::new(),
-        };
-        Error::Interrupted(format!("interrupted: no image written{kept}"))
-    };
-    let out = match outcome.result {
-        Err(RenderError::Cancelled) => return Err(interrupted()),
-        other => other?,
-    };
-    // A signal that came after the last tile still means "stop": the output is not written.
-    if interrupt.raised() {
-        return Err(interrupted());
-    }
-    let features = if trace_features {
-        let started = std::time::Instant::now();
-        let traced = caustic::render::Features::trace(
-            &prepared.render_scene,
-            region,
-            taken.clone(),
-            split,
-            args.threads,
-            options.cancel.as_deref(),
-        );
-        let f = match traced {
-            Err(RenderError::Cancelled) => return Err(interrupted()),
-            other => other?,
-        };
-        if !args.quiet {
+        if let Some(summary) = started.photon_maps_summary() {
+            eprintln!("{summary}");
+        }
+        if let Some(dir) = started.ignored_photon_cache() {
             eprintln!(
-                "features: albedo, normal and depth traced in {:.2} s",
-                started.elapsed().as_secs_f64()
+                "warning: --photon-cache `{}` is ignored: the {:?} integrator keeps no photon maps to cache (only `--integrator photon` does; ppm and path-ppm trace fresh maps every pass)",
+                dir.display(),
+                started.integrator()
             );
         }
-        Some(f)
-    } else {
-        None
-    };
-    let denoised = match (&first_half, &features) {
-        (Some(first), Some(f)) => {
-            let started = std::time::Instant::now();
-            let film = caustic::render::denoised::denoise_render(
-                &out.sums,
-                out.parts.as_deref(),
-                first,
-                f,
-                &caustic::denoise::DenoiseParams::default(),
-                args.threads,
-            )
-            .map_err(|e| Error::Usage(e.to_string()))?;
-            if !args.quiet {
-                eprintln!("denoised in {:.2} s", started.elapsed().as_secs_f64());
-            }
-            Some(film)
+    }
+    let rendered = started.finish(&mut |note| {
+        if args.quiet {
+            return;
         }
-        _ => None,
-    };
-    // The display of 8-bit outputs: the stated exposure, else the finished film's own.
-    let (display, auto) = resolve(
-        denoised.as_ref().unwrap_or(&out.film),
-        stated_exposure,
-        tonemap,
-    );
-    let auto = auto.filter(|_| hash.is_none() && !is_exr(&output));
-    if let Some(hash) = hash {
-        let taken =
-            out.stats.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1);
-        let end = first_sample + taken as u32;
-        let meta = PartMeta {
-            // NaN: automatic (`merge` then chooses it from the merged film).
-            exposure: stated_exposure.unwrap_or(f32::NAN),
-            scene: args.scene.scene.display().to_string(),
-            shard: shard.map(|s| s.to_string()),
-            seconds: out.stats.elapsed.as_secs_f64(),
-            ..PartMeta::of(&prepared.render_scene, hash, first_sample..end, spp, region)
-        };
-        out.sums.write(&output, &meta.to_text())?;
-    } else if features.is_some() || denoised.is_some() {
-        let extras = LayerExtras {
-            features: features.as_ref(),
-            denoised: denoised.as_ref(),
-        };
-        write_with_extras(
-            &out.sums,
-            out.parts.as_deref(),
-            extras,
-            &layers,
-            &output,
-            display,
-        )?;
-    } else if !layers.is_empty() {
-        write_with_layers(&out.sums, out.parts.as_deref(), &layers, &output, display)?;
-    } else {
-        write_image(&out.film, &output, display)?;
+        match note {
+            RenderNote::FeaturesTraced(t) => eprintln!(
+                "features: albedo, normal and depth traced in {:.2} s",
+                t.as_secs_f64()
+            ),
+            RenderNote::Denoised(t) => eprintln!("denoised in {:.2} s", t.as_secs_f64()),
+            RenderNote::CheckpointKept(cp, e) => eprintln!(
+                "warning: cannot remove the checkpoint `{}`: {e}",
+                cp.display()
+            ),
+        }
+    })?;
+    println!("{}", rendered.summary());
+    if !args.quiet {
+        let said = [
+            rendered.target_error_summary(),
+            rendered.adaptive_summary(),
+            rendered.auto_exposure.as_ref().map(|a| a.describe()),
+            (!pictures.is_empty()).then(|| {
+                let names: Vec<String> = pictures
+                    .iter()
+                    .map(|p| format!("`{}`", p.display()))
+                    .collect();
+                format!("layers: {}", names.join(", "))
+            }),
+            rendered.photons_summary(),
+        ];
+        for line in said.into_iter().flatten() {
+            eprintln!("{line}");
+        }
     }
-    if let (Some(cp), Some(_)) = (&args.checkpoint, saved)
-        && let Err(e) = std::fs::remove_file(cp)
-        && !args.quiet
-    {
-        eprintln!(
-            "warning: cannot remove the checkpoint `{}`: {e}",
-            cp.display()
-        );
-    }
-    let st = &out.stats;
-    let secs = st.elapsed.as_secs_f64();
-    let reached = st.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1);
-    // A shard or `--samples` range says which samples of the render's it took.
-    let range = match &samples {
-        Some(r) if reached > 0 => format!(
-            " (samples {}..{} of {spp})",
-            r.start,
-            r.start + reached as u32
-        ),
-        Some(r) => format!(" (none of samples {}..{} of {spp})", r.start, r.end),
-        None => String::new(),
-    };
-    let p = &prepared.render_scene.params;
-    println!(
-        "{}: {}×{}, {} spp{range}, {:?} integrator{}, {:?} sampler, {} rays in {:.2} s ({:.2} Mrays/s, {} thread{})",
-        output.display(),
-        out.film.width,
-        out.film.height,
-        reached,
-        p.integrator,
-        if p.default_estimator.is_some() {
-            " (default)"
-        } else {
-            ""
-        },
-        p.sampler,
-        st.rays,
-        secs,
-        st.rays as f64 / secs.max(1e-9) / 1e6,
-        st.threads,
-        if st.threads == 1 { "" } else { "s" }
-    );
-    if let (Some((e, reached)), Some(target)) = (error, target_error)
-        && !args.quiet
-    {
-        eprintln!(
-            "target error {target}: {} — estimated relMSE {:.5} (its worst 1 % of pixels: {:.4}) at {reached_spp} spp in {secs:.2} s",
-            if reached {
-                "reached"
-            } else {
-                "not reached (the time or samples ran out)"
-            },
-            e.image,
-            e.worst,
-            reached_spp = reached_spp(&out),
-        );
-    }
-    if adaptive && !args.quiet {
-        eprintln!("{}", adaptive_summary(&out.sums, target_error));
-    }
-    if let Some(auto) = &auto
-        && !args.quiet
-    {
-        eprintln!("{}", auto.describe());
-    }
-    if !pictures.is_empty() && !args.quiet {
-        let names: Vec<String> = pictures
-            .iter()
-            .map(|p| format!("`{}`", p.display()))
-            .collect();
-        eprintln!("layers: {}", names.join(", "));
-    }
-    if let Some(pr) = &st.progressive
-        && !args.quiet
-    {
-        let t = &pr.totals;
-        eprintln!(
-            "photons: {} passes of fresh maps, {} photons emitted and {} stored in all ({:.2} s), {} estimates; the last pass read {:.3} of each initial radius{}",
-            t.passes,
-            t.emitted,
-            t.stored,
-            t.time.as_secs_f64(),
-            st.photon_estimates,
-            pr.last_shrink,
-            match pr.caustic_radius {
-                Some((typical, empty)) => format!(
-                    " (caustic map: R = {typical:.4} for a typical photon, {empty:.4} where the pilot map found none)"
-                ),
-                None => String::new(),
-            }
-        );
-    } else if st.photon_estimates > 0 && !args.quiet {
-        eprintln!(
-            "photons: {} estimates, {:.1}% cut short by the largest radius (photons.max_radius): those found fewer than the photons they ask for (photons.gather) within it, so they average fewer photons and are noisier; if the image looks blotchy, trace more photons (--photons, --caustic-photons) or raise --max-radius (which blurs more)",
-            st.photon_estimates,
-            100.0 * st.photon_radius_cut as f64 / st.photon_estimates as f64
-        );
-    }
-    if st.nan_samples > 0 {
-        eprintln!(
-            "warning: {} samples were NaN or infinite and were dropped",
-            st.nan_samples
-        );
+    let nan = rendered.out.stats.nan_samples;
+    if nan > 0 {
+        eprintln!("warning: {nan} samples were NaN or infinite and were dropped");
     }
     if let Some(reference) = &reference {
         super::max_rmse::check(
             reference,
-            denoised.as_ref().unwrap_or(&out.film),
-            &output,
-            display.exposure,
+            rendered.image(),
+            &request.output,
+            rendered.display.exposure,
             region,
             args.max_rmse,
         )?;
     }
     Ok(())
-}
-
-/// What an adaptive render spent: samples per pixel (mean, fewest, most) and the estimated
-/// relMSE of the image and of its worst 1 % of pixels.
-fn adaptive_summary(sums: &caustic::render::PixelSums, target: Option<f32>) -> String {
-    use caustic::render::adaptive::AdaptivePlan;
-    use caustic::render::error_estimate::ErrorEstimate;
-    let n = sums.width as usize * sums.height as usize;
-    let counts = (0..n).map(|i| sums.count(i));
-    let total: u64 = counts.clone().map(u64::from).sum();
-    let e = ErrorEstimate::of_sums(sums);
-    format!(
-        "adaptive: {:.2} samples per pixel on average ({} to {}), each pixel until its estimated relMSE is at most {}; estimated relMSE {:.5}, worst 1 % of pixels {:.4}",
-        total as f64 / n.max(1) as f64,
-        counts.clone().min().unwrap_or(0),
-        counts.max().unwrap_or(0),
-        AdaptivePlan::new(target.map(f64::from), 1).pixel_target as f32,
-        e.image,
-        e.worst
-    )
-}
-
-/// Samples per pixel a render output holds.
-fn reached_spp(out: &caustic::render::RenderOutput) -> u64 {
-    out.stats.samples / (u64::from(out.film.width) * u64::from(out.film.height)).max(1)
 }
 
 pub(super) fn print_stats(s: &caustic::compile::CompileStats) {

@@ -77,6 +77,7 @@ const RULES: &[(&str, &[&str])] = &[
             "render",
         ],
     ),
+    // `scene` for the resolved scene a farm plan writes (the file format, below everything).
     (
         "src/farm",
         &[
@@ -91,6 +92,7 @@ const RULES: &[(&str, &[&str])] = &[
             "integrators",
             "denoise",
             "render",
+            "scene",
         ],
     ),
     ("src/scene", &[]),
@@ -106,6 +108,28 @@ const RULES: &[(&str, &[&str])] = &[
             "spatial",
             "render_scene",
             "scene",
+        ],
+    ),
+    // The front half (read → override → validate → compile) and the commands' library halves
+    // (a render request's phases, golden runs, farm plans): the top of the library, over all.
+    (
+        "src/pipeline",
+        &[
+            "binfile",
+            "geometry",
+            "sampling",
+            "texture",
+            "shading",
+            "accel",
+            "spatial",
+            "denoise",
+            "render_scene",
+            "integrators",
+            "render",
+            "analysis",
+            "farm",
+            "scene",
+            "compile",
         ],
     ),
 ];

@@ -1,10 +1,22 @@
 //! The whole front half of a run: read → override → validate → compile, with every diagnostic
-//! located in the file (or attributed to the command line).
+//! located in the file (or attributed to the command line); and, on top of every other layer,
+//! the library halves of the binary's commands, which a program using caustic as a crate can
+//! call: [`render`] (a render request through its phases to the written output, which
+//! [`rendered`] reports), [`golden`]
+//! (golden images rendered, searched for a detection floor, checked), [`farm_plan`] (a farm
+//! plan's scene and its resolved copy), and [`flags`] (the dedicated flags an override set
+//! states, for the records that apply them again).
+
+pub mod farm_plan;
+pub mod flags;
+pub mod golden;
+pub mod render;
+pub mod rendered;
 
 use std::path::Path;
 
+use crate::Error;
 use crate::compile::{CompileStats, compile_with};
-use crate::error::Error;
 use crate::render_scene::RenderScene;
 use crate::scene::load::SourceFile;
 use crate::scene::overrides::apply_overrides;
