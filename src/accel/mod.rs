@@ -2,7 +2,6 @@
 
 pub(crate) mod build;
 pub mod bvh;
-mod query;
 pub mod sphere_bvh;
 mod traverse;
 

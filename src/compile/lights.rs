@@ -462,7 +462,6 @@ pub(super) fn compile_lights(
                     name: format!("lights[{i}]"),
                     material: None,
                     light: Some(index),
-                    body: None,
                 });
                 builder.spheres.push(SpherePrim { object, ..prim });
                 continue;
@@ -482,7 +481,6 @@ pub(super) fn compile_lights(
                 name: format!("lights[{i}]"),
                 material: None,
                 light: Some(index),
-                body: None,
             });
             out.infinity = Some(InfinityRef {
                 light: index,

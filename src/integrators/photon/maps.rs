@@ -17,7 +17,6 @@ use super::emit::{LightEmitter, split_by_power};
 use super::estimate::{IrradianceCache, Kernel, PhotonMap};
 use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon_into};
 use super::volume::{VolumeMap, VolumePhoton};
-use super::walls::Walls;
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
 use crate::sampling::rng::mix64;
@@ -531,7 +530,6 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
-            Walls::of(scene, None),
             photons,
             MapKind::Caustic,
             p.caustic_gather,
@@ -571,7 +569,6 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
-            Walls::of(scene, None),
             photons,
             MapKind::Global,
             p.gather,
@@ -631,7 +628,7 @@ pub(super) fn precompute_irradiance(
         global
             .as_ref()
             .or(caustic.as_ref())
-            .and_then(|sites| IrradianceCache::build(sites, &maps, Walls::of(scene, None), cancel))
+            .and_then(|sites| IrradianceCache::build(sites, &maps, cancel))
     } else {
         None
     };
@@ -644,7 +641,6 @@ pub(super) fn precompute_irradiance(
 /// Builds the kd-tree of one map's photons, or says why there is none.
 #[allow(clippy::too_many_arguments)]
 fn finish_map(
-    walls: Walls<'_>,
     photons: Vec<Photon>,
     kind: MapKind,
     k: u32,
@@ -669,12 +665,10 @@ fn finish_map(
             return None;
         }
     };
+    *build_time += t.elapsed();
     *memory += tree.memory_bytes();
     *radius = r;
-    let mut map = PhotonMap::new(tree, k as usize, r, kernel);
-    map.mark_walls(walls);
-    *build_time += t.elapsed();
-    Some(map)
+    Some(PhotonMap::new(tree, k as usize, r, kernel))
 }
 
 /// Mean of a flux's channels (W).
