@@ -23,33 +23,44 @@
 //! included), or the map's largest radius when fewer than k lie within it (the photon is then
 //! *capped*, which the summary counts as a search cut short). The kernel is the map's: the box,
 //! or Jensen's cone `1 − d/(k h)` over the disc of radius `h`, normalised by `π h² (1 − 2/(3k))`
-//! (Jensen 2001, §7.1, eq. 7.9's filter, whose integral over the disc that factor makes 1).
+//! (Jensen 2001, §7.1's cone filter, whose integral over the disc that factor makes 1).
 //! Discs are found through hash grids, one per power of two of the radius, each with cells
 //! twice its largest radius, so a query visits at most eight cells of each.
 
 use glam::Vec3;
 
-use super::estimate::{Estimate, Kernel, MIN_RADIUS_FRACTION, landing_cosine};
 use crate::spatial::{HasPosition, HashGrid, KdTree, Photon};
 
 /// Most radius levels (the last also holds every smaller disc): radii down to 2⁻⁹ of the
 /// largest get cells fitted to them.
 const MAX_LEVELS: usize = 10;
 
-/// One photon with its disc, decoded once (no octahedral or RGBE decoding per estimate).
+/// One photon with its disc, decoded once (no octahedral or RGBE decoding per estimate): what
+/// [`PhotonDiscs::covering`] shows of each disc that covers the query.
 #[derive(Debug, Clone, Copy)]
-struct Disc {
+pub struct Disc {
     position: [f32; 3],
     /// Unit direction back towards where the photon came from (−its direction of travel).
-    wi: Vec3,
+    pub wi: Vec3,
     /// Unit geometric normal where it landed.
-    normal: Vec3,
+    pub normal: Vec3,
     /// Power per channel (W).
-    power: Vec3,
+    pub power: Vec3,
     /// The disc's radius (scene units).
-    radius: f32,
+    pub radius: f32,
     /// True when the largest radius cut the photon's k-nearest search short.
-    capped: bool,
+    pub capped: bool,
+}
+
+/// How the discs covered a query ([`PhotonDiscs::covering`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Coverage {
+    /// Discs that cover the query.
+    pub found: usize,
+    /// The largest of their radii (scene units; 0 when none).
+    pub reach: f32,
+    /// True when one of them was capped by the largest radius.
+    pub capped: bool,
 }
 
 impl HasPosition for Disc {
@@ -60,7 +71,7 @@ impl HasPosition for Disc {
 }
 
 /// A map's photons as discs of their own radii ([`PhotonDiscs::build`]), for the sample-point
-/// estimate ([`PhotonDiscs::gather`]).
+/// estimate ([`PhotonDiscs::covering`]).
 #[derive(Debug)]
 pub struct PhotonDiscs {
     /// Level `j` holds the discs of radius in (R/2^(j+1), R/2^j] (the last level every smaller
@@ -72,7 +83,7 @@ pub struct PhotonDiscs {
 
 impl PhotonDiscs {
     /// The discs of a map's photons (`tree`), each of radius `radius_of(its position)` (the
-    /// radius and whether the largest radius capped it: [`disc_radius`]). `None` when there is
+    /// radius and whether the largest radius capped it). `None` when there is
     /// no photon or no radius is a positive finite number. Deterministic for any thread count.
     #[must_use]
     pub fn build(
@@ -126,47 +137,34 @@ impl PhotonDiscs {
             .sum()
     }
 
-    /// The sample-point estimate at `p` (surface normal `ng`): the sum over the discs covering
-    /// `p` of `value(photon's power, ωₚ, cos θₚ) · w(d, h)/(π h² c)`, over the photons that pass
-    /// the side tests (`estimate::accept`'s). The estimate's `radius` is the largest disc that
-    /// covers `p` (how far away light read here may have landed); `cut` says that one of
-    /// them was capped by the largest radius, or that none covers `p`.
+    /// The largest disc radius (scene units).
+    #[must_use]
+    pub fn largest(&self) -> f32 {
+        self.largest
+    }
+
+    /// Calls `visit(disc, d²)` for every disc that covers `p` (its centre closer than its
+    /// radius, `d² < h²`), in an order that depends only on the discs and `p`; the sample-point
+    /// estimate sums their kernels (`PhotonMap`'s gather, which applies the side tests).
     #[inline]
-    pub fn gather(
-        &self,
-        p: Vec3,
-        ng: Vec3,
-        kernel: Kernel,
-        value: impl Fn(Vec3, Vec3, f32) -> Vec3,
-    ) -> Estimate {
+    pub fn covering(&self, p: Vec3, mut visit: impl FnMut(&Disc, f32)) -> Coverage {
         let q = p.to_array();
-        let c = std::f32::consts::PI * kernel.normalisation();
-        let mut sum = Vec3::ZERO;
-        let (mut found, mut reach, mut cut) = (0, 0.0f32, false);
+        let mut cover = Coverage::default();
         for (j, grid) in self.levels.iter().enumerate() {
             let Some(grid) = grid else { continue };
             let discs = grid.items();
             grid.within(q, level_radius(j, self.largest), |n| {
                 let d = &discs[n.index as usize];
-                let h = d.radius;
-                if n.dist2 >= h * h {
+                if n.dist2 >= d.radius * d.radius {
                     return;
                 }
-                found += 1;
-                reach = reach.max(h);
-                cut |= d.capped;
-                if let Some(cos_p) = landing_cosine(d.normal, d.wi, ng) {
-                    let w = kernel.weight(n.dist2.sqrt(), h) / (c * h * h);
-                    sum += value(d.power, d.wi, cos_p) * w;
-                }
+                cover.found += 1;
+                cover.reach = cover.reach.max(d.radius);
+                cover.capped |= d.capped;
+                visit(d, n.dist2);
             });
         }
-        Estimate {
-            radiance: sum,
-            found,
-            radius: if found > 0 { reach } else { self.largest },
-            cut: cut || found == 0,
-        }
+        cover
     }
 }
 
@@ -187,21 +185,10 @@ fn level_radius(j: usize, largest: f32) -> f32 {
     largest / (1u32 << j) as f32
 }
 
-/// A disc radius for a photon at `p` of a map whose k-nearest radius there is `knn` (`None`
-/// when the largest radius cut the search short): the radius and whether it was capped.
-#[must_use]
-pub fn disc_radius(knn: Option<f32>, max_radius: f32) -> (f32, bool) {
-    match knn {
-        Some(r) if r > 0.0 => (r, false),
-        Some(_) => (max_radius * MIN_RADIUS_FRACTION, false),
-        None => (max_radius, true),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrators::photon::PhotonMap;
+    use crate::integrators::photon::{Kernel, PhotonMap};
     use crate::sampling::{Rng, Sampler};
     use crate::settings::SamplerKind;
 

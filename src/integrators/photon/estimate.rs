@@ -47,7 +47,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use super::discs::{PhotonDiscs, disc_radius};
+use super::discs::PhotonDiscs;
 use super::radius_field::RadiusField;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 use crate::spatial::{HasPosition, HashGrid, KdTree, KnnHeap, Photon};
@@ -72,7 +72,7 @@ pub enum Kernel {
 impl Kernel {
     /// Weight of a photon at distance `d` in a disc of radius `r`.
     #[inline]
-    pub(super) fn weight(self, d: f32, r: f32) -> f32 {
+    fn weight(self, d: f32, r: f32) -> f32 {
         match self {
             Kernel::Box => 1.0,
             Kernel::Cone(k) => (1.0 - d / (k * r)).max(0.0),
@@ -82,7 +82,7 @@ impl Kernel {
     /// ∫ weight over the disc divided by its area πr² (Jensen 2001, §7.1: the cone filter's
     /// `1 − 2/(3k)`).
     #[inline]
-    pub(super) fn normalisation(self) -> f32 {
+    fn normalisation(self) -> f32 {
         match self {
             Kernel::Box => 1.0,
             Kernel::Cone(k) => 1.0 - 2.0 / (3.0 * k),
@@ -361,7 +361,7 @@ impl PhotonMap {
             return self.gather_within(pass, p, ng, value);
         }
         if let Some(discs) = &self.discs {
-            return discs.gather(p, ng, self.kernel, value);
+            return self.gather_discs(discs, p, ng, value);
         }
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
@@ -413,6 +413,40 @@ impl PhotonMap {
 }
 
 impl PhotonMap {
+    /// The sample-point estimate at `p` (surface normal `ng`, [`super::discs`]): over the discs
+    /// covering `p` whose photons pass the side tests ([`accept`]'s), the sum of
+    /// `value(power, ωₚ, cos θₚ) · w(d, h)/(π h² c)`, each with its own radius `h` (Jensen 2001,
+    /// §7.1's cone filter normalised over its disc: `c = 1 − 2/(3k)`). Its `radius` is the
+    /// largest disc covering `p` (how far away light read here may have landed); `cut` says one
+    /// of them was capped by the largest radius, or none covers `p`.
+    #[inline]
+    fn gather_discs(
+        &self,
+        discs: &PhotonDiscs,
+        p: Vec3,
+        ng: Vec3,
+        value: impl Fn(Vec3, Vec3, f32) -> Vec3,
+    ) -> Estimate {
+        let c = std::f32::consts::PI * self.kernel.normalisation();
+        let mut sum = Vec3::ZERO;
+        let cover = discs.covering(p, |d, dist2| {
+            if let Some(cos_p) = landing_cosine(d.normal, d.wi, ng) {
+                let w = self.kernel.weight(dist2.sqrt(), d.radius) / (c * d.radius * d.radius);
+                sum += value(d.power, d.wi, cos_p) * w;
+            }
+        });
+        Estimate {
+            radiance: sum,
+            found: cover.found,
+            radius: if cover.found > 0 {
+                cover.reach
+            } else {
+                discs.largest()
+            },
+            cut: cover.capped || cover.found == 0,
+        }
+    }
+
     /// A progressive pass's estimate at `p`: every accepted photon within `r = shrink · R(p)`,
     /// kernel-weighted, over the disc's normalised area `π r² c`.
     #[inline]
@@ -455,6 +489,17 @@ impl PhotonMap {
     }
 }
 
+/// A photon's disc radius from its k-nearest radius `knn` (`None` when the largest radius
+/// `max_radius` cut the search short): the radius and whether it was capped. A radius of 0 (k
+/// coincident photons) is raised to [`MIN_RADIUS_FRACTION`] of the largest radius.
+fn disc_radius(knn: Option<f32>, max_radius: f32) -> (f32, bool) {
+    match knn {
+        Some(r) if r > 0.0 => (r, false),
+        Some(_) => (max_radius * MIN_RADIUS_FRACTION, false),
+        None => (max_radius, true),
+    }
+}
+
 /// The side tests of an estimate at a point of geometric normal `ng`: the photon's incoming
 /// direction `ωₚ` and its landing cosine `cos θₚ = ωₚ·nₚ` with its own stored geometric normal
 /// (at least [`MIN_LANDING_COSINE`]), or `None` when it landed on another surface (stored
@@ -469,7 +514,7 @@ fn accept(ph: &Photon, ng: Vec3) -> Option<(Vec3, f32)> {
 /// [`accept`]'s tests on a decoded photon (stored normal `np`, incoming direction `wi`): its
 /// landing cosine, or `None` when it landed on another surface or arrived from the other side.
 #[inline]
-pub(super) fn landing_cosine(np: Vec3, wi: Vec3, ng: Vec3) -> Option<f32> {
+fn landing_cosine(np: Vec3, wi: Vec3, ng: Vec3) -> Option<f32> {
     (!(np.dot(ng) <= 0.1) && wi.dot(ng) > 0.0).then(|| wi.dot(np).max(MIN_LANDING_COSINE))
 }
 
