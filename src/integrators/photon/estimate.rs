@@ -1,6 +1,13 @@
 //! The radiance estimate from a photon map (Jensen 2001, §7.1): the `k` nearest photons within
 //! the map's largest radius, each weighted by the BSDF, over the area of their disc.
 //!
+//! The photon integrator's maps read another estimate with the same kernels and side tests:
+//! each photon's flux over a disc of its *own* k-nearest radius ([`super::discs`], after
+//! [`PhotonMap::use_photon_discs`]), which keeps a caustic's flux where this k-nearest estimate
+//! around the query reads the dark gaps between bright bands too bright (+4 % on the bath's tub
+//! floor). The k-nearest estimate below remains the progressive passes' (with a shrink) and
+//! gives the radii of both.
+//!
 //! `L(x, ωo) ≈ Σₚ w(dₚ) f(ωo, ωₚ) Φₚ · |ns·ωₚ|/|nₚ·ωₚ| / (π r² c)` where
 //! - `r` is the distance of the k-th nearest photon, which itself is left out of the sum: the
 //!   k − 1 photons strictly inside the disc make the estimate unbiased for a uniform density
@@ -40,6 +47,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
+use super::discs::PhotonDiscs;
 use super::radius_field::RadiusField;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 use crate::spatial::{HasPosition, HashGrid, KdTree, KnnHeap, Photon};
@@ -71,7 +79,8 @@ impl Kernel {
         }
     }
 
-    /// ∫ weight over the disc divided by its area πr².
+    /// ∫ weight over the disc divided by its area πr² (Jensen 2001, §7.1: the cone filter's
+    /// `1 − 2/(3k)`).
     #[inline]
     fn normalisation(self) -> f32 {
         match self {
@@ -94,6 +103,9 @@ pub struct PhotonMap {
     /// Progressive passes: the fixed per-pass lookup (`R(x)` from a pilot map and the pass's
     /// photons in a hash grid) that replaces the k-nearest search.
     pass: Option<PassLookup>,
+    /// The photon integrator's maps: each photon's own disc ([`PhotonMap::use_photon_discs`]),
+    /// read by the sample-point estimate instead of the k-nearest one.
+    discs: Option<PhotonDiscs>,
 }
 
 /// A progressive pass's lookup ([`PhotonMap::set_pass_lookup`]): estimates read the photons
@@ -148,11 +160,13 @@ const MAX_GRID_LEVELS: usize = 10;
 pub struct Estimate {
     /// Reflected radiance (W·m⁻²·sr⁻¹ per channel).
     pub radiance: Vec3,
-    /// Photons found by the k-nearest search.
+    /// Photons found by the k-nearest search (with photon discs: the discs covering the point).
     pub found: usize,
-    /// Radius of the disc used (scene units).
+    /// Radius of the disc used (scene units; with photon discs: the largest disc covering the
+    /// point, how far from it the light read may have landed).
     pub radius: f32,
-    /// True when the largest radius cut the search short (fewer than k photons found).
+    /// True when the largest radius cut the search short (fewer than k photons found; with
+    /// photon discs: a disc covering the point was capped by it, or none covers it).
     pub cut: bool,
 }
 
@@ -172,7 +186,32 @@ impl PhotonMap {
             kernel,
             shrink: 1.0,
             pass: None,
+            discs: None,
         }
+    }
+
+    /// Makes every later estimate (outside progressive passes) the sample-point estimate of
+    /// [`super::discs`]: each photon's flux spread over a disc of its own k-nearest radius
+    /// (capped at the largest radius), which keeps the flux of every region, where the
+    /// k-nearest estimate around the query reads dark gaps between bright caustic bands too
+    /// bright (+4 % on the bath's tub floor). Costs one k-nearest search per photon, once.
+    pub fn use_photon_discs(&mut self) {
+        let max_radius = self.max_radius;
+        self.discs = PhotonDiscs::build(&self.tree, |p| {
+            disc_radius(self.knn_radius_found(p), max_radius)
+        });
+    }
+
+    /// The distance of the k-th nearest photon to `p` (`p`'s own photon included), or `None`
+    /// when fewer than k lie within the largest radius.
+    fn knn_radius_found(&self, p: Vec3) -> Option<f32> {
+        HEAP.with(|h| {
+            let mut heap = h.borrow_mut();
+            heap.set_k(self.k);
+            let max2 = self.max_radius * self.max_radius;
+            let found = self.tree.nearest(p.to_array(), max2, &mut heap);
+            (found >= self.k).then(|| heap.max_dist2().unwrap_or(max2).sqrt())
+        })
     }
 
     /// Makes every later estimate a progressive pass's fixed-radius one: the photons within
@@ -293,7 +332,7 @@ impl PhotonMap {
     /// Bytes the map holds.
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
-        self.tree.memory_bytes()
+        self.tree.memory_bytes() + self.discs.as_ref().map_or(0, PhotonDiscs::memory_bytes)
     }
 
     /// Radiance leaving `p` towards `wo` through the non-delta part of `bsdf` in frame `fr` (as
@@ -320,6 +359,9 @@ impl PhotonMap {
     fn gather(&self, p: Vec3, ng: Vec3, value: impl Fn(Vec3, Vec3, f32) -> Vec3) -> Estimate {
         if let Some(pass) = &self.pass {
             return self.gather_within(pass, p, ng, value);
+        }
+        if let Some(discs) = &self.discs {
+            return self.gather_discs(discs, p, ng, value);
         }
         HEAP.with(|h| {
             let mut heap = h.borrow_mut();
@@ -371,6 +413,40 @@ impl PhotonMap {
 }
 
 impl PhotonMap {
+    /// The sample-point estimate at `p` (surface normal `ng`, [`super::discs`]): over the discs
+    /// covering `p` whose photons pass the side tests ([`accept`]'s), the sum of
+    /// `value(power, ωₚ, cos θₚ) · w(d, h)/(π h² c)`, each with its own radius `h` (Jensen 2001,
+    /// §7.1's cone filter normalised over its disc: `c = 1 − 2/(3k)`). Its `radius` is the
+    /// largest disc covering `p` (how far away light read here may have landed); `cut` says one
+    /// of them was capped by the largest radius, or none covers `p`.
+    #[inline]
+    fn gather_discs(
+        &self,
+        discs: &PhotonDiscs,
+        p: Vec3,
+        ng: Vec3,
+        value: impl Fn(Vec3, Vec3, f32) -> Vec3,
+    ) -> Estimate {
+        let c = std::f32::consts::PI * self.kernel.normalisation();
+        let mut sum = Vec3::ZERO;
+        let cover = discs.covering(p, |d, dist2| {
+            if let Some(cos_p) = landing_cosine(d.normal, d.wi, ng) {
+                let w = self.kernel.weight(dist2.sqrt(), d.radius) / (c * d.radius * d.radius);
+                sum += value(d.power, d.wi, cos_p) * w;
+            }
+        });
+        Estimate {
+            radiance: sum,
+            found: cover.found,
+            radius: if cover.found > 0 {
+                cover.reach
+            } else {
+                discs.largest()
+            },
+            cut: cover.capped || cover.found == 0,
+        }
+    }
+
     /// A progressive pass's estimate at `p`: every accepted photon within `r = shrink · R(p)`,
     /// kernel-weighted, over the disc's normalised area `π r² c`.
     #[inline]
@@ -410,6 +486,17 @@ impl PhotonMap {
             radius: r,
             cut: false,
         }
+    }
+}
+
+/// A photon's disc radius from its k-nearest radius `knn` (`None` when the largest radius
+/// `max_radius` cut the search short): the radius and whether it was capped. A radius of 0 (k
+/// coincident photons) is raised to [`MIN_RADIUS_FRACTION`] of the largest radius.
+fn disc_radius(knn: Option<f32>, max_radius: f32) -> (f32, bool) {
+    match knn {
+        Some(r) if r > 0.0 => (r, false),
+        Some(_) => (max_radius * MIN_RADIUS_FRACTION, false),
+        None => (max_radius, true),
     }
 }
 
