@@ -61,7 +61,7 @@ pub fn upsample(coarse: &[f32], w: usize, h: usize) -> Vec<f32> {
     // weight of the second.
     let taps = |i: usize, n: usize| {
         let c = i / 2;
-        if i % 2 == 0 {
+        if i.is_multiple_of(2) {
             (c.saturating_sub(1), c, 0.75)
         } else {
             (c, (c + 1).min(n - 1), 0.25)
