@@ -2,6 +2,7 @@
 //! E = π L sin²θ (θ its half-angle), the area, the power, and the densities' normalisation.
 
 use super::*;
+use std::f32::consts::PI;
 use crate::sampling::Rng;
 use crate::sampling::warp::uniform_sphere;
 use glam::DQuat;

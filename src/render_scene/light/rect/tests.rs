@@ -1,6 +1,7 @@
 //! The rectangle light against Lambert's polygon formula and its own densities (χ²).
 
 use super::*;
+use std::f32::consts::PI;
 use crate::render_scene::light::test_support::{
     cap_around, lambert_polygon_irradiance, local, stratified,
 };

@@ -2,6 +2,7 @@
 //! formula, and its own densities (χ²).
 
 use super::*;
+use std::f32::consts::PI;
 use crate::render_scene::light::test_support::{
     cap_around, lambert_polygon_irradiance, local, stratified,
 };
