@@ -42,7 +42,7 @@ pub fn downsample(plane: &[f32], w: usize, h: usize, variance: bool) -> Vec<f32>
                     .zip(bottom.chunks_exact(2))
                     .map(|(t, b)| (0.0 + t[0] + t[1] + b[0] + b[1]) * scale),
             );
-            if w % 2 == 0 {
+            if w.is_multiple_of(2) {
                 continue;
             }
         }
