@@ -419,20 +419,17 @@ impl Row<'_> {
     /// Adds the row's weights `min(exp(−d_c·inv), e_f)` and weighted differences to `s`.
     #[inline]
     fn add_one(&self, inv: f32, s: Sums<'_>) {
-        let len = self.dc.len();
-        let (dc, ef) = (&self.dc[..len], &self.ef[..len]);
-        let [p0, p1, p2] = self.cp.map(|p| &p[..len]);
-        let [q0, q1, q2] = self.cq.map(|q| &q[..len]);
-        let w = &mut s.w[..len];
         let [a0, a1, a2] = s.a;
-        let (a0, a1, a2) = (&mut a0[..len], &mut a1[..len], &mut a2[..len]);
-        for i in 0..len {
-            let wt = exp_neg(dc[i] * inv).min(ef[i]);
-            w[i] += wt;
-            a0[i] += wt * (q0[i] - p0[i]);
-            a1[i] += wt * (q1[i] - p1[i]);
-            a2[i] += wt * (q2[i] - p2[i]);
-        }
+        let [p0, p1, p2] = self.cp;
+        let [q0, q1, q2] = self.cq;
+        add_one(
+            inv,
+            [self.dc, self.ef, p0, p1, p2, q0, q1, q2],
+            s.w,
+            a0,
+            a1,
+            a2,
+        );
     }
 
     /// [`Row::add_one`] for three candidates of `inv`, `4·inv` and `16·inv` at once (a
@@ -461,6 +458,33 @@ impl Row<'_> {
             a21,
             a22,
         );
+    }
+}
+
+/// [`Row::add_one`]'s loop, every written plane a parameter of its own (see [`add_three`]).
+#[inline]
+fn add_one(
+    inv: f32,
+    r: [&[f32]; 8],
+    w: &mut [f32],
+    a0: &mut [f32],
+    a1: &mut [f32],
+    a2: &mut [f32],
+) {
+    let len = r[0].len();
+    let [dc, ef, p0, p1, p2, q0, q1, q2] = r.map(|x| &x[..len]);
+    let (w, a0, a1, a2) = (
+        &mut w[..len],
+        &mut a0[..len],
+        &mut a1[..len],
+        &mut a2[..len],
+    );
+    for i in 0..len {
+        let wt = exp_neg(dc[i] * inv).min(ef[i]);
+        w[i] += wt;
+        a0[i] += wt * (q0[i] - p0[i]);
+        a1[i] += wt * (q1[i] - p1[i]);
+        a2[i] += wt * (q2[i] - p2[i]);
     }
 }
 
