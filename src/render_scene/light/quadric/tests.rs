@@ -2,10 +2,10 @@
 //! E = π L sin²θ (θ its half-angle), the area, the power, and the densities' normalisation.
 
 use super::*;
-use std::f32::consts::PI;
 use crate::sampling::Rng;
 use crate::sampling::warp::uniform_sphere;
 use glam::DQuat;
+use std::f32::consts::PI;
 
 /// A disc of radius `r` at height `h` above the origin, facing down (−y), radiance `l`.
 fn ceiling_disc(r: f64, h: f64, l: Vec3, two_sided: bool) -> QuadricLight {

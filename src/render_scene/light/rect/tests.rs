@@ -1,12 +1,12 @@
 //! The rectangle light against Lambert's polygon formula and its own densities (χ²).
 
 use super::*;
-use std::f32::consts::PI;
 use crate::render_scene::light::test_support::{
     cap_around, lambert_polygon_irradiance, local, stratified,
 };
 use crate::sampling::Rng;
 use crate::sampling::chi2::{SphereBins, chi2_test, pearson, sidak_alpha};
+use std::f32::consts::PI;
 
 /// A 2 × 1 rectangle in the plane y = 2, facing down, radiance (1, 2, 3).
 fn ceiling(two_sided: bool) -> RectLight {

@@ -2,12 +2,12 @@
 //! formula, and its own densities (χ²).
 
 use super::*;
-use std::f32::consts::PI;
 use crate::render_scene::light::test_support::{
     cap_around, lambert_polygon_irradiance, local, stratified,
 };
 use crate::sampling::Rng;
 use crate::sampling::chi2::{SphereBins, chi2_test, pearson, sidak_alpha};
+use std::f32::consts::PI;
 
 /// A fan of `n` triangles inscribed in the disc of radius `r` centred at (0, h, 0), facing −y.
 fn fan(n: usize, r: f32, h: f32) -> MeshLight {
