@@ -98,11 +98,12 @@ pub struct RenderArgs {
     /// Denoise the image (docs/denoise.md): a feature-guided filter that keeps caustics. The
     /// render is taken in two halves of its samples per pixel (at least 2) and albedo, normal
     /// and depth are traced beside it. A `.png` output is the denoised image; an `.exr` holds
-    /// the denoised image and the noisy one as the `noisy` layer. Not with `--time` (the
-    /// halves need the samples per pixel in advance) or a `.part` output. A `.png` of the whole
-    /// frame at a stated sample count is denoised by default (`--no-denoise` turns it off);
-    /// this flag asks for it everywhere else it can apply.
-    #[arg(long, conflicts_with_all = ["time", "shard", "no_denoise"])]
+    /// the denoised image and the noisy one as the `noisy` layer. Under `--time` or a target
+    /// error the first half ends at a pass end between a third and a half of the samples. Not
+    /// with `--adaptive`, `--shard`/`--samples` or a `.part` output. A `.png` of the whole frame
+    /// is denoised by default (`--no-denoise` turns it off); this flag asks for it in an EXR
+    /// too, and with `--compare`.
+    #[arg(long, conflicts_with_all = ["shard", "no_denoise"])]
     pub(super) denoise: bool,
     /// Write the raw estimate: no default denoising of a `.png` (docs/denoise.md). Golden
     /// checks, `--compare` (unless with `--denoise`) and the layers use the raw one anyway.
@@ -346,7 +347,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         _ if compare_keeps_raw => Some("--compare (it scores the raw estimate)"),
         _ => None,
     }
-    .map(|why| format!("not denoised: {why} (a PNG is denoised by default only for the whole frame at a stated --spp; docs/denoise.md)"));
+    .map(|why| {
+        format!("not denoised: {why} (docs/denoise.md says when a PNG is denoised by default)")
+    });
     let started = prepared.start(interrupt.start_rendering())?;
     if !args.quiet {
         // The scene and the command line named no integrator: which one, and why.
@@ -380,6 +383,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
                 "denoised in {:.2} s (the default for a PNG; --no-denoise writes the raw estimate)",
                 t.as_secs_f64()
             ),
+            RenderNote::NotDenoised(why) => eprintln!("warning: not denoised: {why}"),
             RenderNote::CheckpointKept(cp, e) => eprintln!(
                 "warning: cannot remove the checkpoint `{}`: {e}",
                 cp.display()

@@ -37,6 +37,10 @@ use crate::settings::IntegratorKind;
 /// samples per pixel are not stated (they then only cap it).
 pub const BUDGET_SPP_CAP: u32 = 1 << 20;
 
+/// The share of a `--time` budget a denoised render's passes take: the features and the
+/// denoiser follow them (on the bath at 800×600 and 8 spp they took 8 % and 9 % of the render).
+pub const DENOISED_PASS_SHARE: f64 = 0.9;
+
 /// [`RenderRequest::auto_denoise_refusal`]'s reason for an EXR or `.part` output, which stays
 /// the linear estimate by design (nothing to warn about).
 pub const NOT_8_BIT: &str = "the output is not an 8-bit image";
@@ -208,7 +212,7 @@ impl RenderRequest {
         let adaptive = prepared.scene.render.with_defaults().adaptive == Some(true);
         let spp = prepared.render_scene.params.samples_per_pixel;
         let auto_skipped = (self.auto_denoise && !self.denoise)
-            .then(|| self.auto_denoise_refusal(adaptive, target_error.is_some(), spp))
+            .then(|| self.auto_denoise_refusal(adaptive, spp))
             .flatten();
         let denoise = self.denoise || (self.auto_denoise && auto_skipped.is_none());
         if adaptive
@@ -236,25 +240,19 @@ impl RenderRequest {
     /// Why the default denoising ([`RenderRequest::auto_denoise`]) does not apply to this render,
     /// or `None` when it does: only an 8-bit image of the whole frame at a sample count known in
     /// advance is denoised by default. EXR and `.part` outputs stay the linear estimate (an EXR
-    /// holds both with `--denoise`); a crop keeps the full render's pixels; `--time`, a target
-    /// error and adaptive sampling do not know the samples per pixel in advance (the denoiser's
-    /// two halves need them); a sample range is one part of a render; light layers add up to the
-    /// raw image; checkpoints show the raw passes; fewer than 2 samples per pixel cannot be
-    /// split in halves. `spp` is the render's samples per pixel, `target_error` whether the
-    /// scene or the command line set one.
+    /// holds both with `--denoise`); a crop keeps the full render's pixels; adaptive sampling
+    /// gives its pixels different samples (the denoiser's two halves need the same split for
+    /// all); a sample range is one part of a render; light layers add up to the raw image;
+    /// checkpoints show the raw passes; fewer than 2 samples per pixel cannot be split in
+    /// halves (a render under `--time` or a target error is denoised when it reaches 2:
+    /// [`crate::render::passes::PassPlan::halves`]). `spp` is the render's samples per pixel
+    /// (the cap of an open-ended render).
     #[must_use]
-    pub fn auto_denoise_refusal(
-        &self,
-        adaptive: bool,
-        target_error: bool,
-        spp: u32,
-    ) -> Option<&'static str> {
+    pub fn auto_denoise_refusal(&self, adaptive: bool, spp: u32) -> Option<&'static str> {
         let png = matches!(OutputFormat::for_path(&self.output), Ok(OutputFormat::Png));
         [
             (!png, NOT_8_BIT),
             (self.region.is_some(), "--region"),
-            (self.time.is_some(), "--time"),
-            (target_error, "a target error"),
             (adaptive, "adaptive sampling"),
             (
                 self.shard.is_some() || self.samples.is_some(),
@@ -287,6 +285,12 @@ pub struct PreparedRender<'q> {
 }
 
 impl<'q> PreparedRender<'q> {
+    /// Whether a time budget or a target error decides when the render stops (its samples per
+    /// pixel are then not known in advance).
+    fn open_ended(&self) -> bool {
+        self.request.time.is_some() || self.target_error.is_some()
+    }
+
     /// Whether the image will be denoised: `--denoise`, or by default where the render allows it.
     #[must_use]
     pub fn denoises(&self) -> bool {
@@ -342,9 +346,11 @@ impl<'q> PreparedRender<'q> {
             light_paths: self.denoise || request.layers.iter().any(|l| matches!(l, Layer::Part(_))),
         };
         let taken = samples.clone().unwrap_or(0..spp);
-        // `--denoise`: the samples below `split` are the first half-buffer.
+        // `--denoise`: the samples below `split` are the first half-buffer. A render that a
+        // time budget or a target error stops keeps its first half at a pass end instead
+        // (`PassPlan::halves`), chosen when it stops.
         let split = taken.start + (taken.end - taken.start) / 2;
-        if self.denoise && split == taken.start {
+        if self.denoise && !self.open_ended() && split == taken.start {
             return Err(RenderRefusal::DenoiseTooFewSamples(taken.end - taken.start).into());
         }
         let job = match RenderJob::new(&prepared.render_scene, &options) {
@@ -392,6 +398,9 @@ pub enum RenderNote {
     FeaturesTraced(Duration),
     /// The image was denoised in this time.
     Denoised(Duration),
+    /// The image was not denoised after all: a time budget or target error stopped the render
+    /// before 2 samples per pixel (the text says so); the raw image is written.
+    NotDenoised(String),
     /// The checkpoint file could not be removed after the final image was written.
     CheckpointKept(PathBuf, std::io::Error),
 }
@@ -453,15 +462,24 @@ impl<'p> StartedRender<'p, '_> {
                 display: self.display,
                 auto_exposure: self.stated_exposure.is_none(),
             }),
-            time_budget: request.time,
+            // Denoised, the features and the denoiser come after the passes: they get the
+            // budget's last tenth (docs/denoise.md measures what they take).
+            time_budget: request.time.map(|t| {
+                if self.prepared.denoise {
+                    t.mul_f64(DENOISED_PASS_SHARE)
+                } else {
+                    t
+                }
+            }),
             progress: request.progress,
             target_error: self.prepared.target_error.map(f64::from),
             adaptive: self
                 .prepared
                 .adaptive
                 .then(|| AdaptivePlan::new(self.prepared.target_error.map(f64::from), spp)),
+            halves: self.prepared.denoise && self.prepared.open_ended(),
         };
-        let first_half = if self.prepared.denoise {
+        let first_half = if self.prepared.denoise && !plan.halves {
             match self.job.render_pass(split - taken.start) {
                 Err(RenderError::Cancelled) => {
                     return Err(
@@ -477,8 +495,30 @@ impl<'p> StartedRender<'p, '_> {
         } else {
             None
         };
-        let outcome = render_in_passes(self.job, &plan);
+        let mut outcome = render_in_passes(self.job, &plan);
         let saved = outcome.checkpoint_spp;
+        // An open-ended render (a time budget or a target error) took the samples that fitted:
+        // the features follow those, and its first half is the pass end the passes kept.
+        let (first_half, taken, split) = if self.prepared.open_ended() {
+            let reached = outcome
+                .result
+                .as_ref()
+                .map_or(0, |out| reached_spp(out) as u32);
+            let taken = taken.start..taken.start + reached;
+            match outcome.first_half.take() {
+                Some((n, half)) => (Some(half), taken.clone(), taken.start + n),
+                None => {
+                    if plan.halves && outcome.result.is_ok() {
+                        note(RenderNote::NotDenoised(format!(
+                            "the render stopped at {reached} sample per pixel; the denoiser compares two halves of at least 2"
+                        )));
+                    }
+                    (None, taken.clone(), taken.start + reached / 2)
+                }
+            }
+        } else {
+            (first_half, taken, split)
+        };
         let interrupted = || {
             let kept = match (&request.checkpoint, saved) {
                 (Some(cp), Some(n)) => format!(
@@ -501,7 +541,7 @@ impl<'p> StartedRender<'p, '_> {
         if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
             return Err(interrupted());
         }
-        let trace_features = self.prepared.denoise || request.layers.iter().any(|l| l.is_feature());
+        let trace_features = first_half.is_some() || request.layers.iter().any(|l| l.is_feature());
         let features = if trace_features {
             let started = Instant::now();
             let traced = Features::trace(

@@ -11,6 +11,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::adaptive::AdaptivePlan;
 use super::auto_exposure::resolve;
+use super::denoised::FirstHalf;
 use super::error_estimate::ErrorEstimate;
 use super::output::write_image;
 use super::tonemap::Display;
@@ -48,6 +49,12 @@ pub struct PassPlan<'a> {
     /// pixel needs more (or at the samples per pixel, the budget, or — with a target error —
     /// once both the image's and its worst 1 %'s estimates reach it).
     pub adaptive: Option<AdaptivePlan>,
+    /// Keep a first half of the samples for the denoiser when the render's length is not
+    /// known in advance (a time budget or a target error): passes end at the marks of
+    /// [`is_half_mark`], the sums are kept at each, and the outcome's
+    /// [`PassesOutcome::first_half`] is the one at the last mark at most half the samples
+    /// taken. Not with `adaptive` (ignored there: its pixels take different samples).
+    pub halves: bool,
 }
 
 /// The result of a render in passes.
@@ -60,6 +67,75 @@ pub struct PassesOutcome {
     /// With a target error: the estimate after the last pass, and whether it reached the
     /// target.
     pub error: Option<(ErrorEstimate, bool)>,
+    /// With [`PassPlan::halves`]: the samples per pixel of the first half (counted from the
+    /// job's first sample) and its sums; `None` when fewer than 2 samples were taken.
+    pub first_half: Option<(u32, FirstHalf)>,
+}
+
+/// Whether a pass may end at `n` samples with the sums kept for a denoiser's first half: `n`
+/// is a power of two or three times one (1, 2, 3, 4, 6, 8, 12, 16, …). Consecutive marks are
+/// at most 1.5× apart, so the last mark at most half of a render's `N` samples is at least
+/// `N/3`: the halves hold between a third and a half, and half and two thirds, of the samples.
+/// Marks thin out geometrically, so a render stops at only about `2 log₂ N` extra pass ends.
+#[must_use]
+pub fn is_half_mark(n: u32) -> bool {
+    n > 0 && (n.is_power_of_two() || (n.is_multiple_of(3) && (n / 3).is_power_of_two()))
+}
+
+/// The first mark of [`is_half_mark`] above `n` (saturating at `u32::MAX`).
+#[must_use]
+pub fn next_half_mark(n: u32) -> u32 {
+    // The least power of two above n, and the least 3·2^k above n (2^k > n/3).
+    let power = n.checked_add(1).and_then(u32::checked_next_power_of_two);
+    let triple = (n / 3 + 1)
+        .checked_next_power_of_two()
+        .and_then(|p| p.checked_mul(3));
+    match (power, triple) {
+        (Some(a), Some(b)) => a.min(b),
+        (Some(a), None) | (None, Some(a)) => a,
+        (None, None) => u32::MAX,
+    }
+}
+
+/// What is kept at the marks of [`is_half_mark`] while a render's length is not known (the
+/// sums, a [`FirstHalf`]): only what can still be the first half (the last mark at most half
+/// the samples so far, and every later one), so at most three.
+#[derive(Debug)]
+struct HalfMarks<T> {
+    kept: Vec<(u32, T)>,
+}
+
+impl<T> HalfMarks<T> {
+    fn new() -> Self {
+        Self { kept: Vec::new() }
+    }
+
+    /// Keeps `keep()` when `done` (samples since the first) is a mark, and drops what can no
+    /// longer be the first half.
+    fn after_pass(&mut self, done: u32, keep: impl FnOnce() -> T) {
+        if is_half_mark(done) {
+            self.kept.push((done, keep()));
+        }
+        if let Some(best) = self.best(done) {
+            self.kept.retain(|&(n, _)| n >= best);
+        }
+    }
+
+    /// The count of the last kept mark at most half of `done`.
+    fn best(&self, done: u32) -> Option<u32> {
+        self.kept
+            .iter()
+            .map(|&(n, _)| n)
+            .filter(|&n| n <= done / 2)
+            .max()
+    }
+
+    /// The first half for a render of `done` samples.
+    fn take(mut self, done: u32) -> Option<(u32, T)> {
+        let best = self.best(done)?;
+        let i = self.kept.iter().position(|&(n, _)| n == best)?;
+        Some(self.kept.swap_remove(i))
+    }
 }
 
 /// The shortest pass worth scheduling (a pass costs a sweep over the tiles).
@@ -83,10 +159,12 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
     let mut render_time = Duration::ZERO;
     let mut pass = 1;
     let mut error = None;
+    let mut marks = plan.halves.then(HalfMarks::new);
     let fail = |e, saved| PassesOutcome {
         result: Err(e),
         checkpoint_spp: saved,
         error: None,
+        first_half: None,
     };
     while job.samples_done() < spp {
         let t = Instant::now();
@@ -96,6 +174,12 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
         render_time += t.elapsed();
         let end = job.samples_done();
         let done = end - first;
+        if let Some(m) = &mut marks {
+            m.after_pass(done, || FirstHalf {
+                sums: job.sums().clone(),
+                parts: job.parts().map(<[_]>::to_vec),
+            });
+        }
         let estimate = plan.target_error.map(|target| {
             let e = ErrorEstimate::of_sums(job.sums());
             (e, e.reached(target))
@@ -141,14 +225,19 @@ pub fn render_in_passes(mut job: RenderJob<'_>, plan: &PassPlan<'_>) -> PassesOu
         if let (Some((e, _)), Some(goal)) = (estimate, plan.target_error) {
             pass = pass.min(samples_towards(e, goal, done));
         }
+        if marks.is_some() {
+            pass = pass.min(next_half_mark(done) - done);
+        }
     }
     if let Some(b) = bar {
         b.finish_and_clear();
     }
+    let done = job.samples_done() - first;
     PassesOutcome {
         result: Ok(job.into_output()),
         checkpoint_spp: saved,
         error,
+        first_half: marks.and_then(|m| m.take(done)),
     }
 }
 
@@ -205,6 +294,7 @@ fn adaptive_rounds(
                 result: Err(e),
                 checkpoint_spp: saved,
                 error: None,
+                first_half: None,
             };
         }
         render_time += t.elapsed();
@@ -250,6 +340,7 @@ fn adaptive_rounds(
         result: Ok(job.into_output()),
         checkpoint_spp: saved,
         error,
+        first_half: None,
     }
 }
 
@@ -283,4 +374,58 @@ fn budget_bar(plan: &PassPlan<'_>) -> Option<ProgressBar> {
         bar.set_style(style.progress_chars("=> "));
     }
     Some(bar)
+}
+
+#[cfg(test)]
+mod half_mark_tests {
+    use super::*;
+
+    #[test]
+    fn the_marks_are_the_powers_of_two_and_three_times_them() {
+        let marks: Vec<u32> = (0..=50).filter(|&n| is_half_mark(n)).collect();
+        assert_eq!(marks, [1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48]);
+        assert_eq!(next_half_mark(0), 1);
+        assert_eq!(next_half_mark(4), 6);
+        assert_eq!(next_half_mark(6), 8);
+        assert_eq!(next_half_mark(47), 48);
+        assert_eq!(next_half_mark(1 << 30), 3 << 29);
+        assert_eq!(next_half_mark(1 << 31), 3 << 30);
+        assert_eq!(next_half_mark(3 << 30), u32::MAX);
+        for n in 0..100_000 {
+            let next = (n + 1..).find(|&m| is_half_mark(m)).unwrap_or(u32::MAX);
+            assert_eq!(next_half_mark(n), next, "{n}");
+        }
+        assert_eq!(next_half_mark(u32::MAX), u32::MAX);
+    }
+
+    /// Passes end at every mark (as `render_in_passes` clips them) and at other counts too;
+    /// whatever the render's length `N ≥ 2`, the first half is the last mark at most `N/2`,
+    /// at least `N/3` (the bound of [`is_half_mark`]), and never more than three are kept.
+    #[test]
+    fn the_first_half_is_the_last_mark_at_most_half_and_at_least_a_third() {
+        for end in 1..3000u32 {
+            let mut marks = HalfMarks::new();
+            let mut done = 0;
+            while done < end {
+                // Passes of 1, 2, 3, … samples, clipped at the next mark and at the end.
+                let pass = (done % 7 + 1)
+                    .min(next_half_mark(done) - done)
+                    .min(end - done);
+                done += pass;
+                marks.after_pass(done, || done);
+                assert!(marks.kept.len() <= 3, "{end}: kept {:?}", marks.kept);
+                assert!(marks.kept.iter().all(|&(n, v)| n == v));
+            }
+            match marks.take(end) {
+                None => assert_eq!(end, 1),
+                Some((n, _)) => {
+                    assert!(
+                        is_half_mark(n) && 2 * n <= end && 3 * n >= end,
+                        "{end}: {n}"
+                    );
+                    assert!(!is_half_mark(next_half_mark(n)) || 2 * next_half_mark(n) > end);
+                }
+            }
+        }
+    }
 }
