@@ -46,6 +46,7 @@ mod queries;
 mod render_snapshots;
 mod reported;
 mod reported_photon;
+mod reported_thin_wall;
 mod reported_transport;
 mod rough_integrators;
 mod rough_textures;

@@ -17,6 +17,7 @@ use super::emit::{LightEmitter, split_by_power};
 use super::estimate::{IrradianceCache, Kernel, PhotonMap};
 use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon_into};
 use super::volume::{VolumeMap, VolumePhoton};
+use super::walls::Walls;
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
 use crate::sampling::rng::mix64;
@@ -530,6 +531,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
+            Walls::of(scene, None),
             photons,
             MapKind::Caustic,
             p.caustic_gather,
@@ -569,6 +571,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
+            Walls::of(scene, None),
             photons,
             MapKind::Global,
             p.gather,
@@ -628,7 +631,7 @@ pub(super) fn precompute_irradiance(
         global
             .as_ref()
             .or(caustic.as_ref())
-            .and_then(|sites| IrradianceCache::build(sites, &maps, cancel))
+            .and_then(|sites| IrradianceCache::build(sites, &maps, Walls::of(scene, None), cancel))
     } else {
         None
     };
@@ -641,6 +644,7 @@ pub(super) fn precompute_irradiance(
 /// Builds the kd-tree of one map's photons, or says why there is none.
 #[allow(clippy::too_many_arguments)]
 fn finish_map(
+    walls: Walls<'_>,
     photons: Vec<Photon>,
     kind: MapKind,
     k: u32,
@@ -665,10 +669,12 @@ fn finish_map(
             return None;
         }
     };
-    *build_time += t.elapsed();
     *memory += tree.memory_bytes();
     *radius = r;
-    Some(PhotonMap::new(tree, k as usize, r, kernel))
+    let mut map = PhotonMap::new(tree, k as usize, r, kernel);
+    map.mark_walls(walls);
+    *build_time += t.elapsed();
+    Some(map)
 }
 
 /// Mean of a flux's channels (W).
