@@ -49,7 +49,9 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::radius_field::RadiusField;
+use super::wall_list::WallList;
 use super::walls::{self, Walls};
+use crate::geometry::Aabb;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 use crate::spatial::{HasPosition, HashGrid, KdTree, KnnHeap, Photon};
 
@@ -176,8 +178,12 @@ pub struct Estimate {
     /// True when the largest radius cut the search short (fewer than k photons found).
     pub cut: bool,
     /// Wall-test rays traced ([`super::walls::separated`]): 0 unless an accepted photon is
-    /// marked near a wall or lies on a level above the query point.
+    /// marked near a wall or lies on a level above the query point, and the estimate's wall
+    /// list could not decide ([`super::wall_list`]).
     pub rays: u32,
+    /// Photons whose segment was tested against the estimate's wall list instead of by a ray
+    /// ([`super::wall_list::WallList::crosses`]).
+    pub listed: u32,
     /// Accepted photons a wall separates from the query point (left out).
     pub hidden: u32,
 }
@@ -185,6 +191,8 @@ pub struct Estimate {
 thread_local! {
     /// Each worker's k-nearest heap (reused; no allocation per estimate).
     static HEAP: RefCell<KnnHeap> = RefCell::new(KnnHeap::new(1));
+    /// Each worker's wall list (reused; taken by an estimate that needs one, then put back).
+    static WALL_LIST: RefCell<WallList> = RefCell::new(WallList::default());
 }
 
 impl PhotonMap {
@@ -457,20 +465,28 @@ impl PhotonMap {
             let r2 = r2 * self.shrink * self.shrink;
             let r = r2.sqrt();
             let photons = self.tree.items();
-            let mut sum = Vec3::ZERO;
             let mut sight = Sight::new(walls, p, ng, r);
-            for n in heap.iter() {
-                if Some(n.index) == skip || (self.shrink < 1.0 && n.dist2 >= r2) {
-                    continue;
+            let pass = |sight: &mut Sight<'_>| {
+                let mut sum = Vec3::ZERO;
+                for n in heap.iter() {
+                    if Some(n.index) == skip || (self.shrink < 1.0 && n.dist2 >= r2) {
+                        continue;
+                    }
+                    let ph = &photons[n.index as usize];
+                    let Some((wi, cos_g)) = accept(ph, ng) else {
+                        continue;
+                    };
+                    if sight.separated(ph.position(), ph.normal(), self.marked(n.index)) {
+                        continue;
+                    }
+                    sum += value(ph.power(), wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r);
                 }
-                let ph = &photons[n.index as usize];
-                let Some((wi, cos_g)) = accept(ph, ng) else {
-                    continue;
-                };
-                if sight.separated(ph.position(), ph.normal(), self.marked(n.index)) {
-                    continue;
-                }
-                sum += value(ph.power(), wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r);
+                sum
+            };
+            let mut sum = pass(&mut sight);
+            if sight.decide() {
+                sum = pass(&mut sight);
+                sight.finish();
             }
             let area = std::f32::consts::PI * r2 * self.kernel.normalisation();
             Estimate {
@@ -479,6 +495,7 @@ impl PhotonMap {
                 radius: r,
                 cut,
                 rays: sight.rays,
+                listed: sight.listed,
                 hidden: sight.hidden,
             }
         })
@@ -511,28 +528,38 @@ impl PhotonMap {
         // The finest grid whose cells are at least the disc's diameter (at most 8 cells to
         // visit); a disc wider than the widest grid's cells is found through the kd-tree. Both
         // find exactly the photons within r.
-        if let Some(grid) = pass.grids.iter().find(|g| g.cell_size() >= 2.0 * r) {
-            let photons = grid.items();
-            grid.within(
-                q,
-                r,
-                GridDisc {
-                    disc: &mut disc,
-                    photons,
-                    value: &value,
-                },
-            );
-        } else {
-            let photons = self.tree.items();
-            self.tree.within(q, r * r, |n| {
-                let ph = &photons[n.index as usize];
-                let clear = if self.marked(n.index) {
-                    0.0
-                } else {
-                    self.wall_radius
-                };
-                disc.add(&Landing::new(ph, clear), n.dist2, &value);
-            });
+        let grid = pass.grids.iter().find(|g| g.cell_size() >= 2.0 * r);
+        let search = |disc: &mut Disc<'_>| {
+            if let Some(grid) = grid {
+                let photons = grid.items();
+                grid.within(
+                    q,
+                    r,
+                    GridDisc {
+                        disc,
+                        photons,
+                        value: &value,
+                    },
+                );
+            } else {
+                let photons = self.tree.items();
+                self.tree.within(q, r * r, |n| {
+                    let ph = &photons[n.index as usize];
+                    let clear = if self.marked(n.index) {
+                        0.0
+                    } else {
+                        self.wall_radius
+                    };
+                    disc.add(&Landing::new(ph, clear), n.dist2, &value);
+                });
+            }
+        };
+        search(&mut disc);
+        if disc.sight.decide() {
+            disc.sum = Vec3::ZERO;
+            disc.found = 0;
+            search(&mut disc);
+            disc.sight.finish();
         }
         let Disc {
             sum, found, sight, ..
@@ -544,6 +571,7 @@ impl PhotonMap {
             radius: r,
             cut: false,
             rays: sight.rays,
+            listed: sight.listed,
             hidden: sight.hidden,
         }
     }
@@ -567,9 +595,11 @@ impl Disc<'_> {
     fn add(&mut self, ph: &Landing, dist2: f32, value: &impl Fn(Vec3, Vec3, f32) -> Vec3) {
         self.found += 1;
         if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, self.ng)
-            && !self
-                .sight
-                .separated(Vec3::from_array(ph.position), ph.normal, self.r > ph.clear)
+            && !self.sight.separated(
+                Vec3::from_array(ph.position),
+                ph.normal,
+                dist2 > ph.clear * ph.clear,
+            )
         {
             self.sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), self.r);
         }
@@ -594,6 +624,13 @@ impl<F: Fn(Vec3, Vec3, f32) -> Vec3> crate::spatial::Visit for GridDisc<'_, '_, 
 
 /// The wall test of one estimate at query point `q` (unit geometric normal `nq` on the side
 /// of `ωo`), counting the rays it traces and the photons it hides.
+///
+/// An estimate searches its disc once with the sight [probing](Stage::Probe): photons that need
+/// a test ([`walls::needs_ray`]) only grow the box of their segments. When none did, that
+/// search's sum is the estimate (no test, no ray). Otherwise [`Sight::decide`] gathers the
+/// potential walls in that box once ([`WallList::collect`]) and the disc is searched again in
+/// the same order, each tested photon decided against the list, or by a ray when the list
+/// cannot decide: the same sum, term for term, as testing each photon on the way.
 struct Sight<'g> {
     walls: Walls<'g>,
     q: Vec3,
@@ -602,8 +639,25 @@ struct Sight<'g> {
     /// `q`: an unmarked photon no higher than this above `q`'s side of its plane needs no ray
     /// (the first of [`walls::needs_ray`]'s tests, decided without the photon's own bound).
     tolerance_floor: f32,
+    stage: Stage,
+    /// The box of the segments that need a test (probing).
+    bounds: Aabb,
+    /// The estimate's wall list (taken from the worker's while deciding).
+    list: WallList,
     rays: u32,
+    listed: u32,
     hidden: u32,
+}
+
+/// What [`Sight::separated`] does with a photon that needs a test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    /// First search: grow the box of the segments, accept the photon for now.
+    Probe,
+    /// Second search: test its segment against the wall list.
+    List,
+    /// Second search, the list undecided: trace the segment ([`walls::separated`]).
+    Rays,
 }
 
 impl<'g> Sight<'g> {
@@ -615,33 +669,79 @@ impl<'g> Sight<'g> {
             q,
             nq,
             tolerance_floor: walls::tolerance_floor(q, r),
+            stage: Stage::Probe,
+            bounds: Aabb::EMPTY,
+            list: WallList::default(),
             rays: 0,
+            listed: 0,
             hidden: 0,
         }
     }
 
-    /// True when a wall separates the accepted photon at `p` (unit normal `np`, wall mark
-    /// `near_wall`) from the query point; a ray is traced only when
-    /// [`walls::needs_ray`] says one is needed.
+    /// True when a wall separates the accepted photon at `p` (unit normal `np`; `near_wall`:
+    /// its mark does not clear it at its distance) from the query point; while probing, false
+    /// (the photon's segment grows the box). Past the gate only when
+    /// [`walls::needs_ray`] says a test is needed.
     #[inline(always)]
     fn separated(&mut self, p: Vec3, np: Vec3, near_wall: bool) -> bool {
         (near_wall || (p - self.q).dot(np) > self.tolerance_floor) && self.traced(p, np, near_wall)
     }
 
     /// [`Sight::separated`] past its first test, out of line (most photons never get here):
-    /// [`walls::needs_ray`]'s exact tests, then the ray.
+    /// [`walls::needs_ray`]'s exact tests, then the stage's work.
     #[cold]
     #[inline(never)]
     fn traced(&mut self, p: Vec3, np: Vec3, near_wall: bool) -> bool {
         if !walls::needs_ray(self.q, self.nq, p, np, near_wall) {
             return false;
         }
-        self.rays += 1;
-        let hidden = walls::separated(&self.walls, self.q, self.nq, p, np);
+        let Some((a, b)) = walls::segment(self.q, self.nq, p, np) else {
+            return false;
+        };
+        let hidden = match self.stage {
+            Stage::Probe => {
+                self.bounds = self.bounds.grow(a).grow(b);
+                return false;
+            }
+            Stage::List => {
+                self.listed += 1;
+                self.list.crosses(a, b, np)
+            }
+            Stage::Rays => {
+                self.rays += 1;
+                walls::separated(&self.walls, self.q, self.nq, p, np)
+            }
+        };
         self.hidden += u32::from(hidden);
         hidden
     }
+
+    /// After the probing search: false when no photon needed a test (the search's sum
+    /// stands); else gathers the wall list for the box of the tested segments and readies the
+    /// second search (by list, or by rays when the list cannot decide). Call
+    /// [`Sight::finish`] after that search.
+    #[inline]
+    fn decide(&mut self) -> bool {
+        if self.bounds.is_empty() {
+            return false;
+        }
+        self.list = WALL_LIST.with(RefCell::take);
+        self.stage = if self.list.collect(&self.walls, self.nq, &self.bounds) {
+            Stage::List
+        } else {
+            Stage::Rays
+        };
+        true
+    }
+
+    /// Gives the wall list back to the worker (its storage is reused).
+    #[inline]
+    fn finish(&mut self) {
+        let list = std::mem::take(&mut self.list);
+        WALL_LIST.with(|w| *w.borrow_mut() = list);
+    }
 }
+
 
 /// The side tests of an estimate at a point of geometric normal `ng`: the photon's incoming
 /// direction `ωₚ` and its landing cosine `cos θₚ = ωₚ·nₚ` with its own stored geometric normal

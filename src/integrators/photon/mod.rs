@@ -24,6 +24,7 @@ pub mod passes;
 pub mod radius_field;
 pub mod trace;
 pub mod volume;
+pub mod wall_list;
 pub mod walls;
 
 pub use estimate::{Estimate, IrradianceCache, Kernel, PhotonMap};

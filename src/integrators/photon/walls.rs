@@ -105,6 +105,13 @@ impl<'a> Walls<'a> {
         !own && self.can_block_any(object)
     }
 
+    /// [`Walls::can_block`] for the wall list of one estimate
+    /// ([`super::wall_list::WallList`]).
+    #[inline]
+    pub(super) fn can_block_object(&self, object: u32) -> bool {
+        self.can_block(object)
+    }
+
     /// Whether a surface of object `object` can be a wall to some query point (opaque).
     #[inline]
     fn can_block_any(&self, object: u32) -> bool {
@@ -297,13 +304,9 @@ pub fn needs_ray(q: Vec3, nq: Vec3, p: Vec3, np: Vec3, near_wall: bool) -> bool 
 #[must_use]
 pub fn separated(walls: &Walls<'_>, q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> bool {
     let geometry = walls.geometry;
-    let tol = tolerance(p).max(tolerance(q));
-    let d = q.distance(p);
-    if !(d > tol) {
+    let Some((a, b)) = segment(q, nq, p, np) else {
         return false;
-    }
-    let lift = tol * (1.0 + 1.0 / nq.dot(np).max(0.1)) + 0.25 * d * nq.cross(np).length();
-    let (a, b) = (q + lift * nq, p + lift * np);
+    };
     let mut origin = a;
     for _ in 0..=MAX_CROSSINGS {
         let ray = Ray {
@@ -324,6 +327,23 @@ pub fn separated(walls: &Walls<'_>, q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> boo
         origin = offset_ray_origin(sp.p, sp.p_error, sp.ng, b - sp.p);
     }
     false
+}
+
+/// The lifted segment [`separated`] tests between the query point `q` (unit normal `nq`) and
+/// the photon at `p` (unit normal `np`): its ends `(a, b)`, each lifted off its own surface
+/// along its own normal by `τ (1 + 1/max(n_q·n_p, 0.1)) + d sin α / 4` (module docs); `None`
+/// when the two points are within the rounding tolerance of each other (nothing separates
+/// them).
+#[inline]
+#[must_use]
+pub fn segment(q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> Option<(Vec3, Vec3)> {
+    let tol = tolerance(p).max(tolerance(q));
+    let d = q.distance(p);
+    if !(d > tol) {
+        return None;
+    }
+    let lift = tol * (1.0 + 1.0 / nq.dot(np).max(0.1)) + 0.25 * d * nq.cross(np).length();
+    Some((q + lift * nq, p + lift * np))
 }
 
 /// Squared distance from `p` to box `b` (0 inside).
