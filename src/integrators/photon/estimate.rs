@@ -191,8 +191,9 @@ pub struct Estimate {
 thread_local! {
     /// Each worker's k-nearest heap (reused; no allocation per estimate).
     static HEAP: RefCell<KnnHeap> = RefCell::new(KnnHeap::new(1));
-    /// Each worker's wall list (reused; taken by an estimate that needs one, then put back).
-    static WALL_LIST: RefCell<WallList> = RefCell::new(WallList::default());
+    /// Each worker's wall list and kept terms (reused; taken by an estimate that tests
+    /// photons, then put back).
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
 impl PhotonMap {
@@ -465,29 +466,25 @@ impl PhotonMap {
             let r2 = r2 * self.shrink * self.shrink;
             let r = r2.sqrt();
             let photons = self.tree.items();
+            let mut sum = Vec3::ZERO;
             let mut sight = Sight::new(walls, p, ng, r);
-            let pass = |sight: &mut Sight<'_>| {
-                let mut sum = Vec3::ZERO;
-                for n in heap.iter() {
-                    if Some(n.index) == skip || (self.shrink < 1.0 && n.dist2 >= r2) {
-                        continue;
-                    }
-                    let ph = &photons[n.index as usize];
-                    let Some((wi, cos_g)) = accept(ph, ng) else {
-                        continue;
-                    };
-                    if sight.separated(ph.position(), ph.normal(), self.marked(n.index)) {
-                        continue;
-                    }
-                    sum += value(ph.power(), wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r);
+            for n in heap.iter() {
+                if Some(n.index) == skip || (self.shrink < 1.0 && n.dist2 >= r2) {
+                    continue;
                 }
-                sum
-            };
-            let mut sum = pass(&mut sight);
-            if sight.decide() {
-                sum = pass(&mut sight);
-                sight.finish();
+                let ph = &photons[n.index as usize];
+                let Some((wi, cos_g)) = accept(ph, ng) else {
+                    continue;
+                };
+                sight.add(
+                    &mut sum,
+                    ph.position(),
+                    ph.normal(),
+                    self.marked(n.index),
+                    || value(ph.power(), wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r),
+                );
             }
+            sight.resolve(&mut sum);
             let area = std::f32::consts::PI * r2 * self.kernel.normalisation();
             Estimate {
                 radiance: sum / area,
@@ -528,42 +525,36 @@ impl PhotonMap {
         // The finest grid whose cells are at least the disc's diameter (at most 8 cells to
         // visit); a disc wider than the widest grid's cells is found through the kd-tree. Both
         // find exactly the photons within r.
-        let grid = pass.grids.iter().find(|g| g.cell_size() >= 2.0 * r);
-        let search = |disc: &mut Disc<'_>| {
-            if let Some(grid) = grid {
-                let photons = grid.items();
-                grid.within(
-                    q,
-                    r,
-                    GridDisc {
-                        disc,
-                        photons,
-                        value: &value,
-                    },
-                );
-            } else {
-                let photons = self.tree.items();
-                self.tree.within(q, r * r, |n| {
-                    let ph = &photons[n.index as usize];
-                    let clear = if self.marked(n.index) {
-                        0.0
-                    } else {
-                        self.wall_radius
-                    };
-                    disc.add(&Landing::new(ph, clear), n.dist2, &value);
-                });
-            }
-        };
-        search(&mut disc);
-        if disc.sight.decide() {
-            disc.sum = Vec3::ZERO;
-            disc.found = 0;
-            search(&mut disc);
-            disc.sight.finish();
+        if let Some(grid) = pass.grids.iter().find(|g| g.cell_size() >= 2.0 * r) {
+            let photons = grid.items();
+            grid.within(
+                q,
+                r,
+                GridDisc {
+                    disc: &mut disc,
+                    photons,
+                    value: &value,
+                },
+            );
+        } else {
+            let photons = self.tree.items();
+            self.tree.within(q, r * r, |n| {
+                let ph = &photons[n.index as usize];
+                let clear = if self.marked(n.index) {
+                    0.0
+                } else {
+                    self.wall_radius
+                };
+                disc.add(&Landing::new(ph, clear), n.dist2, &value);
+            });
         }
         let Disc {
-            sum, found, sight, ..
+            mut sum,
+            found,
+            mut sight,
+            ..
         } = disc;
+        sight.resolve(&mut sum);
         let area = std::f32::consts::PI * r * r * self.kernel.normalisation();
         Estimate {
             radiance: if found > 0 { sum / area } else { Vec3::ZERO },
@@ -594,14 +585,15 @@ impl Disc<'_> {
     #[inline(always)]
     fn add(&mut self, ph: &Landing, dist2: f32, value: &impl Fn(Vec3, Vec3, f32) -> Vec3) {
         self.found += 1;
-        if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, self.ng)
-            && !self.sight.separated(
+        if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, self.ng) {
+            let (kernel, r) = (self.kernel, self.r);
+            self.sight.add(
+                &mut self.sum,
                 Vec3::from_array(ph.position),
                 ph.normal,
                 dist2 > ph.clear * ph.clear,
-            )
-        {
-            self.sum += value(ph.power, ph.wi, cos_g) * self.kernel.weight(dist2.sqrt(), self.r);
+                || value(ph.power, ph.wi, cos_g) * kernel.weight(dist2.sqrt(), r),
+            );
         }
     }
 }
@@ -625,12 +617,13 @@ impl<F: Fn(Vec3, Vec3, f32) -> Vec3> crate::spatial::Visit for GridDisc<'_, '_, 
 /// The wall test of one estimate at query point `q` (unit geometric normal `nq` on the side
 /// of `ωo`), counting the rays it traces and the photons it hides.
 ///
-/// An estimate searches its disc once with the sight [probing](Stage::Probe): photons that need
-/// a test ([`walls::needs_ray`]) only grow the box of their segments. When none did, that
-/// search's sum is the estimate (no test, no ray). Otherwise [`Sight::decide`] gathers the
-/// potential walls in that box once ([`WallList::collect`]) and the disc is searched again in
-/// the same order, each tested photon decided against the list, or by a ray when the list
-/// cannot decide: the same sum, term for term, as testing each photon on the way.
+/// Photons are summed as the search finds them until the first that needs a test
+/// ([`walls::needs_ray`]); from there on each accepted photon's term is kept, in order, with
+/// the photon when it needs a test, and the box of the tested segments grows. At the end
+/// ([`Sight::resolve`]) the potential walls in that box are gathered once
+/// ([`WallList::collect`]), each kept photon is decided against them (by a ray when the list
+/// cannot decide) and the terms of the photons no wall separates are added in the search's
+/// order: the same sum, bit for bit, as testing each photon on the way.
 struct Sight<'g> {
     walls: Walls<'g>,
     q: Vec3,
@@ -639,25 +632,35 @@ struct Sight<'g> {
     /// `q`: an unmarked photon no higher than this above `q`'s side of its plane needs no ray
     /// (the first of [`walls::needs_ray`]'s tests, decided without the photon's own bound).
     tolerance_floor: f32,
-    stage: Stage,
-    /// The box of the segments that need a test (probing).
+    /// Whether a photon needed a test (its term and the later ones are kept in `scratch`).
+    pending: bool,
+    /// The box of the segments that need a test.
     bounds: Aabb,
-    /// The estimate's wall list (taken from the worker's while deciding).
-    list: WallList,
+    /// The worker's wall list and kept terms, taken while pending.
+    scratch: Scratch,
     rays: u32,
     listed: u32,
     hidden: u32,
 }
 
-/// What [`Sight::separated`] does with a photon that needs a test.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Stage {
-    /// First search: grow the box of the segments, accept the photon for now.
-    Probe,
-    /// Second search: test its segment against the wall list.
-    List,
-    /// Second search, the list undecided: trace the segment ([`walls::separated`]).
-    Rays,
+/// A worker's reusable storage for estimates that test photons: the wall list and the terms
+/// kept after the first photon that needed a test (no allocation per estimate once grown).
+#[derive(Debug, Default)]
+struct Scratch {
+    list: WallList,
+    terms: Vec<Term>,
+}
+
+/// One accepted photon's term, kept until the estimate's walls are known.
+#[derive(Debug, Clone, Copy)]
+struct Term {
+    /// Its weighted contribution to the sum.
+    value: Vec3,
+    /// Its position and unit normal.
+    p: Vec3,
+    np: Vec3,
+    /// Whether a wall test decides it (else it counts).
+    tested: bool,
 }
 
 impl<'g> Sight<'g> {
@@ -669,79 +672,97 @@ impl<'g> Sight<'g> {
             q,
             nq,
             tolerance_floor: walls::tolerance_floor(q, r),
-            stage: Stage::Probe,
+            pending: false,
             bounds: Aabb::EMPTY,
-            list: WallList::default(),
+            scratch: Scratch::default(),
             rays: 0,
             listed: 0,
             hidden: 0,
         }
     }
 
-    /// True when a wall separates the accepted photon at `p` (unit normal `np`; `near_wall`:
-    /// its mark does not clear it at its distance) from the query point; while probing, false
-    /// (the photon's segment grows the box). Past the gate only when
-    /// [`walls::needs_ray`] says a test is needed.
+    /// Adds the accepted photon at `p` (unit normal `np`; `near_wall`: its mark does not clear
+    /// it at its distance) of term `term` to `sum`, or keeps it for [`Sight::resolve`] when it
+    /// or an earlier photon needs a wall test.
     #[inline(always)]
-    fn separated(&mut self, p: Vec3, np: Vec3, near_wall: bool) -> bool {
-        (near_wall || (p - self.q).dot(np) > self.tolerance_floor) && self.traced(p, np, near_wall)
+    fn add(
+        &mut self,
+        sum: &mut Vec3,
+        p: Vec3,
+        np: Vec3,
+        near_wall: bool,
+        term: impl FnOnce() -> Vec3,
+    ) {
+        let gate = near_wall || (p - self.q).dot(np) > self.tolerance_floor;
+        if !gate && !self.pending {
+            *sum += term();
+        } else {
+            self.keep(sum, p, np, gate && near_wall, gate, term());
+        }
     }
 
-    /// [`Sight::separated`] past its first test, out of line (most photons never get here):
-    /// [`walls::needs_ray`]'s exact tests, then the stage's work.
+    /// [`Sight::add`] past its first test, out of line (most photons never get here):
+    /// [`walls::needs_ray`]'s exact tests, then the photon kept (or added, when nothing is
+    /// pending and it needs no test).
     #[cold]
     #[inline(never)]
-    fn traced(&mut self, p: Vec3, np: Vec3, near_wall: bool) -> bool {
-        if !walls::needs_ray(self.q, self.nq, p, np, near_wall) {
-            return false;
-        }
-        let Some((a, b)) = walls::segment(self.q, self.nq, p, np) else {
-            return false;
-        };
-        let hidden = match self.stage {
-            Stage::Probe => {
-                self.bounds = self.bounds.grow(a).grow(b);
-                return false;
-            }
-            Stage::List => {
-                self.listed += 1;
-                self.list.crosses(a, b, np)
-            }
-            Stage::Rays => {
-                self.rays += 1;
-                walls::separated(&self.walls, self.q, self.nq, p, np)
-            }
-        };
-        self.hidden += u32::from(hidden);
-        hidden
-    }
-
-    /// After the probing search: false when no photon needed a test (the search's sum
-    /// stands); else gathers the wall list for the box of the tested segments and readies the
-    /// second search (by list, or by rays when the list cannot decide). Call
-    /// [`Sight::finish`] after that search.
-    #[inline]
-    fn decide(&mut self) -> bool {
-        if self.bounds.is_empty() {
-            return false;
-        }
-        self.list = WALL_LIST.with(RefCell::take);
-        self.stage = if self.list.collect(&self.walls, self.nq, &self.bounds) {
-            Stage::List
+    fn keep(&mut self, sum: &mut Vec3, p: Vec3, np: Vec3, near_wall: bool, gate: bool, value: Vec3) {
+        let segment = if gate && walls::needs_ray(self.q, self.nq, p, np, near_wall) {
+            walls::segment(self.q, self.nq, p, np)
         } else {
-            Stage::Rays
+            None
         };
-        true
+        if let Some((a, b)) = segment {
+            if !self.pending {
+                self.pending = true;
+                self.scratch = SCRATCH.with(RefCell::take);
+                self.scratch.terms.clear();
+            }
+            self.bounds = self.bounds.grow(a).grow(b);
+        } else if !self.pending {
+            *sum += value;
+            return;
+        }
+        self.scratch.terms.push(Term {
+            value,
+            p,
+            np,
+            tested: segment.is_some(),
+        });
     }
 
-    /// Gives the wall list back to the worker (its storage is reused).
-    #[inline]
-    fn finish(&mut self) {
-        let list = std::mem::take(&mut self.list);
-        WALL_LIST.with(|w| *w.borrow_mut() = list);
+    /// Adds the kept terms of the photons no wall separates from the query point to `sum`,
+    /// in order: the walls in the box of the tested segments are gathered once
+    /// ([`WallList::collect`]) and each tested photon is decided against them, or by a ray
+    /// ([`walls::separated`]) when the list cannot decide.
+    fn resolve(&mut self, sum: &mut Vec3) {
+        if !self.pending {
+            return;
+        }
+        let Scratch { list, terms } = &mut self.scratch;
+        let by_list = list.collect(&self.walls, self.nq, &self.bounds);
+        for t in terms.iter() {
+            if t.tested {
+                let hidden = if by_list {
+                    self.listed += 1;
+                    walls::segment(self.q, self.nq, t.p, t.np)
+                        .is_some_and(|(a, b)| list.crosses(a, b, t.np))
+                } else {
+                    self.rays += 1;
+                    walls::separated(&self.walls, self.q, self.nq, t.p, t.np)
+                };
+                if hidden {
+                    self.hidden += 1;
+                    continue;
+                }
+            }
+            *sum += t.value;
+        }
+        let scratch = std::mem::take(&mut self.scratch);
+        SCRATCH.with(|s| *s.borrow_mut() = scratch);
+        self.pending = false;
     }
 }
-
 
 /// The side tests of an estimate at a point of geometric normal `ng`: the photon's incoming
 /// direction `ωₚ` and its landing cosine `cos θₚ = ωₚ·nₚ` with its own stored geometric normal

@@ -40,6 +40,11 @@ use crate::render_scene::geometry::PrimKind;
 /// most ~40 beside a floor point.
 pub const MAX_LISTED: usize = 48;
 
+/// Most triangles the region query looks at (in leaves whose boxes meet the segments' box)
+/// before it gives up and lets the estimate trace rays: a box around a mesh's thousands of
+/// triangles would cost more than the rays.
+pub const MAX_EXAMINED: usize = 4 * MAX_LISTED;
+
 /// One triangle of a [`WallList`]: its corners, unit normal (as a hit on it reports it) and
 /// plane offset, and its bounds.
 #[derive(Debug, Clone, Copy)]
@@ -74,24 +79,30 @@ impl WallList {
         };
         let meets = |b: &Aabb| overlaps(b, &bounds);
         let listed = &mut self.listed;
+        let mut examined = 0;
         let stopped = geometry.bvh.any_leaf_in(meets, |first, count| {
+            examined += count as usize;
+            if examined > MAX_EXAMINED {
+                return true;
+            }
             for slot in first..first + count {
                 let Some(&prim) = geometry.slots.get(slot as usize) else {
                     return true;
                 };
-                let object = geometry.object_of(prim);
                 match prim.kind() {
                     PrimKind::Triangle => {
                         let Some(&corners) = geometry.triangles.get(prim.index()) else {
                             return true;
                         };
                         let [p0, p1, p2] = corners;
-                        let ng = (p1 - p0).cross(p2 - p0).normalize();
                         let tri_bounds = Aabb::from_points(&corners);
+                        if !overlaps(&tri_bounds, &bounds) {
+                            continue;
+                        }
+                        let ng = (p1 - p0).cross(p2 - p0).normalize();
                         // A degenerate triangle (NaN normal) is never hit.
                         if !(ng.dot(nq).abs() <= PARALLEL_COSINE)
-                            || !overlaps(&tri_bounds, &bounds)
-                            || !walls.can_block_object(object)
+                            || !walls.can_block_object(geometry.object_of(prim))
                         {
                             continue;
                         }
@@ -106,7 +117,7 @@ impl WallList {
                         });
                     }
                     PrimKind::Sphere | PrimKind::Ellipsoid | PrimKind::Quadric => {
-                        if walls.can_block_object(object) {
+                        if walls.can_block_object(geometry.object_of(prim)) {
                             return true;
                         }
                     }
