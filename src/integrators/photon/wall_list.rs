@@ -56,11 +56,19 @@ struct Listed {
 }
 
 /// The triangles that can be a wall to one estimate's segments (module docs). Reused by each
-/// worker (no allocation per estimate once it has grown).
+/// worker (no allocation per estimate once it has grown), and by the next estimate whose
+/// segments' box lies in the box it was collected for, with the same query normal and body.
 #[derive(Debug, Default)]
 pub struct WallList {
     listed: Vec<Listed>,
+    /// What the list holds: the walls' key ([`Walls::key`]), the query normal's bits and the
+    /// box collected; `None` when the list is not reusable.
+    covers: Option<((usize, usize, Option<u32>), [u32; 3], Aabb)>,
 }
+
+/// Each axis of a box is grown by this fraction of its length (and the rounding tolerance)
+/// when a list is collected, so the next estimates nearby reuse it.
+const GROWTH: f32 = 0.25;
 
 impl WallList {
     /// Fills the list with every triangle of `walls`' geometry that meets box `bounds` (grown
@@ -69,7 +77,45 @@ impl WallList {
     /// when the list cannot decide: more than [`MAX_LISTED`] such triangles, or a sphere,
     /// ellipsoid or quadric that can block within `bounds` (their crossings' normals depend on
     /// where they are crossed), or a tree deeper than the region query's stack.
+    ///
+    /// A list collected for a box holding `bounds` (grown by [`GROWTH`]) with the same query
+    /// normal and body is reused: it holds every triangle the exact box would, and a few more
+    /// that [`WallList::crosses`] rejects, so the decisions are the same; and when it could
+    /// decide, so could the exact box's (fewer triangles, the same leaves or fewer). Whether
+    /// an estimate's photons are decided by the list or by rays therefore depends on its own
+    /// segments only, not on the estimates before it.
     pub fn collect(&mut self, walls: &Walls<'_>, nq: Vec3, bounds: &Aabb) -> bool {
+        let key = walls.key();
+        let bits = nq.to_array().map(f32::to_bits);
+        if let Some((k, b, covered)) = &self.covers
+            && *k == key
+            && *b == bits
+            && covered.min.cmple(bounds.min).all()
+            && bounds.max.cmple(covered.max).all()
+        {
+            return true;
+        }
+        let tol = walls::tolerance(bounds.min.abs().max(bounds.max.abs()));
+        let grow = GROWTH * bounds.extent() + Vec3::splat(tol);
+        let grown = Aabb {
+            min: bounds.min - grow,
+            max: bounds.max + grow,
+        };
+        if self.fill(walls, nq, &grown) {
+            self.covers = Some((key, bits, grown));
+            return true;
+        }
+        self.covers = None;
+        let decides = self.fill(walls, nq, bounds);
+        if decides {
+            self.covers = Some((key, bits, *bounds));
+        }
+        decides
+    }
+
+    /// [`WallList::collect`] without reuse: the triangles in `bounds` grown by the rounding
+    /// tolerance.
+    fn fill(&mut self, walls: &Walls<'_>, nq: Vec3, bounds: &Aabb) -> bool {
         self.listed.clear();
         let geometry = walls.geometry();
         let tol = walls::tolerance(bounds.min.abs().max(bounds.max.abs()));

@@ -112,6 +112,22 @@ impl<'a> Walls<'a> {
         self.can_block(object)
     }
 
+    /// What [`Walls::can_block`] depends on, for the reuse of a wall list: the geometry's and
+    /// the scene's addresses and the query's body.
+    #[inline]
+    pub(super) fn key(&self) -> (usize, usize, Option<u32>) {
+        let body = match (self.object, self.scene) {
+            (Some(q), Some(s)) => Some(s.body_of(q)),
+            (q, None) => q,
+            (None, Some(_)) => None,
+        };
+        (
+            std::ptr::from_ref(self.geometry) as usize,
+            self.scene.map_or(0, |s| std::ptr::from_ref(s) as usize),
+            body,
+        )
+    }
+
     /// Whether a surface of object `object` can be a wall to some query point (opaque).
     #[inline]
     fn can_block_any(&self, object: u32) -> bool {
@@ -300,13 +316,33 @@ pub fn needs_ray(q: Vec3, nq: Vec3, p: Vec3, np: Vec3, near_wall: bool) -> bool 
 /// `ωo`) from the photon at `p` (unit geometric normal `np` on the side it arrived from): the
 /// lifted segment between them crosses an opaque surface of another object than the query's,
 /// standing across the receiver (module docs). Traces one closest-hit ray per surface crossed,
-/// at most `MAX_CROSSINGS` + 1.
+/// at most `MAX_CROSSINGS` + 1; in geometry of triangles only, one any-hit ray that counts
+/// only the triangles that are walls (the same answer, but where more than `MAX_CROSSINGS`
+/// parallel crossings come before the wall).
 #[must_use]
 pub fn separated(walls: &Walls<'_>, q: Vec3, nq: Vec3, p: Vec3, np: Vec3) -> bool {
     let geometry = walls.geometry;
     let Some((a, b)) = segment(q, nq, p, np) else {
         return false;
     };
+    if geometry.spheres.is_empty() && geometry.ellipsoids.is_empty() && geometry.quadrics.is_empty()
+    {
+        // Triangles only: a triangle's normal is the same all over it, so whether a crossing
+        // is a wall is known from the primitive: one any-hit query, no walk.
+        let ray = Ray {
+            origin: a,
+            dir: b - a,
+            t_max: 1.0,
+        };
+        return geometry.occluded_by(&ray, |prim| {
+            prim.kind() == PrimKind::Triangle
+                && geometry.triangles.get(prim.index()).is_some_and(|t| {
+                    let ng = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+                    ng.dot(nq).abs() <= PARALLEL_COSINE && ng.dot(np).abs() <= PARALLEL_COSINE
+                })
+                && walls.can_block(geometry.object_of(prim))
+        });
+    }
     let mut origin = a;
     for _ in 0..=MAX_CROSSINGS {
         let ray = Ray {
