@@ -706,7 +706,15 @@ impl<'g> Sight<'g> {
     /// pending and it needs no test).
     #[cold]
     #[inline(never)]
-    fn keep(&mut self, sum: &mut Vec3, p: Vec3, np: Vec3, near_wall: bool, gate: bool, value: Vec3) {
+    fn keep(
+        &mut self,
+        sum: &mut Vec3,
+        p: Vec3,
+        np: Vec3,
+        near_wall: bool,
+        gate: bool,
+        value: Vec3,
+    ) {
         let segment = if gate && walls::needs_ray(self.q, self.nq, p, np, near_wall) {
             walls::segment(self.q, self.nq, p, np)
         } else {

@@ -112,22 +112,6 @@ impl<'a> Walls<'a> {
         self.can_block(object)
     }
 
-    /// What [`Walls::can_block`] depends on, for the reuse of a wall list: the geometry's and
-    /// the scene's addresses and the query's body.
-    #[inline]
-    pub(super) fn key(&self) -> (usize, usize, Option<u32>) {
-        let body = match (self.object, self.scene) {
-            (Some(q), Some(s)) => Some(s.body_of(q)),
-            (q, None) => q,
-            (None, Some(_)) => None,
-        };
-        (
-            std::ptr::from_ref(self.geometry) as usize,
-            self.scene.map_or(0, |s| std::ptr::from_ref(s) as usize),
-            body,
-        )
-    }
-
     /// Whether a surface of object `object` can be a wall to some query point (opaque).
     #[inline]
     fn can_block_any(&self, object: u32) -> bool {
