@@ -191,8 +191,8 @@ pub struct Estimate {
 thread_local! {
     /// Each worker's k-nearest heap (reused; no allocation per estimate).
     static HEAP: RefCell<KnnHeap> = RefCell::new(KnnHeap::new(1));
-    /// Each worker's wall list and kept terms (reused; taken by an estimate that tests
-    /// photons, then put back).
+    /// Each worker's wall list and kept terms (reused; no allocation per estimate once grown),
+    /// borrowed by an estimate that tests photons.
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
@@ -548,13 +548,10 @@ impl PhotonMap {
                 disc.add(&Landing::new(ph, clear), n.dist2, &value);
             });
         }
+        disc.sight.resolve(&mut disc.sum);
         let Disc {
-            mut sum,
-            found,
-            mut sight,
-            ..
+            sum, found, sight, ..
         } = disc;
-        sight.resolve(&mut sum);
         let area = std::f32::consts::PI * r * r * self.kernel.normalisation();
         Estimate {
             radiance: if found > 0 { sum / area } else { Vec3::ZERO },
@@ -636,8 +633,6 @@ struct Sight<'g> {
     pending: bool,
     /// The box of the segments that need a test.
     bounds: Aabb,
-    /// The worker's wall list and kept terms, taken while pending.
-    scratch: Scratch,
     rays: u32,
     listed: u32,
     hidden: u32,
@@ -674,7 +669,6 @@ impl<'g> Sight<'g> {
             tolerance_floor: walls::tolerance_floor(q, r),
             pending: false,
             bounds: Aabb::EMPTY,
-            scratch: Scratch::default(),
             rays: 0,
             listed: 0,
             hidden: 0,
@@ -696,47 +690,50 @@ impl<'g> Sight<'g> {
         let gate = near_wall || (p - self.q).dot(np) > self.tolerance_floor;
         if !gate && !self.pending {
             *sum += term();
-        } else {
-            self.keep(sum, p, np, gate && near_wall, gate, term());
+        } else if let Some(value) = self.keep(p, np, near_wall, gate, term()) {
+            *sum += value;
         }
     }
 
     /// [`Sight::add`] past its first test, out of line (most photons never get here):
-    /// [`walls::needs_ray`]'s exact tests, then the photon kept (or added, when nothing is
-    /// pending and it needs no test).
+    /// [`walls::needs_ray`]'s exact tests, then the photon kept; or its term `value` returned
+    /// to be added at once, when nothing is pending and it needs no test (the sum stays out of
+    /// this function, in registers).
     #[cold]
     #[inline(never)]
     fn keep(
         &mut self,
-        sum: &mut Vec3,
         p: Vec3,
         np: Vec3,
         near_wall: bool,
         gate: bool,
         value: Vec3,
-    ) {
+    ) -> Option<Vec3> {
         let segment = if gate && walls::needs_ray(self.q, self.nq, p, np, near_wall) {
             walls::segment(self.q, self.nq, p, np)
         } else {
             None
         };
+        let first = !self.pending;
         if let Some((a, b)) = segment {
-            if !self.pending {
-                self.pending = true;
-                self.scratch = SCRATCH.with(RefCell::take);
-                self.scratch.terms.clear();
-            }
+            self.pending = true;
             self.bounds = self.bounds.grow(a).grow(b);
-        } else if !self.pending {
-            *sum += value;
-            return;
+        } else if first {
+            return Some(value);
         }
-        self.scratch.terms.push(Term {
-            value,
-            p,
-            np,
-            tested: segment.is_some(),
+        SCRATCH.with(|s| {
+            let terms = &mut s.borrow_mut().terms;
+            if first {
+                terms.clear();
+            }
+            terms.push(Term {
+                value,
+                p,
+                np,
+                tested: segment.is_some(),
+            });
         });
+        None
     }
 
     /// Adds the kept terms of the photons no wall separates from the query point to `sum`,
@@ -747,7 +744,13 @@ impl<'g> Sight<'g> {
         if !self.pending {
             return;
         }
-        let Scratch { list, terms } = &mut self.scratch;
+        SCRATCH.with(|s| self.resolve_with(&mut s.borrow_mut(), sum));
+        self.pending = false;
+    }
+
+    /// [`Sight::resolve`] with the worker's scratch.
+    fn resolve_with(&mut self, scratch: &mut Scratch, sum: &mut Vec3) {
+        let Scratch { list, terms } = scratch;
         let by_list = list.collect(&self.walls, self.nq, &self.bounds);
         for t in terms.iter() {
             if t.tested {
@@ -766,9 +769,6 @@ impl<'g> Sight<'g> {
             }
             *sum += t.value;
         }
-        let scratch = std::mem::take(&mut self.scratch);
-        SCRATCH.with(|s| *s.borrow_mut() = scratch);
-        self.pending = false;
     }
 }
 
