@@ -25,7 +25,8 @@
 //!   query's plane with its normal, where the tests above accept them (issue 47,
 //!   thin-wall-photon-leak: a dark room read up to 0.1). Photons are marked when their map is
 //!   built ([`PhotonMap::mark_walls`]) if a surface rises above their plane within reach; only
-//!   those (and photons on a level above the query) cost a ray, and a crossing counts as a
+//!   those (and photons on a level above the query) are tested, all of an estimate's against
+//!   one list of the walls in reach ([`super::wall_list`]) or by rays, and a crossing counts as a
 //!   wall only when the surface stands across the receiver, so contact regions, creases and
 //!   curved receivers read what they read without the test.
 //!
@@ -134,9 +135,9 @@ struct Landing {
     normal: Vec3,
     /// Power per channel (W).
     power: Vec3,
-    /// The largest estimate radius (scene units) for which the photon is known to have no
-    /// wall within reach ([`walls::near_wall`]): estimates of a larger radius test it by a ray.
-    /// 0 for a photon marked near a wall.
+    /// The radius (scene units) its wall mark was made for ([`walls::near_wall`] false): no
+    /// wall separates it from a query point within that distance, whatever the disc's radius;
+    /// farther query points test it. 0 for a photon marked near a wall.
     clear: f32,
 }
 

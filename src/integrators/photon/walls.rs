@@ -37,7 +37,12 @@
 //!   convex surfaces and in the open no photon is marked and an estimate costs one flag and a
 //!   few products per photon, no ray. A photon beside a wall, a corner or an object on the
 //!   floor, or a query point below the photon's plane by more than the curvature between them
-//!   explains (a step), costs one segment (a closest-hit ray per crossing).
+//!   explains (a step), costs one segment test. The argument holds for each query point within
+//!   distance `ρ` of the photon whatever the disc's radius (the ball's radius and the lift only
+//!   depend on that distance), so a mark made for radius `ρ` clears the photon for every query
+//!   point within `ρ` of it. An estimate tests all its segments against one list of the
+//!   potential walls in their box ([`super::wall_list`]), or, when that list cannot decide, by
+//!   rays ([`separated`]).
 //!
 //! What is not resolved: a partition in the same mesh as the floor is not a wall to the floor's
 //! points; a surface parallel to the receiver is never a wall, so photons on a
