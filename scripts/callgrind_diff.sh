@@ -6,7 +6,9 @@
 # one thread (valgrind runs it ~50x slower), e.g.
 #   scripts/callgrind_diff.sh OLD_BIN NEW_BIN render benches/scenes/cbox_caustic.ron \
 #       --integrator path --spp 16 --width 128 --height 128 --threads 1
-# (the output path is added). Needs valgrind (apt install valgrind).
+# (the output path is added). Needs valgrind (apt install valgrind). Function names need no debug
+# info; for per-line counts build with `cargo build --profile profiling` (line tables) and pass
+# target/profiling/caustic.
 set -euo pipefail
 a=$1 b=$2
 shift 2

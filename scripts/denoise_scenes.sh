@@ -17,8 +17,8 @@
 #   bath:  `--integrator ppm` (pure progressive photon mapping: another estimator than the
 #          default path-ppm under test), 1284 passes, seed 103, 200×150 (80 min on one thread;
 #          it agrees with path-ppm at 128 passes of 100 000 caustic photons within 1.3 % on the
-#          tub floor's caustic, where `--integrator photon` reads 4 % above both:
-#          docs/denoise.md);
+#          tub floor's caustic, where `--integrator photon` read 4 % above both before its maps took
+#          the sample-point estimate: docs/denoise.md);
 #   water: benches/scenes/user/glass_of_water.ron, default estimator, 1024 spp, seed 7, 128×96;
 #   pool:  benches/scenes/user/pool_noon.ron, default estimator, 1024 spp, seed 7, 128×96.
 # The caustic region is read from the 16×-spp render's caustic layer. Pictures (PNG, the

@@ -7,7 +7,9 @@
 //! `((Y_p − Y_q)² − (V_p + min(V_p, V_q))) / (ε + V_p + V_q)`, averaged over the channels and
 //! over a `(2f+1)²` patch; a feature's distance is the same form with a bandwidth σ in the
 //! denominator (albedo and normal; depth with σ relative to the depth plus the surface's own
-//! slope times |o|). The weight of candidate `k` is `exp(−max(d_colour / k², d_features))`
+//! slope times |o|), its variance subtracted only by the share
+//! [`DenoiseParams::feature_variance_cancel`] (by default none: a feature's variance is a
+//! pixel's coverage of several surfaces, and only widens the bandwidth). The weight of candidate `k` is `exp(−max(d_colour / k², d_features))`
 //! (Rousselle 2013 take the smaller of the colour and feature weights), and the filtered value
 //! `X_p + Σ w (X_q − X_p) / Σ w`: exactly `X_p` where every neighbour with weight agrees.
 
@@ -17,6 +19,7 @@ use super::DenoiseParams;
 use super::fast_exp::exp_neg;
 use super::input::{Guide, HalfBuffers};
 use super::planes::{box_filter, box_rows};
+use super::scales;
 
 /// Rows per work item: a fixed split (not by thread count), so any thread count gives the same
 /// bytes.
@@ -24,14 +27,12 @@ const BAND: usize = 16;
 /// Keeps the colour distance finite where both variances are zero (a noise-free pixel): any
 /// real difference then gives a distance far beyond the weights' range.
 const EPS: f32 = 1e-30;
-/// Number of candidate filters.
-pub const CANDIDATES: usize = 3;
 
 /// The candidate filters of one layer: their colour bandwidths, the window and patch radii.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Candidates {
     /// Colour bandwidth `k` of each candidate.
-    pub k: [f32; CANDIDATES],
+    pub k: Vec<f32>,
     /// Search window radius.
     pub radius: usize,
     /// Patch radius.
@@ -86,6 +87,21 @@ impl LayerPlanes {
             v: std::array::from_fn(|hf| half(&layer.variance[hf], 2).map(smooth)),
         }
     }
+
+    /// These planes (`w × h`) at half the size ([`scales::downsample`]: 2×2 means, and the
+    /// variances of those means), for the coarse candidates.
+    #[must_use]
+    pub fn downsampled(&self, w: usize, h: usize) -> Self {
+        let down = |planes: &[[Vec<f32>; 3]; 2], variance: bool| {
+            std::array::from_fn(|half| {
+                std::array::from_fn(|ch| scales::downsample(&planes[half][ch], w, h, variance))
+            })
+        };
+        Self {
+            c: down(&self.c, false),
+            v: down(&self.v, true),
+        }
+    }
 }
 
 /// The feature guide as planes, with the bandwidths folded in, and the demodulation factor.
@@ -104,6 +120,9 @@ pub struct GuidePlanes {
     sigma_albedo2: f32,
     sigma_normal2: f32,
     sigma_depth: f32,
+    /// Share of a feature's variance subtracted from its squared difference (1: Rousselle et
+    /// al. 2013's variance cancellation; 0: the variance only widens the bandwidth).
+    cancel: f32,
 }
 
 impl GuidePlanes {
@@ -151,6 +170,7 @@ impl GuidePlanes {
             sigma_albedo2: params.sigma_albedo * params.sigma_albedo,
             sigma_normal2: params.sigma_normal * params.sigma_normal,
             sigma_depth: params.sigma_depth,
+            cancel: params.feature_variance_cancel,
         }
     }
 
@@ -161,18 +181,41 @@ impl GuidePlanes {
     pub fn same_surface(&self, w: usize, h: usize, r: usize) -> SameSurface {
         let side = 2 * r + 1;
         let mut mask = vec![false; w * h * side * side];
-        let mut d = [0.0f32];
-        for i in 0..w * h {
-            let (x, y) = (i % w, i / w);
-            for yy in y.saturating_sub(r)..=(y + r).min(h - 1) {
-                for xx in x.saturating_sub(r)..=(x + r).min(w - 1) {
-                    let steps = (x.abs_diff(xx) + y.abs_diff(yy)) as f32;
-                    self.distances(i, yy * w + xx, steps, &mut d);
-                    mask[i * side * side + (yy + r - y) * side + (xx + r - x)] = d[0] <= 1.0;
+        let mut d = vec![0.0f32; w];
+        let r = r as isize;
+        // Offset by offset, a row at a time (the distances of a row's pixels in one call).
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let (x0, x1) = (
+                    (-dx).max(0) as usize,
+                    (w as isize - dx.max(0)).max(0) as usize,
+                );
+                if x1 <= x0 {
+                    continue;
+                }
+                let slot = ((dy + r) as usize) * side + (dx + r) as usize;
+                let steps = (dx.abs() + dy.abs()) as f32;
+                for y in 0..h {
+                    let qy = y as isize + dy;
+                    if qy < 0 || qy >= h as isize {
+                        continue;
+                    }
+                    let p_at = y * w + x0;
+                    let q_at = ((qy as usize * w + x0) as isize + dx) as usize;
+                    let d = &mut d[..x1 - x0];
+                    self.distances(p_at, q_at, steps, d);
+                    for (j, &dist) in d.iter().enumerate() {
+                        mask[(p_at + j) * side * side + slot] = dist <= 1.0;
+                    }
                 }
             }
         }
-        SameSurface { w, h, r, mask }
+        SameSurface {
+            w,
+            h,
+            r: r as usize,
+            mask,
+        }
     }
 
     /// The feature distances of the pixels from `p_at` on to those from `q_at` on, `steps`
@@ -189,7 +232,7 @@ impl GuidePlanes {
         {
             let s = self.sigma_depth * a.abs() + g * steps + 1e-6;
             let t = a - b;
-            *o = (t * t - (va + va.min(vb))).max(0.0) / (s * s + va + vb);
+            *o = (t * t - self.cancel * (va + va.min(vb))).max(0.0) / (s * s + va + vb);
         }
         let features = [
             (&self.albedo, &self.albedo_var, self.sigma_albedo2),
@@ -204,7 +247,7 @@ impl GuidePlanes {
                 let (t0, t1, t2) = (f0p[i] - f0q[i], f1p[i] - f1q[i], f2p[i] - f2q[i]);
                 let (va, vb) = (vp[i], vq[i]);
                 let d2 = t0 * t0 + t1 * t1 + t2 * t2;
-                let d = (d2 - (va + va.min(vb))).max(0.0) / (sigma2 + va + vb);
+                let d = (d2 - self.cancel * (va + va.min(vb))).max(0.0) / (sigma2 + va + vb);
                 out[i] = out[i].max(d);
             }
         }
@@ -250,7 +293,7 @@ impl SameSurface {
 
 /// Per candidate and channel, the filtered half less that half (albedo-divided):
 /// `[candidate][channel][pixel]`.
-pub type Deltas = [[Vec<f32>; 3]; CANDIDATES];
+pub type Deltas = Vec<[Vec<f32>; 3]>;
 
 /// Filters both halves of `layer` with each candidate: half 0 with weights from half 1 and the
 /// other way round, with the feature guide when given. Runs on the current rayon pool in fixed
@@ -269,14 +312,16 @@ pub fn cross_filter(
         .map(|&y0| filter_band(layer, guide, candidates, w, h, y0..(y0 + BAND).min(h)))
         .collect();
     std::array::from_fn(|half| {
-        std::array::from_fn(|k| {
-            std::array::from_fn(|ch| {
-                parts
-                    .iter()
-                    .flat_map(|p| p[half][k][ch].iter().copied())
-                    .collect()
+        (0..candidates.k.len())
+            .map(|k| {
+                std::array::from_fn(|ch| {
+                    parts
+                        .iter()
+                        .flat_map(|p| p[half][k][ch].iter().copied())
+                        .collect()
+                })
             })
-        })
+            .collect()
     })
 }
 
@@ -315,7 +360,12 @@ fn filter_band(
 ) -> [Deltas; 2] {
     let (r, f) = (cand.radius as isize, cand.patch);
     let n = rows.len() * w;
-    let inv_k2 = cand.k.map(|k| 1.0 / (3.0 * (k * k).max(1e-12)));
+    let inv_k2: Vec<f32> = cand
+        .k
+        .iter()
+        .map(|k| 1.0 / (3.0 * (k * k).max(1e-12)))
+        .collect();
+    let nk = inv_k2.len();
     let (p0, p1) = (rows.start.saturating_sub(f), (rows.end + f).min(h));
     // Per half: the colour distance of its guide (the other half), and its patch average.
     let mut dist = [vec![0.0f32; (p1 - p0) * w], vec![0.0f32; (p1 - p0) * w]];
@@ -323,10 +373,13 @@ fn filter_band(
     let mut scratch = Vec::new();
     let mut df = vec![0.0f32; w];
     let mut wt = vec![0.0f32; w];
-    let zero = || -> Deltas { std::array::from_fn(|_| std::array::from_fn(|_| vec![0.0; n])) };
+    let zero = || -> Deltas {
+        (0..nk)
+            .map(|_| std::array::from_fn(|_| vec![0.0; n]))
+            .collect()
+    };
     let mut acc = [zero(), zero()];
-    let mut wsum: [[Vec<f32>; CANDIDATES]; 2] =
-        std::array::from_fn(|_| std::array::from_fn(|_| vec![0.0; n]));
+    let mut wsum: [Vec<Vec<f32>>; 2] = std::array::from_fn(|_| vec![vec![0.0; n]; nk]);
     for dy in -r..=r {
         for dx in -r..=r {
             let x0 = (-dx).max(0) as usize;
@@ -369,7 +422,7 @@ fn filter_band(
                 for half in 0..2 {
                     let cx = &layer.c[half];
                     let dc = &patch[half][b_at..b_at + len];
-                    for k in 0..CANDIDATES {
+                    for k in 0..nk {
                         let (wt, df) = (&mut wt[..len], &df[..len]);
                         let inv = inv_k2[k];
                         for i in 0..len {

@@ -9,16 +9,19 @@
 use glam::Vec3;
 
 use super::DenoiseParams;
-use super::cross_filter::{CANDIDATES, Deltas};
 use super::input::HalfBuffers;
 use super::planes::box_filter;
 
+/// One candidate filter's change to each half (filtered less input, in albedo-divided units):
+/// `[half][channel][pixel]`.
+pub type Change = [[Vec<f32>; 3]; 2];
+
 /// The output of the candidate each pixel's cross-validated error picks: `layer`'s halves
-/// plus the albedo (`demodulate`) times `deltas` (each half's [`super::cross_filter`]).
+/// plus the albedo (`demodulate`) times the candidate's [`Change`].
 #[must_use]
 pub fn select(
     layer: &HalfBuffers,
-    deltas: &[Deltas; 2],
+    changes: &[Change],
     demodulate: &[Vec<f32>; 3],
     shares: [f32; 2],
     params: &DenoiseParams,
@@ -29,29 +32,42 @@ pub fn select(
     let [ma, mb] = &layer.mean;
     let [va, vb] = &layer.variance;
     let a = |i: usize| Vec3::new(demodulate[0][i], demodulate[1][i], demodulate[2][i]);
-    let delta = |half: usize, k: usize, i: usize| {
-        let d = &deltas[half][k];
+    let change = |c: &Change, half: usize, i: usize| {
+        let d = &c[half];
         Vec3::new(d[0][i], d[1][i], d[2][i])
     };
-    // The filtered halves of candidate k at pixel i.
-    let filtered =
-        |k: usize, i: usize| (ma[i] + a(i) * delta(0, k, i), mb[i] + a(i) * delta(1, k, i));
-    let errors: [Vec<f32>; CANDIDATES] = std::array::from_fn(|k| {
-        let raw: Vec<f32> = (0..n)
-            .map(|i| {
-                let (fa, fb) = filtered(k, i);
-                let (da, db) = (fa - mb[i], fb - ma[i]);
-                let e = (da * da - vb[i] + db * db - va[i]).element_sum() / 6.0;
-                let m = (ma[i] * shares[0] + mb[i] * shares[1]).element_sum() / 3.0;
-                e / (m * m + 1e-4)
-            })
-            .collect();
-        box_filter(&raw, w, h, params.select_radius)
-    });
+    // The filtered halves of candidate `k` at pixel i.
+    let filtered = |k: usize, i: usize| {
+        (
+            ma[i] + a(i) * change(&changes[k], 0, i),
+            mb[i] + a(i) * change(&changes[k], 1, i),
+        )
+    };
+    // Each pixel's squared brightness (plus a floor), the errors' scale: once for all
+    // candidates.
+    let scale: Vec<f32> = (0..n)
+        .map(|i| {
+            let m = (ma[i] * shares[0] + mb[i] * shares[1]).element_sum() / 3.0;
+            m * m + 1e-4
+        })
+        .collect();
+    let errors: Vec<Vec<f32>> = (0..changes.len())
+        .map(|k| {
+            let raw: Vec<f32> = (0..n)
+                .map(|i| {
+                    let (fa, fb) = filtered(k, i);
+                    let (da, db) = (fa - mb[i], fb - ma[i]);
+                    let e = (da * da - vb[i] + db * db - va[i]).element_sum() / 6.0;
+                    e / scale[i]
+                })
+                .collect();
+            box_filter(&raw, w, h, params.select_radius)
+        })
+        .collect();
     let out: Vec<Vec3> = (0..n)
         .map(|i| {
             let mut best = 0;
-            for k in 1..CANDIDATES {
+            for k in 1..changes.len() {
                 if errors[k][i] < errors[best][i] {
                     best = k;
                 }

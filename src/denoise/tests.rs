@@ -324,3 +324,30 @@ fn the_variance_prefilter_stays_on_one_surface() {
     // A plain box would have mixed them: 2 of the 6 in-image neighbours of (3, 0) are wall.
     assert!((planes::box_filter(&plane, w, h, 1)[3] - 2.0 / 6.0).abs() < 1e-6);
 }
+
+/// A pixel that is partly sky and partly deck (the pool's horizon row): albedo 0.16 with the
+/// variance of that mixture over a few samples (0.07, summed over RGB), beside the sky (albedo
+/// 0, no variance). By hand, the albedo distance is 3 · 0.16² = 0.0768 over σ² + 0.07 =
+/// 0.0725: 1.06, beyond 1, so not the same surface (the default, the variance only widening
+/// the bandwidth); with Rousselle et al. (2013)'s cancellation the mixed pixel's variance is
+/// subtracted first, (0.0768 − 0.07) / 0.0725 is under 1, and from the mixed pixel the sky
+/// counts as its surface (its mean over the 2×2 becomes 0.5; from the sky, whose own variance
+/// is 0, nothing is subtracted and the sky keeps 0).
+#[test]
+fn a_mixed_pixels_feature_variance_does_not_make_it_the_same_surface() {
+    let (w, h) = (2, 2);
+    let mut guide = flat_guide(w * h);
+    guide.albedo = vec![Vec3::splat(0.16), Vec3::ZERO, Vec3::splat(0.16), Vec3::ZERO];
+    guide.albedo_variance = vec![0.07, 0.0, 0.07, 0.0];
+    let plane = [1.0, 0.0, 1.0, 0.0];
+    let mean = |params: &DenoiseParams| {
+        let planes = cross_filter::GuidePlanes::new(&guide, w, params);
+        planes.same_surface(w, h, 1).mean(&plane)
+    };
+    assert_eq!(mean(&DenoiseParams::default()), plane);
+    let cancelled = DenoiseParams {
+        feature_variance_cancel: 1.0,
+        ..DenoiseParams::default()
+    };
+    assert_eq!(mean(&cancelled), vec![0.5, 0.0, 0.5, 0.0]);
+}

@@ -8,6 +8,7 @@ mod assets;
 mod auto_exposure;
 mod bad_scenes;
 mod bath;
+mod caustic_stripes;
 mod cli;
 mod common;
 mod compare;

@@ -30,7 +30,7 @@ use glam::Vec3;
 use super::estimate::{Kernel, PhotonMap};
 use super::maps::{
     PhotonMaps, PhotonSummary, auto_radius, build_maps_cancellable, diffuse_area,
-    precompute_irradiance,
+    precompute_irradiance, use_photon_discs,
 };
 use super::trace::{MapKind, TraceCounts};
 use super::walls::Walls;
@@ -399,6 +399,8 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
     )?;
     summary.memory = memory;
     summary.trace_time = Duration::ZERO;
+    let (mut caustic, mut global) = (caustic, global);
+    use_photon_discs(scene, &mut caustic, &mut global, &mut summary);
     summary.build_time = t0.elapsed();
     let irradiance = precompute_irradiance(scene, &caustic, &global, &mut summary, None);
     Ok(PhotonMaps {

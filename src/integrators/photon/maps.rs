@@ -587,7 +587,9 @@ pub fn build_maps_with(
     summary.trace_time = t0.elapsed().saturating_sub(build_time);
     summary.build_time = build_time;
     summary.memory = memory;
+    let (mut caustic, mut global) = (caustic, global);
     let irradiance = if pass.is_none() {
+        use_photon_discs(scene, &mut caustic, &mut global, &mut summary);
         precompute_irradiance(scene, &caustic, &global, &mut summary, cancel)
     } else {
         None
@@ -612,6 +614,26 @@ fn cancelled(mut summary: PhotonSummary) -> PhotonMaps {
         summary,
         ..PhotonMaps::default()
     }
+}
+
+/// Gives the photon integrator's maps (not a progressive pass's) their photons' discs
+/// ([`PhotonMap::use_photon_discs`]: the sample-point estimate, which keeps each region's flux),
+/// adding the time to `summary`'s build time and the bytes to its memory; each disc's wall mark
+/// is made for its own radius against `scene`'s surfaces. Used by [`build_maps`] and by the
+/// photon-map cache after loading the maps.
+pub(super) fn use_photon_discs(
+    scene: &RenderScene,
+    caustic: &mut Option<PhotonMap>,
+    global: &mut Option<PhotonMap>,
+    summary: &mut PhotonSummary,
+) {
+    let t = Instant::now();
+    for map in [caustic, global].into_iter().flatten() {
+        let before = map.memory_bytes();
+        map.use_photon_discs(Walls::of(scene, None));
+        summary.memory += map.memory_bytes() - before;
+    }
+    summary.build_time += t.elapsed();
 }
 
 /// The irradiance final gathering reads, precomputed from the built (or cached) maps: `None`

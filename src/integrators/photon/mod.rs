@@ -17,6 +17,7 @@
 
 pub mod aim;
 pub mod cache;
+pub mod discs;
 pub mod emit;
 pub mod estimate;
 pub mod maps;
