@@ -32,8 +32,9 @@
 //!   query's plane with its normal, where the tests above accept them (issue 47,
 //!   thin-wall-photon-leak: a dark room read up to 0.1). Photons are marked when their map is
 //!   built ([`PhotonMap::mark_walls`]) if a surface rises above their plane within reach; only
-//!   those (and photons on a level above the query) are tested, all of an estimate's against
-//!   one list of the walls in reach ([`super::wall_list`]) or by rays, and a crossing counts as a
+//!   those (and photons on a level above the query) are tested, each at once against the list
+//!   of the walls within reach of the query's cell of a grid built with the marks
+//!   ([`super::wall_grid`], [`super::wall_list`]) or by a ray, and a crossing counts as a
 //!   wall only when the surface stands across the receiver, so contact regions, creases and
 //!   curved receivers read what they read without the test.
 //!
@@ -58,9 +59,9 @@ use glam::Vec3;
 
 use super::discs::PhotonDiscs;
 use super::radius_field::RadiusField;
-use super::wall_list::WallList;
+use super::wall_grid::{WallGrid, estimate_reach};
+use super::wall_list::{Crossing, WallList};
 use super::walls::{self, Walls};
-use crate::geometry::Aabb;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 use crate::spatial::{HasPosition, HashGrid, KdTree, KnnHeap, Photon};
 
@@ -121,6 +122,10 @@ pub struct PhotonMap {
     near_wall: Vec<bool>,
     /// The estimate radius the marks hold for (scene units; 0 before marking).
     wall_radius: f32,
+    /// The potential walls near every point, for estimates of radius up to `wall_radius`
+    /// ([`WallGrid`], built with the marks); `None` before marking or when the scene is too
+    /// large for one (estimates then test by rays).
+    wall_grid: Option<WallGrid>,
     /// The photon integrator's maps: each photon's own disc ([`PhotonMap::use_photon_discs`]),
     /// read by the sample-point estimate instead of the k-nearest one.
     discs: Option<PhotonDiscs>,
@@ -196,8 +201,9 @@ pub struct Estimate {
     /// marked near a wall or lies on a level above the query point, and the estimate's wall
     /// list could not decide ([`super::wall_list`]).
     pub rays: u32,
-    /// Photons whose segment was tested against the estimate's wall list instead of by a ray
-    /// ([`super::wall_list::WallList::crosses`]).
+    /// Photons whose segment was tested against the estimate's wall list
+    /// ([`super::wall_list::WallList::crosses`]; those it could not decide, a mesh or a sphere
+    /// in the segment's box, are counted in `rays` too).
     pub listed: u32,
     /// Accepted photons a wall separates from the query point (left out).
     pub hidden: u32,
@@ -206,9 +212,6 @@ pub struct Estimate {
 thread_local! {
     /// Each worker's k-nearest heap (reused; no allocation per estimate).
     static HEAP: RefCell<KnnHeap> = RefCell::new(KnnHeap::new(1));
-    /// Each worker's wall list and kept terms (reused; no allocation per estimate once grown),
-    /// borrowed by an estimate that tests photons.
-    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
 impl PhotonMap {
@@ -224,6 +227,7 @@ impl PhotonMap {
             pass: None,
             near_wall: Vec::new(),
             wall_radius: 0.0,
+            wall_grid: None,
             discs: None,
         }
     }
@@ -245,6 +249,9 @@ impl PhotonMap {
             .map(|ph| walls::near_wall(&walls, ph.position(), ph.normal(), radius))
             .collect();
         self.wall_radius = radius;
+        let bounds = walls.geometry().bvh.bounds;
+        let far = bounds.min.abs().max(bounds.max.abs());
+        self.wall_grid = WallGrid::build(&walls, estimate_reach(far, radius));
     }
 
     /// Photons marked near a wall ([`PhotonMap::mark_walls`]; all of them before marking).
@@ -307,10 +314,11 @@ impl PhotonMap {
     /// pilot map's), each estimate is the plain density estimate over a fixed disc: its mean is
     /// the radiance averaged over the disc (Knaus & Zwicker 2011).
     ///
-    /// The wall marks are made again for the pass's disc: a photon marked for the largest
-    /// radius is tested again at twice the pass's radius where it lies, `2 · shrink · R(p)`
-    /// (one BVH region query each); an estimate whose disc is larger than the radius a
-    /// photon's mark was made for tests that photon by a ray ([`walls::needs_ray`]).
+    /// The wall marks are made for the pass's discs: every photon for the widest disc of the
+    /// pass (`shrink` times the field's largest radius; unless already marked for one at least
+    /// as wide), and a photon marked for it again at twice the pass's radius where it lies,
+    /// `2 · shrink · R(p)` (one BVH region query each); an estimate whose disc is larger than the
+    /// radius a photon's mark was made for tests that photon ([`walls::needs_ray`]).
     pub fn set_pass_lookup(&mut self, shrink: f32, field: Arc<RadiusField>, walls: Walls<'_>) {
         use rayon::prelude::*;
         self.set_shrink(shrink);
@@ -446,7 +454,9 @@ impl PhotonMap {
     /// Bytes the map holds.
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
-        self.tree.memory_bytes() + self.discs.as_ref().map_or(0, PhotonDiscs::memory_bytes)
+        self.tree.memory_bytes()
+            + self.discs.as_ref().map_or(0, PhotonDiscs::memory_bytes)
+            + self.wall_grid.as_ref().map_or(0, WallGrid::memory_bytes)
     }
 
     /// Radiance leaving `p` towards `wo` through the non-delta part of `bsdf` in frame `fr` (as
@@ -522,7 +532,7 @@ impl PhotonMap {
             let r = r2.sqrt();
             let photons = self.tree.items();
             let mut sum = Vec3::ZERO;
-            let mut sight = Sight::new(walls, p, ng, r);
+            let mut sight = Sight::new(walls, self.wall_grid.as_ref(), p, ng, r);
             for n in heap.iter() {
                 if Some(n.index) == skip || (self.shrink < 1.0 && n.dist2 >= r2) {
                     continue;
@@ -539,7 +549,6 @@ impl PhotonMap {
                     || value(ph.power(), wi, cos_g) * self.kernel.weight(n.dist2.sqrt(), r),
                 );
             }
-            sight.resolve(&mut sum);
             let area = std::f32::consts::PI * r2 * self.kernel.normalisation();
             Estimate {
                 radiance: sum / area,
@@ -573,7 +582,7 @@ impl PhotonMap {
     ) -> Estimate {
         let c = std::f32::consts::PI * self.kernel.normalisation();
         let mut sum = Vec3::ZERO;
-        let mut sight = Sight::new(walls, p, ng, discs.largest());
+        let mut sight = Sight::new(walls, self.wall_grid.as_ref(), p, ng, discs.largest());
         let cover = discs.covering(p, |d, dist2| {
             if let Some(cos_p) = landing_cosine(d.normal, d.wi, ng) {
                 sight.add(
@@ -589,7 +598,6 @@ impl PhotonMap {
                 );
             }
         });
-        sight.resolve(&mut sum);
         Estimate {
             radiance: sum,
             found: cover.found,
@@ -622,7 +630,7 @@ impl PhotonMap {
         let mut disc = Disc {
             sum: Vec3::ZERO,
             found: 0,
-            sight: Sight::new(walls, p, ng, r),
+            sight: Sight::new(walls, self.wall_grid.as_ref(), p, ng, r),
             ng,
             r,
             kernel: self.kernel,
@@ -653,7 +661,6 @@ impl PhotonMap {
                 disc.add(&Landing::new(ph, clear), n.dist2, &value);
             });
         }
-        disc.sight.resolve(&mut disc.sum);
         let Disc {
             sum, found, sight, ..
         } = disc;
@@ -716,64 +723,53 @@ impl<F: Fn(Vec3, Vec3, f32) -> Vec3> crate::spatial::Visit for GridDisc<'_, '_, 
     }
 }
 
-/// The wall test of one estimate at query point `q` (unit geometric normal `nq` on the side
-/// of `ωo`), counting the rays it traces and the photons it hides.
+/// The wall test of one estimate of radius `r` at query point `q` (unit geometric normal `nq`
+/// on the side of `ωo`), counting the photons it tests and hides.
 ///
-/// Photons are summed as the search finds them until the first that needs a test
-/// ([`walls::needs_ray`]); from there on each accepted photon's term is kept, in order, with
-/// the photon when it needs a test, and the box of the tested segments grows. At the end
-/// ([`Sight::resolve`]) the potential walls in that box are gathered once
-/// ([`WallList::collect`]), each kept photon is decided against them (by a ray when the list
-/// cannot decide) and the terms of the photons no wall separates are added in the search's
-/// order: the same sum, bit for bit, as testing each photon on the way.
+/// A photon is added as the search finds it unless it needs a test ([`walls::needs_ray`]:
+/// marked near a wall at its distance, or on a level above `q`); a tested photon is decided at
+/// once, in the search's order, so the sum is the one testing every photon by a ray would give.
+/// At the estimate's first tested photon the candidates of `q`'s cell of the map's
+/// [`WallGrid`] are cut down to the estimate's wall list ([`WallList::fill`], kept in the
+/// worker's scratch); each tested segment is decided against it, or by a ray
+/// ([`walls::separated`]) where the list cannot decide (no grid, a cell with too many
+/// candidates, a mesh or a sphere in the segment's box). An estimate that tests nothing costs
+/// one comparison per photon beyond the side tests and no state.
 struct Sight<'g> {
     walls: Walls<'g>,
+    grid: Option<&'g WallGrid>,
     q: Vec3,
     nq: Vec3,
+    r: f32,
     /// A lower bound of [`walls::tolerance`] at every point within the estimate's radius of
-    /// `q`: an unmarked photon no higher than this above `q`'s side of its plane needs no ray
+    /// `q`: an unmarked photon no higher than this above `q`'s side of its plane needs no test
     /// (the first of [`walls::needs_ray`]'s tests, decided without the photon's own bound).
     tolerance_floor: f32,
-    /// Whether a photon needed a test (its term and the later ones are kept in `scratch`).
-    pending: bool,
-    /// The box of the segments that need a test.
-    bounds: Aabb,
+    /// Whether the worker's wall list holds this estimate's (`Some(false)`: no list, rays).
+    list: Option<bool>,
     rays: u32,
     listed: u32,
     hidden: u32,
 }
 
-/// A worker's reusable storage for estimates that test photons: the wall list and the terms
-/// kept after the first photon that needed a test (no allocation per estimate once grown).
-#[derive(Debug, Default)]
-struct Scratch {
-    list: WallList,
-    terms: Vec<Term>,
-}
-
-/// One accepted photon's term, kept until the estimate's walls are known.
-#[derive(Debug, Clone, Copy)]
-struct Term {
-    /// Its weighted contribution to the sum.
-    value: Vec3,
-    /// Its position and unit normal.
-    p: Vec3,
-    np: Vec3,
-    /// Whether a wall test decides it (else it counts).
-    tested: bool,
+thread_local! {
+    /// Each worker's wall list (reused; no allocation per estimate once grown), filled by an
+    /// estimate at its first tested photon.
+    static LIST: RefCell<WallList> = RefCell::new(WallList::default());
 }
 
 impl<'g> Sight<'g> {
-    /// The wall test of an estimate of radius `r` (scene units) around `q`.
+    /// The wall test of an estimate of radius `r` (scene units) around `q`, with the map's grid.
     #[inline]
-    fn new(walls: Walls<'g>, q: Vec3, nq: Vec3, r: f32) -> Self {
+    fn new(walls: Walls<'g>, grid: Option<&'g WallGrid>, q: Vec3, nq: Vec3, r: f32) -> Self {
         Self {
             walls,
+            grid,
             q,
             nq,
+            r,
             tolerance_floor: walls::tolerance_floor(q, r),
-            pending: false,
-            bounds: Aabb::EMPTY,
+            list: None,
             rays: 0,
             listed: 0,
             hidden: 0,
@@ -781,8 +777,7 @@ impl<'g> Sight<'g> {
     }
 
     /// Adds the accepted photon at `p` (unit normal `np`; `near_wall`: its mark does not clear
-    /// it at its distance) of term `term` to `sum`, or keeps it for [`Sight::resolve`] when it
-    /// or an earlier photon needs a wall test.
+    /// it at its distance) of term `term` to `sum`, unless a wall separates it from `q`.
     #[inline(always)]
     fn add(
         &mut self,
@@ -792,88 +787,52 @@ impl<'g> Sight<'g> {
         near_wall: bool,
         term: impl FnOnce() -> Vec3,
     ) {
-        let gate = near_wall || (p - self.q).dot(np) > self.tolerance_floor;
-        if !gate && !self.pending {
+        if !((near_wall || (p - self.q).dot(np) > self.tolerance_floor)
+            && self.hides(p, np, near_wall))
+        {
             *sum += term();
-        } else if let Some(value) = self.keep(p, np, near_wall, gate, term()) {
-            *sum += value;
         }
     }
 
-    /// [`Sight::add`] past its first test, out of line (most photons never get here):
-    /// [`walls::needs_ray`]'s exact tests, then the photon kept; or its term `value` returned
-    /// to be added at once, when nothing is pending and it needs no test (the sum stays out of
-    /// this function, in registers).
+    /// True when a wall separates the photon at `p` (unit normal `np`) from `q`:
+    /// [`walls::needs_ray`]'s exact tests, then the estimate's wall list or a ray. Out of line
+    /// (most photons never get here).
     #[cold]
     #[inline(never)]
-    fn keep(
-        &mut self,
-        p: Vec3,
-        np: Vec3,
-        near_wall: bool,
-        gate: bool,
-        value: Vec3,
-    ) -> Option<Vec3> {
-        let segment = if gate && walls::needs_ray(self.q, self.nq, p, np, near_wall) {
-            walls::segment(self.q, self.nq, p, np)
-        } else {
-            None
+    fn hides(&mut self, p: Vec3, np: Vec3, near_wall: bool) -> bool {
+        if !walls::needs_ray(self.q, self.nq, p, np, near_wall) {
+            return false;
+        }
+        let Some((a, b)) = walls::segment(self.q, self.nq, p, np) else {
+            return false;
         };
-        let first = !self.pending;
-        if let Some((a, b)) = segment {
-            self.pending = true;
-            self.bounds = self.bounds.grow(a).grow(b);
-        } else if first {
-            return Some(value);
-        }
-        SCRATCH.with(|s| {
-            let terms = &mut s.borrow_mut().terms;
-            if first {
-                terms.clear();
-            }
-            terms.push(Term {
-                value,
-                p,
-                np,
-                tested: segment.is_some(),
-            });
-        });
-        None
-    }
-
-    /// Adds the kept terms of the photons no wall separates from the query point to `sum`,
-    /// in order: the walls in the box of the tested segments are gathered once
-    /// ([`WallList::collect`]) and each tested photon is decided against them, or by a ray
-    /// ([`walls::separated`]) when the list cannot decide.
-    fn resolve(&mut self, sum: &mut Vec3) {
-        if !self.pending {
-            return;
-        }
-        SCRATCH.with(|s| self.resolve_with(&mut s.borrow_mut(), sum));
-        self.pending = false;
-    }
-
-    /// [`Sight::resolve`] with the worker's scratch.
-    fn resolve_with(&mut self, scratch: &mut Scratch, sum: &mut Vec3) {
-        let Scratch { list, terms } = scratch;
-        let by_list = list.collect(&self.walls, self.nq, &self.bounds);
-        for t in terms.iter() {
-            if t.tested {
-                let hidden = if by_list {
-                    self.listed += 1;
-                    walls::segment(self.q, self.nq, t.p, t.np)
-                        .is_some_and(|(a, b)| list.crosses(a, b, t.np))
-                } else {
-                    self.rays += 1;
-                    walls::separated(&self.walls, self.q, self.nq, t.p, t.np)
-                };
-                if hidden {
-                    self.hidden += 1;
-                    continue;
+        let crossing = LIST.with(|l| {
+            let mut list = l.borrow_mut();
+            let ready = *self.list.get_or_insert_with(|| {
+                let reach = estimate_reach(self.q, self.r);
+                match self.grid.and_then(|g| g.near(self.q, reach)) {
+                    Some(near) => {
+                        list.fill(near, self.q, self.nq, reach, self.walls.own_body());
+                        true
+                    }
+                    None => false,
                 }
+            });
+            ready.then(|| list.crosses(a, b, np))
+        });
+        let hidden = match crossing {
+            Some(Crossing::Wall) => true,
+            Some(Crossing::Clear) => false,
+            Some(Crossing::Unknown) | None => {
+                self.rays += 1;
+                walls::separated(&self.walls, self.q, self.nq, p, np)
             }
-            *sum += t.value;
+        };
+        if crossing.is_some() {
+            self.listed += 1;
         }
+        self.hidden += u32::from(hidden);
+        hidden
     }
 }
 

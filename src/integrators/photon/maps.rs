@@ -531,7 +531,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
-            Walls::of(scene, None),
+            pass.is_none().then(|| Walls::of(scene, None)),
             photons,
             MapKind::Caustic,
             p.caustic_gather,
@@ -571,7 +571,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
-            Walls::of(scene, None),
+            pass.is_none().then(|| Walls::of(scene, None)),
             photons,
             MapKind::Global,
             p.gather,
@@ -663,10 +663,14 @@ pub(super) fn precompute_irradiance(
     irradiance
 }
 
-/// Builds the kd-tree of one map's photons, or says why there is none.
+/// Builds the kd-tree of one map's photons, or says why there is none; with `walls`, marks its
+/// photons near walls ([`PhotonMap::mark_walls`]). A progressive pass's maps (and the pilot,
+/// which makes no estimate) are marked later, for the pass's own radii
+/// ([`PhotonMap::set_pass_lookup`]): marking them here for the largest radius first cost a
+/// second BVH region query per photon for nothing.
 #[allow(clippy::too_many_arguments)]
 fn finish_map(
-    walls: Walls<'_>,
+    walls: Option<Walls<'_>>,
     photons: Vec<Photon>,
     kind: MapKind,
     k: u32,
@@ -694,7 +698,9 @@ fn finish_map(
     *memory += tree.memory_bytes();
     *radius = r;
     let mut map = PhotonMap::new(tree, k as usize, r, kernel);
-    map.mark_walls(walls);
+    if let Some(walls) = walls {
+        map.mark_walls(walls);
+    }
     *build_time += t.elapsed();
     Some(map)
 }

@@ -25,6 +25,7 @@ pub mod passes;
 pub mod radius_field;
 pub mod trace;
 pub mod volume;
+pub mod wall_grid;
 pub mod wall_list;
 pub mod walls;
 

@@ -159,8 +159,11 @@ impl<'a> ProgressivePhotons<'a> {
             match field {
                 Some(f) => m.set_pass_lookup(shrink, Arc::clone(f), Walls::of(self.scene, None)),
                 // No pilot photon although this pass stored some (a rare light path): the
-                // pass's own k-nearest radius, shrunk.
-                None => m.set_shrink(shrink),
+                // pass's own k-nearest radius, shrunk (its photons marked for it).
+                None => {
+                    m.mark_walls(Walls::of(self.scene, None));
+                    m.set_shrink(shrink);
+                }
             }
         }
         // The volume photons' spheres: radius `shrink · R(x)` (2-D kernel across the ray, so the

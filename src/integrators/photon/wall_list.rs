@@ -1,6 +1,6 @@
-//! One decision per estimate instead of one ray per photon (issue 47, the cost of the wall
-//! test): the potential walls of one estimate's segments, gathered by a single BVH region
-//! query, against which each photon's segment is tested directly.
+//! The wall list of one estimate (issue 47, the cost of the wall test): the potential walls of
+//! its cell of the map's [`WallGrid`], cut down to those its segments can cross, against which
+//! each photon's segment is tested directly instead of by a ray through the scene.
 //!
 //! **Why.** A wide disc (on the bath, the discs of `R = 0.48 m` where the pilot map found no
 //! photon) finds photons whose marks were made for smaller discs, or photons on another level,
@@ -8,159 +8,104 @@
 //! (on the bath, 1.1 G of 5.4 G instructions: ~2,000 instructions a ray through the duck's, the
 //! boat's and the faucet's 74,000 triangles).
 //!
-//! **What.** Every segment of an estimate (the lifted ends `a` near the query point and `b`
-//! near each photon, [`walls::segment`]) lies in the box of all its ends, `B`. A surface the
-//! segment crosses is a wall only if it is opaque, not of the query's body and its normal is
-//! more than ~26° from the query's normal ([`walls::separated`]'s rule, which does not depend on
-//! the photon but for the photon's normal): so every primitive that can be a wall to any of the
-//! estimate's segments meets `B` and passes those tests. One BVH region query collects them
-//! ([`WallList::collect`]); when they are few triangles (at most [`MAX_LISTED`]), each segment
-//! is tested against them alone ([`WallList::crosses`]: a plane-side test, then the same
-//! watertight triangle test the BVH uses, [`intersect_triangle`]), and an empty list needs no
-//! test at all. A sphere, ellipsoid or quadric in `B`, or more triangles, and the estimate
-//! traces rays as before.
+//! **What.** Every segment of an estimate of radius `r` around `q` (the lifted ends of
+//! [`walls::segment`]) lies within [`estimate_reach`](super::wall_grid::estimate_reach) of `q`.
+//! A surface the segment crosses is a wall only if it is opaque, not of the query's body and
+//! its normal is more than ~26° from the query's normal ([`walls::separated`]'s rule, which
+//! does not depend on the photon but for the photon's normal). At the estimate's first tested
+//! photon, the candidates of `q`'s grid cell are filtered by those tests and by that reach
+//! ([`WallList::fill`], a few instructions per candidate); each tested segment is then decided
+//! against the list ([`WallList::crosses`]: a box and a plane-side test, then the same
+//! watertight triangle test the BVH uses, [`intersect_triangle`]). A segment whose box meets a
+//! candidate known only by its bounds (a mesh, a sphere) is decided by a ray.
 //!
 //! **Same decisions.** The walk of [`walls::separated`] reports a wall when one of the
 //! surfaces it crosses, in order, has a normal more than ~26° from both normals and can block;
 //! the list reports one when any listed triangle crossed has. They differ only where the walk
 //! gives up (more than 8 parallel crossings before the wall) or steps over a wall within the
 //! rounding offset of a parallel crossing (micrometres): there the list rejects the photon,
-//! never accepts one the walk rejects. The list is built from the estimate's own segments
-//! only, so the decision does not depend on the order of estimates or the thread count.
+//! never accepts one the walk rejects. The list depends only on the geometry, the query point
+//! and the map's grid, so the decision does not depend on the order of estimates or the
+//! thread count.
 
 use glam::Vec3;
 
-use super::walls::{self, PARALLEL_COSINE, Walls};
+use super::wall_grid::{Wall, WallKind, overlaps};
+use super::walls::{self, PARALLEL_COSINE};
 use crate::geometry::triangle::{TriRay, intersect_triangle};
 use crate::geometry::{Aabb, Ray};
-use crate::render_scene::geometry::PrimKind;
 
-/// Most triangles a list holds; an estimate whose segments' box meets more potential walls
-/// traces a ray per photon instead. The bath's tub (five boxes) and room (eight quads) give at
-/// most ~40 beside a floor point.
-pub const MAX_LISTED: usize = 48;
-
-/// Most triangles the region query looks at (in leaves whose boxes meet the segments' box)
-/// before it gives up and lets the estimate trace rays: a box around a mesh's thousands of
-/// triangles would cost more than the rays.
-pub const MAX_EXAMINED: usize = 4 * MAX_LISTED;
-
-/// One triangle of a [`WallList`]: its corners, unit normal (as a hit on it reports it) and
-/// plane offset, and its bounds.
-#[derive(Debug, Clone, Copy)]
-struct Listed {
-    corners: [Vec3; 3],
-    ng: Vec3,
-    offset: f32,
-    bounds: Aabb,
+/// How a segment meets an estimate's wall list ([`WallList::crosses`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Crossing {
+    /// It crosses a listed triangle that stands across both ends' surfaces: a wall.
+    Wall,
+    /// It crosses no wall.
+    Clear,
+    /// Its box meets a candidate known only by its bounds: a ray decides.
+    Unknown,
 }
 
-/// The triangles that can be a wall to one estimate's segments (module docs). Reused by each
-/// worker (no allocation per estimate once it has grown). Reusing the list itself for the next
-/// estimates nearby (collected for a box grown by a quarter, kept while the next boxes fit in
-/// it) cost more on the bath than it saved: 6.34 G instructions against 6.21 G without.
+/// The candidates that can be a wall to one estimate's segments (module docs). Reused by each
+/// worker (no allocation per estimate once it has grown).
 #[derive(Debug, Default)]
 pub struct WallList {
-    listed: Vec<Listed>,
+    listed: Vec<Wall>,
 }
 
 impl WallList {
-    /// Fills the list with every triangle of `walls`' geometry that meets box `bounds` (grown
-    /// by the rounding tolerance), can block ([`Walls`]) and whose unit normal has a cosine of
-    /// at most [`PARALLEL_COSINE`] with the query's normal `nq` (either orientation). False
-    /// when the list cannot decide: more than [`MAX_LISTED`] such triangles, or a sphere,
-    /// ellipsoid or quadric that can block within `bounds` (their crossings' normals depend on
-    /// where they are crossed), or a tree deeper than the region query's stack.
-    pub fn collect(&mut self, walls: &Walls<'_>, nq: Vec3, bounds: &Aabb) -> bool {
+    /// Fills the list with the candidates `near` (the query's cell of a [`super::wall_grid::WallGrid`])
+    /// whose bounds meet the cube of half-side `reach` around the query point `q`, that are
+    /// not of the query's body `own`, and, for triangles, whose unit normal has a cosine of at
+    /// most [`PARALLEL_COSINE`] with the query's normal `nq` (either orientation).
+    pub fn fill<'w>(
+        &mut self,
+        near: impl Iterator<Item = &'w Wall>,
+        q: Vec3,
+        nq: Vec3,
+        reach: f32,
+        own: Option<u32>,
+    ) {
         self.listed.clear();
-        let geometry = walls.geometry();
-        let tol = walls::tolerance(bounds.min.abs().max(bounds.max.abs()));
-        let bounds = Aabb {
-            min: bounds.min - Vec3::splat(tol),
-            max: bounds.max + Vec3::splat(tol),
+        let disc = Aabb {
+            min: q - Vec3::splat(reach),
+            max: q + Vec3::splat(reach),
         };
-        let meets = |b: &Aabb| overlaps(b, &bounds);
-        let listed = &mut self.listed;
-        let mut examined = 0;
-        let stopped = geometry.bvh.any_leaf_in(meets, |first, count| {
-            examined += count as usize;
-            if examined > MAX_EXAMINED {
-                return true;
-            }
-            for slot in first..first + count {
-                let Some(&prim) = geometry.slots.get(slot as usize) else {
-                    return true;
-                };
-                match prim.kind() {
-                    PrimKind::Triangle => {
-                        let Some(&corners) = geometry.triangles.get(prim.index()) else {
-                            return true;
-                        };
-                        let [p0, p1, p2] = corners;
-                        let tri_bounds = Aabb::from_points(&corners);
-                        if !overlaps(&tri_bounds, &bounds) {
-                            continue;
-                        }
-                        // Parallel to the query beyond doubt (a margin over the rounding of
-                        // the normalised test below): skipped without normalising.
-                        let c = (p1 - p0).cross(p2 - p0);
-                        let cn = c.dot(nq);
-                        if cn * cn > 0.8101 * c.length_squared() {
-                            continue;
-                        }
-                        let ng = c.normalize();
-                        // A degenerate triangle (NaN normal) is never hit.
-                        if !(ng.dot(nq).abs() <= PARALLEL_COSINE)
-                            || !walls.can_block_object(geometry.object_of(prim))
-                        {
-                            continue;
-                        }
-                        if listed.len() == MAX_LISTED {
-                            return true;
-                        }
-                        listed.push(Listed {
-                            corners,
-                            ng,
-                            offset: ng.dot(p0),
-                            bounds: tri_bounds,
-                        });
-                    }
-                    PrimKind::Sphere | PrimKind::Ellipsoid | PrimKind::Quadric => {
-                        if walls.can_block_object(geometry.object_of(prim)) {
-                            return true;
-                        }
-                    }
-                }
-            }
-            false
-        });
-        !stopped
+        self.listed.extend(
+            near.filter(|w| {
+                Some(w.body) != own
+                    && overlaps(&w.bounds, &disc)
+                    && (w.kind == WallKind::Bounds || w.ng.dot(nq).abs() <= PARALLEL_COSINE)
+            })
+            .copied(),
+        );
     }
 
-    /// Number of triangles listed.
+    /// Number of candidates listed.
     #[must_use]
     pub fn len(&self) -> usize {
         self.listed.len()
     }
 
-    /// True when nothing listed: no segment inside the collected box can be separated.
+    /// True when nothing is listed: no segment of the estimate can be separated.
     #[must_use]
     pub fn is_empty(&self) -> bool {
         self.listed.is_empty()
     }
 
-    /// True when the segment from `a` to `b` (the lifted ends of [`walls::segment`], inside the
-    /// collected box) crosses a listed triangle whose normal also has a cosine of at most
-    /// [`PARALLEL_COSINE`] with the photon's unit normal `np`: a wall separates them.
+    /// Whether the segment from `a` to `b` (the lifted ends of [`walls::segment`], within the
+    /// reach the list was filled for) crosses a listed triangle whose normal also has a cosine
+    /// of at most [`PARALLEL_COSINE`] with the photon's unit normal `np` ([`Crossing::Wall`]),
+    /// or its box meets a candidate known by its bounds only ([`Crossing::Unknown`]).
     #[must_use]
-    pub fn crosses(&self, a: Vec3, b: Vec3, np: Vec3) -> bool {
+    pub fn crosses(&self, a: Vec3, b: Vec3, np: Vec3) -> Crossing {
         let ray = Ray {
             origin: a,
             dir: b - a,
             t_max: 1.0,
         };
         if self.listed.is_empty() || !ray.is_valid() {
-            return false;
+            return Crossing::Clear;
         }
         // Ends farther than this on one side of a plane: the watertight test cannot hit it
         // (its rounding is a few ulps of the coordinates, this is 64).
@@ -170,21 +115,37 @@ impl WallList {
             max: a.max(b) + Vec3::splat(margin),
         };
         let tri_ray = TriRay::new(&ray);
-        self.listed.iter().any(|w| {
-            let (sa, sb) = (w.ng.dot(a) - w.offset, w.ng.dot(b) - w.offset);
-            w.ng.dot(np).abs() <= PARALLEL_COSINE
-                && !((sa > margin && sb > margin) || (sa < -margin && sb < -margin))
-                && overlaps(&w.bounds, &seg)
-                && intersect_triangle(&tri_ray, w.corners[0], w.corners[1], w.corners[2], 1.0)
-                    .is_some()
-        })
+        let mut unknown = false;
+        for w in &self.listed {
+            if !overlaps(&w.bounds, &seg) {
+                continue;
+            }
+            match w.kind {
+                WallKind::Bounds => unknown = true,
+                WallKind::Triangle => {
+                    let (sa, sb) = (w.ng.dot(a) - w.offset, w.ng.dot(b) - w.offset);
+                    if w.ng.dot(np).abs() <= PARALLEL_COSINE
+                        && !((sa > margin && sb > margin) || (sa < -margin && sb < -margin))
+                        && intersect_triangle(
+                            &tri_ray,
+                            w.corners[0],
+                            w.corners[1],
+                            w.corners[2],
+                            1.0,
+                        )
+                        .is_some()
+                    {
+                        return Crossing::Wall;
+                    }
+                }
+            }
+        }
+        if unknown {
+            Crossing::Unknown
+        } else {
+            Crossing::Clear
+        }
     }
-}
-
-/// Whether boxes `a` and `b` share a point.
-#[inline]
-fn overlaps(a: &Aabb, b: &Aabb) -> bool {
-    a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
 }
 
 #[cfg(test)]
@@ -192,7 +153,10 @@ mod tests {
     use glam::Vec2;
 
     use super::*;
-    use crate::integrators::photon::walls::{near_wall, reach, segment, separated, tolerance};
+    use crate::integrators::photon::wall_grid::{WallGrid, estimate_reach};
+    use crate::integrators::photon::walls::{
+        Walls, near_wall, reach, segment, separated, tolerance,
+    };
     use crate::integrators::photon::{Kernel, PhotonMap};
     use crate::render_scene::Geometry;
     use crate::render_scene::geometry::{GeometryBuilder, TriAttrs};
@@ -278,10 +242,14 @@ mod tests {
     #[test]
     fn the_list_decides_as_the_ray_does() {
         // Reference: walls::separated's ray walk. Floor points near the divider and the cube,
-        // photons on the floor and on the cube's top within 30 cm: one list per query point,
-        // collected for the box of its segments, decides every photon as the ray does.
+        // photons on the floor and on the cube's top within 0.43 m: one list per query point,
+        // filled from its cell of a grid built for that radius, decides every photon as the
+        // ray does (the scene is triangles of small objects only: no ray is needed).
         let g = rooms();
         let walls = Walls::every_surface(&g);
+        let radius = 0.43;
+        let grid_reach = 1.2501 * radius + 12.0 * tolerance(Vec3::splat(2.2));
+        let grid = WallGrid::build(&walls, grid_reach).expect("grid");
         let mut rng = Rng::new(3, 5);
         let mut list = WallList::default();
         let (mut hidden, mut seen) = (0, 0);
@@ -289,33 +257,54 @@ mod tests {
             let (u, v) = rng.next_2d();
             let centre = if i % 2 == 0 { -0.05 } else { -0.49 };
             let q = Vec3::new(centre + 0.2 * (u - 0.5), 0.0, 0.2 * (v - 0.5));
-            let photons: Vec<(Vec3, Vec3)> = (0..8)
-                .map(|j| {
-                    let (a, b) = rng.next_2d();
-                    let p = q + Vec3::new(0.6 * (a - 0.5), 0.0, 0.6 * (b - 0.5));
-                    let on_top = j == 0 && i % 2 == 1;
-                    if on_top {
-                        (Vec3::new(-0.49, 0.02, 0.005 * (b - 0.5)), Vec3::Y)
-                    } else {
-                        (p, Vec3::Y)
-                    }
-                })
-                .collect();
-            let bounds = photons
-                .iter()
-                .filter_map(|&(p, np)| segment(q, Vec3::Y, p, np))
-                .fold(Aabb::EMPTY, |b, (a, e)| b.grow(a).grow(e));
-            assert!(list.collect(&walls, Vec3::Y, &bounds), "{q}");
-            for &(p, np) in &photons {
+            let reach = estimate_reach(q, radius);
+            let near = grid.near(q, reach).expect("a cell with a list");
+            list.fill(near, q, Vec3::Y, reach, None);
+            for j in 0..8 {
+                let (a, b) = rng.next_2d();
+                let on_top = j == 0 && i % 2 == 1;
+                let (p, np) = if on_top {
+                    (Vec3::new(-0.49, 0.02, 0.005 * (b - 0.5)), Vec3::Y)
+                } else {
+                    (
+                        q + Vec3::new(0.6 * (a - 0.5), 0.0, 0.6 * (b - 0.5)),
+                        Vec3::Y,
+                    )
+                };
                 let by_ray = separated(&walls, q, Vec3::Y, p, np);
-                let by_list =
-                    segment(q, Vec3::Y, p, np).is_some_and(|(a, b)| list.crosses(a, b, np));
-                assert_eq!(by_list, by_ray, "{q} {p}");
+                let by_list = segment(q, Vec3::Y, p, np).map(|(a, b)| list.crosses(a, b, np));
+                assert_ne!(by_list, Some(Crossing::Unknown), "{q} {p}");
+                assert_eq!(by_list == Some(Crossing::Wall), by_ray, "{q} {p}");
                 hidden += usize::from(by_ray);
                 seen += usize::from(!by_ray);
             }
         }
         assert!(hidden > 100 && seen > 400, "{hidden} hidden, {seen} seen");
+    }
+
+    #[test]
+    fn a_cell_lists_the_surfaces_within_reach_and_an_estimate_keeps_the_walls_among_them() {
+        // Hand count on the rooms (floor: 2 triangles spanning it, divider at x = 0: 2, cube at
+        // x ∈ [-0.5, -0.48], z ∈ [-0.01, 0.01]: 10). Reach 0.1: cells of side
+        // max(0.1, 4/24) = 1/6 m from x = -2, each listing what meets it grown by the reach.
+        // x = -1.5 (cell [-1.67, -1.5] or [-1.5, -1.33]): the floor alone, which lies in the
+        // query's plane (no wall). x = -0.05 (cell [-1/6, 0], grown to [-0.27, 0.1]): floor
+        // and divider; the divider is a wall. x = -0.2 (cell [-1/3, -1/6], grown to
+        // [-0.43, -0.07]): the floor alone. x = -0.45 (cell [-1/2, -1/3]): floor and cube, whose
+        // four side faces are walls to a floor point (its top lies in the floor's plane).
+        let g = rooms();
+        let walls = Walls::every_surface(&g);
+        let grid = WallGrid::build(&walls, 0.1).expect("grid");
+        let mut list = WallList::default();
+        for (x, cell, kept) in [(-1.5f32, 2, 0), (-0.05, 4, 2), (-0.2, 2, 0), (-0.45, 12, 8)] {
+            let q = Vec3::new(x, 0.0, 0.0);
+            let near: Vec<&Wall> = grid.near(q, 0.05).expect("a list").collect();
+            assert_eq!(near.len(), cell, "{x}");
+            list.fill(near.into_iter(), q, Vec3::Y, 0.1, None);
+            assert_eq!(list.len(), kept, "{x}");
+        }
+        // An estimate wider than the grid's reach gets no list.
+        assert!(grid.near(Vec3::new(-1.5, 0.0, 0.0), 0.2).is_none());
     }
 
     /// Photons on a 2 cm grid (offset by 1 cm, so none lies on the divider) over the floor

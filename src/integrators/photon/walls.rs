@@ -40,9 +40,9 @@
 //!   explains (a step), costs one segment test. The argument holds for each query point within
 //!   distance `ρ` of the photon whatever the disc's radius (the ball's radius and the lift only
 //!   depend on that distance), so a mark made for radius `ρ` clears the photon for every query
-//!   point within `ρ` of it. An estimate tests all its segments against one list of the
-//!   potential walls in their box ([`super::wall_list`]), or, when that list cannot decide, by
-//!   rays ([`separated`]).
+//!   point within `ρ` of it. An estimate tests its segments against the list of the potential
+//!   walls of its cell of the map's grid ([`super::wall_grid`], [`super::wall_list`]), or,
+//!   where that list cannot decide, by rays ([`separated`]).
 //!
 //! What is not resolved: a partition in the same mesh as the floor is not a wall to the floor's
 //! points; a surface parallel to the receiver is never a wall, so photons on a
@@ -110,11 +110,23 @@ impl<'a> Walls<'a> {
         !own && self.can_block_any(object)
     }
 
-    /// [`Walls::can_block`] for the wall list of one estimate
-    /// ([`super::wall_list::WallList`]).
+    /// [`Walls::can_block_any`] for the wall grid ([`super::wall_grid::WallGrid`]).
     #[inline]
-    pub(super) fn can_block_object(&self, object: u32) -> bool {
-        self.can_block(object)
+    pub(super) fn can_block_any_object(&self, object: u32) -> bool {
+        self.can_block_any(object)
+    }
+
+    /// The body object `object` belongs to ([`RenderScene::body_of`]; the object itself
+    /// without a scene): what [`Walls::can_block`] compares with the query's.
+    #[inline]
+    pub(super) fn body_of(&self, object: u32) -> u32 {
+        self.scene.map_or(object, |s| s.body_of(object))
+    }
+
+    /// The query point's body (`None`: not on an object of the scene).
+    #[inline]
+    pub(super) fn own_body(&self) -> Option<u32> {
+        self.object.map(|q| self.body_of(q))
     }
 
     /// Whether a surface of object `object` can be a wall to some query point (opaque).

@@ -1,0 +1,315 @@
+//! The potential walls of every region of a scene, listed once per photon map (issue 47, the
+//! cost of the wall test): a coarse grid whose every cell lists the opaque surfaces within the
+//! reach of the map's widest estimate, so that an estimate takes its cell's list instead of a
+//! BVH region query.
+//!
+//! **Why.** The geometry does not change between estimates: the walls near a query point are
+//! the same for every estimate around it. Collecting them per estimate with a BVH region query
+//! cost the bath ~340 M instructions (105 000 estimates looking at 33 triangles each, ~76
+//! instructions a triangle) of its ~820 M for the wall test.
+//!
+//! **What a cell lists.** Every segment an estimate of radius `r` around `q` tests (the lifted
+//! ends of [`walls::segment`]: `q` lifted by at most `11 τ + r/4`, a photon within `r` of `q`
+//! lifted as much) lies within [`estimate_reach`]`(q, r) = 1.2501 r + 12 τ(q)` of `q`
+//! ([`walls::tolerance`] grows by at most `64 ε r` between `q` and the photon, which the
+//! `0.0001 r` covers while `r` is below ten times the scene's size). So a surface that crosses
+//! such a segment meets the box of `q`'s cell grown by that reach. A cell of a grid built for
+//! reach `R` lists every wall candidate whose bounds meet its box grown by `R` (plus the
+//! rounding tolerance of the scene's coordinates): an estimate whose reach is at most `R` and
+//! whose point lies in the grid finds in its cell every surface that could separate it from a
+//! photon. The candidates ([`Wall`]) are the scene's opaque surfaces
+//! ([`Walls`](super::walls::Walls): the surfaces of transmitting materials are no walls):
+//!
+//! - the triangles of objects of at most [`SMALL_OBJECT`] triangles (quads, cubes, the bath's
+//!   tub and room), each with its unit normal, plane offset and bounds, so that a segment is
+//!   tested against it directly ([`super::wall_list::WallList::crosses`]);
+//! - every larger object (a mesh: the duck, the boat, the faucet) and every sphere, ellipsoid
+//!   and quadric as its bounds alone: a segment whose box meets them is decided by a ray
+//!   ([`walls::separated`]), as every segment was before the lists.
+//!
+//! A cell listing more than [`MAX_PER_CELL`] candidates lists none and says so: its estimates
+//! trace a ray per tested photon. The grid's cells are at least the reach wide and at most
+//! [`MAX_CELLS_PER_AXIS`] a side, and a grid whose build would test more than [`MAX_BUILD_TESTS`]
+//! cell–candidate pairs is not built (every estimate then traces rays): its cost is bounded by a
+//! few milliseconds per map whatever the scene.
+//!
+//! The lists depend only on the geometry and the reach, so the decisions do not depend on the
+//! order of estimates or the thread count.
+
+use glam::{DVec3, Vec3};
+
+use super::walls::{self, Walls};
+use crate::geometry::Aabb;
+use crate::render_scene::Geometry;
+
+/// Objects of at most this many triangles are listed triangle by triangle; larger ones (meshes)
+/// by their bounds, decided by a ray where a segment meets them.
+pub const SMALL_OBJECT: usize = 64;
+
+/// Most candidates a cell lists; a cell with more lists none (its estimates trace rays).
+pub const MAX_PER_CELL: usize = 96;
+
+/// Most cells along each axis of a grid (cells are widened to keep within it).
+pub const MAX_CELLS_PER_AXIS: f32 = 24.0;
+
+/// Most cell–candidate box tests a grid's build may make (~10 instructions each); a scene that
+/// would need more gets no grid.
+pub const MAX_BUILD_TESTS: usize = 1 << 21;
+
+/// What a wall candidate is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WallKind {
+    /// One triangle, tested exactly.
+    Triangle,
+    /// A mesh of more than [`SMALL_OBJECT`] triangles, or a sphere, ellipsoid or quadric: known
+    /// by its bounds; a segment whose box meets them is decided by a ray.
+    Bounds,
+}
+
+/// One opaque surface that can separate a query point from a photon.
+#[derive(Debug, Clone, Copy)]
+pub struct Wall {
+    /// Triangle or bounds only.
+    pub kind: WallKind,
+    /// A triangle's corners (zero for bounds).
+    pub corners: [Vec3; 3],
+    /// A triangle's unit normal, as a hit on it reports it (zero for bounds).
+    pub ng: Vec3,
+    /// A triangle's plane offset `ng · corners[0]`.
+    pub offset: f32,
+    /// Its bounds.
+    pub bounds: Aabb,
+    /// The body it belongs to ([`crate::render_scene::RenderScene::body_of`]; its object
+    /// without a scene): never a wall to a query point of the same body.
+    pub body: u32,
+}
+
+/// The wall candidates of every cell of a coarse grid over the scene, for estimates of reach up
+/// to [`WallGrid::reach`] (module docs).
+#[derive(Debug)]
+pub struct WallGrid {
+    /// Lowest corner of the grid (the scene's bounds' lowest corner).
+    origin: Vec3,
+    /// Cell side (scene units).
+    side: f32,
+    /// Cells along x, y, z.
+    dims: [usize; 3],
+    /// The reach the lists hold for (scene units).
+    reach: f32,
+    /// How far outside its cell a point may lie and still take its cell's list: the rounding
+    /// tolerance of the scene's coordinates.
+    slack: f32,
+    /// Per cell, the range of its candidates in `entries`, or `None` when it has too many.
+    cells: Vec<Option<(u32, u32)>>,
+    /// Indices into `walls`, cell after cell.
+    entries: Vec<u32>,
+    /// Every candidate.
+    walls: Vec<Wall>,
+}
+
+impl WallGrid {
+    /// The grid of `walls`' opaque surfaces for estimates of reach up to `reach` (scene units;
+    /// [`estimate_reach`] of the widest estimate). `None` when the scene has no finite bounds,
+    /// `reach` is not a positive finite number, or the build would cost more than
+    /// [`MAX_BUILD_TESTS`] box tests.
+    #[must_use]
+    pub fn build(walls: &Walls<'_>, reach: f32) -> Option<Self> {
+        let geometry = walls.geometry();
+        let bounds = geometry.bvh.bounds;
+        let extent = bounds.max - bounds.min;
+        if !(reach.is_finite() && reach > 0.0) || !extent.is_finite() || extent.min_element() < 0.0
+        {
+            return None;
+        }
+        let candidates = candidates(walls, geometry);
+        let side = reach.max(extent.max_element() / MAX_CELLS_PER_AXIS);
+        let dims = extent
+            .to_array()
+            .map(|e| ((e / side).ceil() as usize).clamp(1, MAX_CELLS_PER_AXIS as usize + 1));
+        let count = dims[0] * dims[1] * dims[2];
+        if count.saturating_mul(candidates.len()) > MAX_BUILD_TESTS {
+            return None;
+        }
+        let slack = walls::tolerance(bounds.min.abs().max(bounds.max.abs()));
+        let grow = Vec3::splat(reach + 2.0 * slack);
+        let mut cells = Vec::with_capacity(count);
+        let mut entries = Vec::new();
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    let lo = bounds.min + side * Vec3::new(x as f32, y as f32, z as f32);
+                    let cell = Aabb {
+                        min: lo - grow,
+                        max: lo + Vec3::splat(side) + grow,
+                    };
+                    let start = entries.len();
+                    entries.extend(
+                        (0..candidates.len() as u32)
+                            .filter(|&i| overlaps(&candidates[i as usize].bounds, &cell)),
+                    );
+                    if entries.len() - start > MAX_PER_CELL {
+                        entries.truncate(start);
+                        cells.push(None);
+                    } else {
+                        cells.push(Some((start as u32, entries.len() as u32)));
+                    }
+                }
+            }
+        }
+        Some(Self {
+            origin: bounds.min,
+            side,
+            dims,
+            reach,
+            slack,
+            cells,
+            entries,
+            walls: candidates,
+        })
+    }
+
+    /// The reach the lists hold for (scene units).
+    #[must_use]
+    pub fn reach(&self) -> f32 {
+        self.reach
+    }
+
+    /// The candidates of the cell holding `q` for an estimate of reach `reach`: `None` when
+    /// `reach` exceeds the grid's, `q` lies outside the grid (by more than the rounding
+    /// tolerance) or its cell has too many candidates; then a ray decides each segment.
+    #[must_use]
+    pub fn near(&self, q: Vec3, reach: f32) -> Option<impl Iterator<Item = &Wall>> {
+        if !(reach <= self.reach) {
+            return None;
+        }
+        let rel = (q - self.origin) / self.side;
+        let slack = self.slack / self.side;
+        let mut index = 0usize;
+        for axis in (0..3).rev() {
+            let (c, n) = (rel[axis], self.dims[axis]);
+            if !(c >= -slack && c <= n as f32 + slack) {
+                return None;
+            }
+            let i = (c.max(0.0) as usize).min(n - 1);
+            index = index * n + i;
+        }
+        let (start, end) = (*self.cells.get(index)?)?;
+        let entries = self.entries.get(start as usize..end as usize)?;
+        Some(entries.iter().filter_map(|&i| self.walls.get(i as usize)))
+    }
+
+    /// Number of cells.
+    #[must_use]
+    pub fn cell_count(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// Bytes held.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        self.cells.len() * std::mem::size_of::<Option<(u32, u32)>>()
+            + self.entries.len() * 4
+            + self.walls.len() * std::mem::size_of::<Wall>()
+    }
+}
+
+/// The reach of an estimate of radius `r` around `q`: every segment it tests lies within it of
+/// `q` (module docs).
+#[inline]
+#[must_use]
+pub fn estimate_reach(q: Vec3, r: f32) -> f32 {
+    1.2501 * r + 12.0 * walls::tolerance(q)
+}
+
+/// Every opaque surface of `walls`' geometry as a wall candidate (module docs), in the
+/// geometry's order.
+fn candidates(walls: &Walls<'_>, geometry: &Geometry) -> Vec<Wall> {
+    let objects = geometry
+        .tri_attrs
+        .iter()
+        .map(|a| a.object as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut per_object = vec![0usize; objects];
+    for a in &geometry.tri_attrs {
+        per_object[a.object as usize] += 1;
+    }
+    let mut big: Vec<Option<Aabb>> = vec![None; objects];
+    let mut out = Vec::new();
+    for (t, a) in geometry.triangles.iter().zip(&geometry.tri_attrs) {
+        if !walls.can_block_any_object(a.object) {
+            continue;
+        }
+        let bounds = Aabb::from_points(t);
+        if per_object[a.object as usize] > SMALL_OBJECT {
+            let b = &mut big[a.object as usize];
+            *b = Some(b.map_or(bounds, |b| b.union(bounds)));
+            continue;
+        }
+        let ng = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+        // A degenerate triangle (NaN normal) is never hit.
+        if !ng.is_finite() {
+            continue;
+        }
+        out.push(Wall {
+            kind: WallKind::Triangle,
+            corners: *t,
+            ng,
+            offset: ng.dot(t[0]),
+            bounds,
+            body: walls.body_of(a.object),
+        });
+    }
+    let solid = |bounds: Aabb, object: u32| Wall {
+        kind: WallKind::Bounds,
+        corners: [Vec3::ZERO; 3],
+        ng: Vec3::ZERO,
+        offset: 0.0,
+        bounds,
+        body: walls.body_of(object),
+    };
+    for (object, b) in big.iter().enumerate() {
+        if let Some(b) = b {
+            out.push(solid(*b, object as u32));
+        }
+    }
+    for s in &geometry.spheres {
+        if walls.can_block_any_object(s.object) {
+            let r = Vec3::splat(s.radius * (1.0 + 1e-6) + walls::tolerance(s.center));
+            out.push(solid(
+                Aabb {
+                    min: s.center - r,
+                    max: s.center + r,
+                },
+                s.object,
+            ));
+        }
+    }
+    for e in &geometry.ellipsoids {
+        if walls.can_block_any_object(e.object) {
+            let l = e.world_from_object.matrix3;
+            let half = DVec3::new(l.row(0).length(), l.row(1).length(), l.row(2).length());
+            let c = e.world_from_object.translation;
+            let pad = Vec3::splat(walls::tolerance((c.abs() + half).as_vec3()));
+            out.push(solid(
+                Aabb {
+                    min: (c - half).as_vec3() - pad,
+                    max: (c + half).as_vec3() + pad,
+                },
+                e.object,
+            ));
+        }
+    }
+    for q in &geometry.quadrics {
+        if walls.can_block_any_object(q.object) {
+            out.push(solid(q.bounds(), q.object));
+        }
+    }
+    out
+}
+
+/// Whether boxes `a` and `b` share a point.
+#[inline]
+pub(super) fn overlaps(a: &Aabb, b: &Aabb) -> bool {
+    a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
+}
