@@ -29,13 +29,14 @@
 //! thread count.
 
 use glam::Vec3;
+use wide::f32x8;
 
-use super::wall_grid::{Wall, WallKind, overlaps};
+use super::wall_grid::{LANES, Wall, WallGrid, WallKind};
 use super::walls::{self, PARALLEL_COSINE};
+use crate::geometry::Ray;
 use crate::geometry::triangle::{TriRay, intersect_triangle};
-use crate::geometry::{Aabb, Ray};
 
-/// How a segment meets an estimate's wall list ([`WallList::crosses`]).
+/// How a segment meets an estimate's wall list ([`CellList::crosses`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Crossing {
     /// It crosses a listed triangle that stands across both ends' surfaces: a wall.
@@ -46,99 +47,96 @@ pub enum Crossing {
     Unknown,
 }
 
-/// The candidates that can be a wall to one estimate's segments (module docs). Reused by each
-/// worker (no allocation per estimate once it has grown).
-#[derive(Debug, Default)]
-pub struct WallList {
-    listed: Vec<Wall>,
+/// The wall candidates of one estimate: its query point's cell of the map's [`WallGrid`]
+/// ([`WallGrid::near`]). A view; nothing is copied per estimate.
+#[derive(Debug, Clone, Copy)]
+pub struct CellList<'a> {
+    pub(super) grid: &'a WallGrid,
+    /// The cell's slots in the grid's arrays.
+    pub(super) start: usize,
+    pub(super) end: usize,
 }
 
-impl WallList {
-    /// Fills the list with the candidates `near` (the query's cell of a [`super::wall_grid::WallGrid`])
-    /// whose bounds meet the cube of half-side `reach` around the query point `q`, that are
-    /// not of the query's body `own`, and, for triangles, whose unit normal has a cosine of at
-    /// most [`PARALLEL_COSINE`] with the query's normal `nq` (either orientation).
-    pub fn fill<'w>(
-        &mut self,
-        near: impl Iterator<Item = &'w Wall>,
-        q: Vec3,
-        nq: Vec3,
-        reach: f32,
-        own: Option<u32>,
-    ) {
-        self.listed.clear();
-        let disc = Aabb {
-            min: q - Vec3::splat(reach),
-            max: q + Vec3::splat(reach),
-        };
-        self.listed.extend(
-            near.filter(|w| {
-                Some(w.body) != own
-                    && overlaps(&w.bounds, &disc)
-                    && (w.kind == WallKind::Bounds || w.ng.dot(nq).abs() <= PARALLEL_COSINE)
-            })
-            .copied(),
-        );
+impl<'a> CellList<'a> {
+    /// The cell's candidates.
+    pub fn walls(&self) -> impl Iterator<Item = &'a Wall> {
+        let grid = self.grid;
+        grid.slot
+            .get(self.start..self.end)
+            .unwrap_or_default()
+            .iter()
+            .filter_map(move |&i| grid.walls.get(i as usize))
     }
 
-    /// Number of candidates listed.
+    /// Whether the segment from `a` to `b` (the lifted ends of [`walls::segment`] between a
+    /// query point of unit normal `nq` on body `own` and a photon of unit normal `np`) crosses
+    /// a candidate triangle of another body whose normal has a cosine of at most
+    /// [`PARALLEL_COSINE`] with both normals ([`Crossing::Wall`]), or its box meets a candidate
+    /// of another body known by its bounds only ([`Crossing::Unknown`]). The candidates' boxes
+    /// are tested [`LANES`] at once against the segment's; the few that meet it get the
+    /// normal tests, a plane-side test and the BVH's own watertight triangle test
+    /// ([`intersect_triangle`]).
     #[must_use]
-    pub fn len(&self) -> usize {
-        self.listed.len()
-    }
-
-    /// True when nothing is listed: no segment of the estimate can be separated.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.listed.is_empty()
-    }
-
-    /// Whether the segment from `a` to `b` (the lifted ends of [`walls::segment`], within the
-    /// reach the list was filled for) crosses a listed triangle whose normal also has a cosine
-    /// of at most [`PARALLEL_COSINE`] with the photon's unit normal `np` ([`Crossing::Wall`]),
-    /// or its box meets a candidate known by its bounds only ([`Crossing::Unknown`]).
-    #[must_use]
-    pub fn crosses(&self, a: Vec3, b: Vec3, np: Vec3) -> Crossing {
+    pub fn crosses(&self, a: Vec3, b: Vec3, nq: Vec3, np: Vec3, own: Option<u32>) -> Crossing {
         let ray = Ray {
             origin: a,
             dir: b - a,
             t_max: 1.0,
         };
-        if self.listed.is_empty() || !ray.is_valid() {
+        if !ray.is_valid() {
             return Crossing::Clear;
         }
         // Ends farther than this on one side of a plane: the watertight test cannot hit it
         // (its rounding is a few ulps of the coordinates, this is 64).
         let margin = walls::tolerance(a.abs().max(b.abs()));
-        let seg = Aabb {
-            min: a.min(b) - Vec3::splat(margin),
-            max: a.max(b) + Vec3::splat(margin),
-        };
-        let tri_ray = TriRay::new(&ray);
+        let (lo, hi) = (
+            a.min(b) - Vec3::splat(margin),
+            a.max(b) + Vec3::splat(margin),
+        );
+        let g = self.grid;
+        let load =
+            |v: &[f32x8], i: usize| v.get(i / LANES).copied().unwrap_or(f32x8::splat(f32::NAN));
+        let (lx, ly, lz) = (f32x8::splat(lo.x), f32x8::splat(lo.y), f32x8::splat(lo.z));
+        let (hx, hy, hz) = (f32x8::splat(hi.x), f32x8::splat(hi.y), f32x8::splat(hi.z));
+        let mut tri_ray = None;
         let mut unknown = false;
-        for w in &self.listed {
-            if !overlaps(&w.bounds, &seg) {
-                continue;
-            }
-            match w.kind {
-                WallKind::Bounds => unknown = true,
-                WallKind::Triangle => {
-                    let (sa, sb) = (w.ng.dot(a) - w.offset, w.ng.dot(b) - w.offset);
-                    if w.ng.dot(np).abs() <= PARALLEL_COSINE
-                        && !((sa > margin && sb > margin) || (sa < -margin && sb < -margin))
-                        && intersect_triangle(
-                            &tri_ray,
-                            w.corners[0],
-                            w.corners[1],
-                            w.corners[2],
-                            1.0,
-                        )
-                        .is_some()
-                    {
-                        return Crossing::Wall;
+        let mut i = self.start;
+        while i < self.end {
+            // Boxes sharing a point with the segment's (padding and NaN lanes never do).
+            let meets = load(&g.lo[0], i).simd_le(hx)
+                & load(&g.lo[1], i).simd_le(hy)
+                & load(&g.lo[2], i).simd_le(hz)
+                & lx.simd_le(load(&g.hi[0], i))
+                & ly.simd_le(load(&g.hi[1], i))
+                & lz.simd_le(load(&g.hi[2], i));
+            let mut hits = meets.to_bitmask();
+            while hits != 0 {
+                let lane = hits.trailing_zeros() as usize;
+                hits &= hits - 1;
+                let Some(w) = g.slot.get(i + lane).and_then(|&k| g.walls.get(k as usize)) else {
+                    continue;
+                };
+                if Some(w.body) == own {
+                    continue;
+                }
+                match w.kind {
+                    WallKind::Bounds => unknown = true,
+                    WallKind::Triangle => {
+                        let (sa, sb) = (w.ng.dot(a) - w.offset, w.ng.dot(b) - w.offset);
+                        if w.ng.dot(nq).abs() <= PARALLEL_COSINE
+                            && w.ng.dot(np).abs() <= PARALLEL_COSINE
+                            && !((sa > margin && sb > margin) || (sa < -margin && sb < -margin))
+                        {
+                            let tri_ray = tri_ray.get_or_insert_with(|| TriRay::new(&ray));
+                            let [c0, c1, c2] = w.corners;
+                            if intersect_triangle(tri_ray, c0, c1, c2, 1.0).is_some() {
+                                return Crossing::Wall;
+                            }
+                        }
                     }
                 }
             }
+            i += LANES;
         }
         if unknown {
             Crossing::Unknown
@@ -251,15 +249,13 @@ mod tests {
         let grid_reach = 1.2501 * radius + 12.0 * tolerance(Vec3::splat(2.2));
         let grid = WallGrid::build(&walls, grid_reach).expect("grid");
         let mut rng = Rng::new(3, 5);
-        let mut list = WallList::default();
         let (mut hidden, mut seen) = (0, 0);
         for i in 0..200 {
             let (u, v) = rng.next_2d();
             let centre = if i % 2 == 0 { -0.05 } else { -0.49 };
             let q = Vec3::new(centre + 0.2 * (u - 0.5), 0.0, 0.2 * (v - 0.5));
             let reach = estimate_reach(q, radius);
-            let near = grid.near(q, reach).expect("a cell with a list");
-            list.fill(near, q, Vec3::Y, reach, None);
+            let list = grid.near(q, reach).expect("a cell with a list");
             for j in 0..8 {
                 let (a, b) = rng.next_2d();
                 let on_top = j == 0 && i % 2 == 1;
@@ -272,7 +268,8 @@ mod tests {
                     )
                 };
                 let by_ray = separated(&walls, q, Vec3::Y, p, np);
-                let by_list = segment(q, Vec3::Y, p, np).map(|(a, b)| list.crosses(a, b, np));
+                let by_list =
+                    segment(q, Vec3::Y, p, np).map(|(a, b)| list.crosses(a, b, Vec3::Y, np, None));
                 assert_ne!(by_list, Some(Crossing::Unknown), "{q} {p}");
                 assert_eq!(by_list == Some(Crossing::Wall), by_ray, "{q} {p}");
                 hidden += usize::from(by_ray);
@@ -295,13 +292,30 @@ mod tests {
         let g = rooms();
         let walls = Walls::every_surface(&g);
         let grid = WallGrid::build(&walls, 0.1).expect("grid");
-        let mut list = WallList::default();
-        for (x, cell, kept) in [(-1.5f32, 2, 0), (-0.05, 4, 2), (-0.2, 2, 0), (-0.45, 12, 8)] {
+        for (x, cell, across) in [(-1.5f32, 2, 0), (-0.05, 4, 2), (-0.2, 2, 0), (-0.45, 12, 8)] {
             let q = Vec3::new(x, 0.0, 0.0);
-            let near: Vec<&Wall> = grid.near(q, 0.05).expect("a list").collect();
-            assert_eq!(near.len(), cell, "{x}");
-            list.fill(near.into_iter(), q, Vec3::Y, 0.1, None);
-            assert_eq!(list.len(), kept, "{x}");
+            let list = grid.near(q, 0.05).expect("a list");
+            assert_eq!(list.walls().count(), cell, "{x}");
+            let standing = list
+                .walls()
+                .filter(|w| w.kind == WallKind::Triangle && w.ng.dot(Vec3::Y).abs() <= 0.9)
+                .count();
+            assert_eq!(standing, across, "{x}");
+        }
+        // Across the divider from x = -0.05, a wall; along the floor, none.
+        let q = Vec3::new(-0.05, 0.0, 0.0);
+        let list = grid.near(q, 0.1).expect("a list");
+        for (p, hidden) in [
+            (Vec3::new(0.03, 0.0, 0.01), true),
+            (Vec3::new(-0.12, 0.0, 0.05), false),
+        ] {
+            let (a, b) = segment(q, Vec3::Y, p, Vec3::Y).expect("a segment");
+            let expected = if hidden {
+                Crossing::Wall
+            } else {
+                Crossing::Clear
+            };
+            assert_eq!(list.crosses(a, b, Vec3::Y, Vec3::Y, None), expected, "{p}");
         }
         // An estimate wider than the grid's reach gets no list.
         assert!(grid.near(Vec3::new(-1.5, 0.0, 0.0), 0.2).is_none());
