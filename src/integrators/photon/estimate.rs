@@ -59,8 +59,8 @@ use glam::Vec3;
 
 use super::discs::PhotonDiscs;
 use super::radius_field::RadiusField;
-use super::wall_grid::{WallGrid, estimate_reach};
-use super::wall_list::{CellList, Crossing};
+use super::wall_grid::{CellList, WallGrid, estimate_reach};
+use super::wall_list::Crossing;
 use super::walls::{self, Walls};
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
 use crate::spatial::{HasPosition, HashGrid, KdTree, KnnHeap, Photon};

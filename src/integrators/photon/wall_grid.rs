@@ -41,7 +41,6 @@
 use glam::{DVec3, Vec3};
 use wide::f32x8;
 
-use super::wall_list::CellList;
 use super::walls::{self, Walls};
 use crate::geometry::Aabb;
 use crate::render_scene::Geometry;
@@ -254,6 +253,18 @@ impl WallGrid {
             + self.slot.len() * 28
             + self.walls.len() * std::mem::size_of::<Wall>()
     }
+}
+
+/// The wall candidates of one estimate: its query point's cell of the map's [`WallGrid`]
+/// ([`WallGrid::near`]), tested by `CellList::crosses` (`wall_list.rs`). A view; nothing is
+/// copied per estimate.
+#[derive(Debug, Clone, Copy)]
+pub struct CellList<'a> {
+    pub(super) grid: &'a WallGrid,
+    /// The cell's first slot in the grid's arrays.
+    pub(super) start: usize,
+    /// One past the cell's last slot.
+    pub(super) end: usize,
 }
 
 /// The reach of an estimate of radius `r` around `q`: every segment it tests lies within it of
