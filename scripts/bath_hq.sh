@@ -13,9 +13,9 @@ cd "$(dirname "$0")/.."
 spp=${1:-128}
 source scripts/caustic_bin.sh
 out=docs/images/bath_hq.png
-echo "caustic render scenes/bath.ron --spp $spp -o $out"
+echo "caustic render scenes/bath.ron --spp $spp --no-denoise -o $out"
 start=$(date +%s.%N)
-"$caustic" render scenes/bath.ron --spp "$spp" -o "$out"
+"$caustic" render scenes/bath.ron --spp "$spp" --no-denoise -o "$out"
 end=$(date +%s.%N)
 cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo 2>/dev/null | head -n 1)
 echo "wall time $(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.1f", b - a }') s (loading and photon tracing included) on $(nproc) threads of ${cpu:-an unknown CPU}, $(date +'%-d %B %Y')"

@@ -32,7 +32,7 @@ while read -r file args; do
     found=$((found + named))
   fi
   echo "caustic render ${argv[*]} -o docs/images/$file"
-  "$caustic" render "${argv[@]}" -o "docs/images/$file" --quiet
+  "$caustic" render "${argv[@]}" -o "docs/images/$file" --quiet --no-denoise
   if [ "${#files[@]}" -gt 1 ]; then echo "  and its layers: ${files[*]:1}"; fi
 done <"$manifest"
 if [ $# -gt 0 ] && [ "$found" -ne $# ]; then

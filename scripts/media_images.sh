@@ -19,10 +19,10 @@ render() {
   local name=$1
   shift
   local out="docs/images/$name.png"
-  echo "caustic render benches/scenes/$name.ron $* -o $out"
+  echo "caustic render benches/scenes/$name.ron $* --no-denoise -o $out"
   local start end
   start=$(date +%s.%N)
-  "$caustic" render "benches/scenes/$name.ron" "$@" -o "$out"
+  "$caustic" render "benches/scenes/$name.ron" "$@" --no-denoise -o "$out"
   end=$(date +%s.%N)
   echo "wall time $(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.1f", b - a }') s on $(nproc) threads of ${cpu:-an unknown CPU}, $(date -u +'%-d %B %Y %H:%M UTC')"
 }

@@ -38,11 +38,15 @@ PY
 fi
 bin=$1; out=$2; mkdir -p "$out"
 W=40; H=30
+# The raw estimate in every PNG: binaries since the default denoising take `--no-denoise`
+# (older ones wrote it raw anyway), so old and new binaries compare like with like.
+raw=()
+if "$bin" render --help 2>/dev/null | grep -q -- --no-denoise; then raw=(--no-denoise); fi
 for scene in scenes/*.ron scenes/*.toml; do
   s=$(basename "$scene"); s=${s%.*}_${scene##*.}
   for integ in whitted path photon ppm path-ppm; do
     common=(--width $W --height $H --spp 2 --seed 7 --threads 2 --quiet --integrator $integ)
-    "$bin" render "$scene" "${common[@]}" -o "$out/$s.$integ.png"
+    "$bin" render "$scene" "${common[@]}" "${raw[@]}" -o "$out/$s.$integ.png"
     "$bin" render "$scene" "${common[@]}" -o "$out/$s.$integ.exr"
     "$bin" render "$scene" "${common[@]}" -o "$out/$s.$integ.part"
     "$bin" render "$scene" "${common[@]}" --layers all -o "$out/$s.$integ.layers.exr"

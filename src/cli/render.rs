@@ -12,7 +12,7 @@ use clap::Args;
 
 use caustic::Error;
 pub(super) use caustic::pipeline::render::{BUDGET_SPP_CAP, is_part, output_shard};
-use caustic::pipeline::render::{RenderNote, RenderRequest};
+use caustic::pipeline::render::{NOT_8_BIT, RenderNote, RenderRequest};
 use caustic::render::output::OutputFormat;
 use caustic::render::{Layer, Region};
 
@@ -54,7 +54,8 @@ pub struct RenderArgs {
     pub(super) checkpoint: Option<PathBuf>,
     /// After writing the image, compare it with this reference (PNG or EXR; for a `--region`
     /// render the reference may be the whole image or the crop) and print RMSE, relMSE, mean
-    /// absolute error and bias.
+    /// absolute error and bias. The raw estimate is written and scored (a PNG is not denoised
+    /// by default with it), unless `--denoise` asks for the denoised image.
     #[arg(long, value_name = "REF")]
     pub(super) compare: Option<PathBuf>,
     /// With `--compare`: a golden-image check: exit with code 3 (the image is still written)
@@ -98,9 +99,15 @@ pub struct RenderArgs {
     /// render is taken in two halves of its samples per pixel (at least 2) and albedo, normal
     /// and depth are traced beside it. A `.png` output is the denoised image; an `.exr` holds
     /// the denoised image and the noisy one as the `noisy` layer. Not with `--time` (the
-    /// halves need the samples per pixel in advance) or a `.part` output.
-    #[arg(long, conflicts_with_all = ["time", "shard"])]
+    /// halves need the samples per pixel in advance) or a `.part` output. A `.png` of the whole
+    /// frame at a stated sample count is denoised by default (`--no-denoise` turns it off);
+    /// this flag asks for it everywhere else it can apply.
+    #[arg(long, conflicts_with_all = ["time", "shard", "no_denoise"])]
     pub(super) denoise: bool,
+    /// Write the raw estimate: no default denoising of a `.png` (docs/denoise.md). Golden
+    /// checks, `--compare` (unless with `--denoise`) and the layers use the raw one anyway.
+    #[arg(long)]
+    pub(super) no_denoise: bool,
     /// Linear scale of radiance for 8-bit images (`render.exposure`). Unset, and not in the
     /// scene: chosen from the rendered image (Reinhard et al.'s key 0.18 over the log-average
     /// luminance, lowered so at most 1 % of the pixels clip); the summary prints it. EXR and
@@ -306,12 +313,23 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         samples: args.samples.clone(),
         layers,
         denoise: args.denoise,
+        // `--compare` scores the raw estimate unless `--denoise` asks for the denoised one.
+        auto_denoise: !args.no_denoise && reference.is_none(),
         exposure: args.exposure,
         target_error: args.target_error,
         adaptive: args.adaptive,
         progress: !args.quiet && std::io::stderr().is_terminal(),
     };
     let prepared = request.prepare()?;
+    let compare_keeps_raw = reference.is_some()
+        && !args.no_denoise
+        && !args.denoise
+        && matches!(
+            OutputFormat::for_path(&request.output),
+            Ok(OutputFormat::Png)
+        )
+        && prepared.auto_denoise_skipped().is_none()
+        && request.region.is_none();
     if !args.quiet {
         print_warnings(&prepared.prepared.warnings);
     }
@@ -322,6 +340,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         let p = &prepared.prepared.render_scene.params;
         super::max_rmse::check_size(reference, p.width, p.height, region)?;
     }
+    // Why a PNG was left raw: said with the summary, after the render.
+    let not_denoised = match prepared.auto_denoise_skipped() {
+        Some(why) if why != NOT_8_BIT => Some(why),
+        _ if compare_keeps_raw => Some("--compare (it scores the raw estimate)"),
+        _ => None,
+    }
+    .map(|why| format!("not denoised: {why} (a PNG is denoised by default only for the whole frame at a stated --spp; docs/denoise.md)"));
     let started = prepared.start(interrupt.start_rendering())?;
     if !args.quiet {
         // The scene and the command line named no integrator: which one, and why.
@@ -348,7 +373,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
                 "features: albedo, normal and depth traced in {:.2} s",
                 t.as_secs_f64()
             ),
-            RenderNote::Denoised(t) => eprintln!("denoised in {:.2} s", t.as_secs_f64()),
+            RenderNote::Denoised(t) if args.denoise => {
+                eprintln!("denoised in {:.2} s", t.as_secs_f64());
+            }
+            RenderNote::Denoised(t) => eprintln!(
+                "denoised in {:.2} s (the default for a PNG; --no-denoise writes the raw estimate)",
+                t.as_secs_f64()
+            ),
             RenderNote::CheckpointKept(cp, e) => eprintln!(
                 "warning: cannot remove the checkpoint `{}`: {e}",
                 cp.display()
@@ -369,6 +400,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
                 format!("layers: {}", names.join(", "))
             }),
             rendered.photons_summary(),
+            not_denoised,
         ];
         for line in said.into_iter().flatten() {
             eprintln!("{line}");

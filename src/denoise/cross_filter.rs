@@ -67,7 +67,7 @@ impl LayerPlanes {
             values
                 .iter()
                 .zip(&demodulate[ch])
-                .map(|(v, a)| v[ch] / a.powi(power))
+                .map(|(v, a)| v[ch] / if power == 2 { a * a } else { *a })
                 .collect()
         };
         let half =
@@ -325,8 +325,8 @@ pub fn cross_filter(
     })
 }
 
-/// Adds the colour distance of the pixels of `row` (row `y`) to those `dx, dy` away, in the
-/// guiding half's planes `c`, `v`, for the columns `xs` (all of whose neighbours are inside).
+/// Writes the colour distance of the pixels of `row` (`len` of them, from `p_at`) to those from
+/// `q_at` on, in the guiding half's planes `c`, `v`: the sum over the channels.
 #[inline]
 fn colour_distance(
     c: &[Vec<f32>; 3],
@@ -342,10 +342,234 @@ fn colour_distance(
         // Indexed over slices of one length (no bounds checks): vectorises, where the
         // five-way zip ran scalar.
         let row = &mut row[..len];
-        for i in 0..len {
-            let (t, va, vb) = (yp[i] - yq[i], vp[i], vq[i]);
-            row[i] += (t * t - (va + va.min(vb))) / (EPS + va + vb);
+        if ch == 0 {
+            for i in 0..len {
+                let (t, va, vb) = (yp[i] - yq[i], vp[i], vq[i]);
+                row[i] = (t * t - (va + va.min(vb))) / (EPS + va + vb);
+            }
+        } else {
+            for i in 0..len {
+                let (t, va, vb) = (yp[i] - yq[i], vp[i], vq[i]);
+                row[i] += (t * t - (va + va.min(vb))) / (EPS + va + vb);
+            }
         }
+    }
+}
+
+/// Candidates whose weights are computed together: `exp(−d/k²)` for a bandwidth `k` is
+/// `exp(−d/(2k)²)` to the fourth power, so of three candidates `4k, 2k, k` only the widest
+/// needs an exponential, the others two multiplies each.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Chain {
+    /// One candidate, its own exponential.
+    One(usize),
+    /// Candidates of bandwidths `k, k/2, k/4` (exactly), the widest first.
+    Three([usize; 3]),
+}
+
+/// The candidates of bandwidths `k` grouped into [`Chain`]s, from the widest.
+fn chains(k: &[f32]) -> Vec<Chain> {
+    let mut order: Vec<usize> = (0..k.len()).collect();
+    order.sort_by(|&a, &b| k[b].total_cmp(&k[a]));
+    let mut used = vec![false; k.len()];
+    let mut out = Vec::new();
+    for &top in &order {
+        if used[top] {
+            continue;
+        }
+        let half_of = |i: usize| (0..k.len()).find(|&j| !used[j] && j != i && 2.0 * k[j] == k[i]);
+        let chain = half_of(top).and_then(|mid| {
+            let low =
+                (0..k.len()).find(|&j| !used[j] && j != top && j != mid && 2.0 * k[j] == k[mid]);
+            low.map(|low| [top, mid, low])
+        });
+        match chain {
+            Some(three) => {
+                for i in three {
+                    used[i] = true;
+                }
+                out.push(Chain::Three(three));
+            }
+            None => {
+                used[top] = true;
+                out.push(Chain::One(top));
+            }
+        }
+    }
+    out
+}
+
+/// One row's inputs to the weighted sums of one half: the patch colour distances, the feature
+/// weights, the centre pixels' and the neighbours' values per channel (all of one length).
+struct Row<'a> {
+    dc: &'a [f32],
+    ef: &'a [f32],
+    cp: [&'a [f32]; 3],
+    cq: [&'a [f32]; 3],
+}
+
+/// One candidate's running sums over a row: of the weights, and of the weighted differences
+/// per channel.
+struct Sums<'a> {
+    w: &'a mut [f32],
+    a: [&'a mut [f32]; 3],
+}
+
+impl Row<'_> {
+    /// Adds the row's weights `min(exp(−d_c·inv), e_f)` and weighted differences to `s`.
+    #[inline]
+    fn add_one(&self, inv: f32, s: Sums<'_>) {
+        let [a0, a1, a2] = s.a;
+        let [p0, p1, p2] = self.cp;
+        let [q0, q1, q2] = self.cq;
+        add_one(
+            inv,
+            [self.dc, self.ef, p0, p1, p2, q0, q1, q2],
+            s.w,
+            a0,
+            a1,
+            a2,
+        );
+    }
+
+    /// [`Row::add_one`] for three candidates of `inv`, `4·inv` and `16·inv` at once (a
+    /// [`Chain::Three`]), the narrower weights by squaring the wider twice.
+    #[inline]
+    fn add_three(&self, inv: f32, s: [Sums<'_>; 3]) {
+        let [s0, s1, s2] = s;
+        let [a00, a01, a02] = s0.a;
+        let [a10, a11, a12] = s1.a;
+        let [a20, a21, a22] = s2.a;
+        let [p0, p1, p2] = self.cp;
+        let [q0, q1, q2] = self.cq;
+        add_three(
+            inv,
+            [self.dc, self.ef, p0, p1, p2, q0, q1, q2],
+            s0.w,
+            a00,
+            a01,
+            a02,
+            s1.w,
+            a10,
+            a11,
+            a12,
+            s2.w,
+            a20,
+            a21,
+            a22,
+        );
+    }
+}
+
+/// [`Row::add_one`]'s loop, every written plane a parameter of its own (see [`add_three`]).
+#[inline]
+fn add_one(
+    inv: f32,
+    r: [&[f32]; 8],
+    w: &mut [f32],
+    a0: &mut [f32],
+    a1: &mut [f32],
+    a2: &mut [f32],
+) {
+    let len = r[0].len();
+    let [dc, ef, p0, p1, p2, q0, q1, q2] = r.map(|x| &x[..len]);
+    let (w, a0, a1, a2) = (
+        &mut w[..len],
+        &mut a0[..len],
+        &mut a1[..len],
+        &mut a2[..len],
+    );
+    for i in 0..len {
+        let wt = exp_neg(dc[i] * inv).min(ef[i]);
+        w[i] += wt;
+        a0[i] += wt * (q0[i] - p0[i]);
+        a1[i] += wt * (q1[i] - p1[i]);
+        a2[i] += wt * (q2[i] - p2[i]);
+    }
+}
+
+/// [`Row::add_three`]'s loop, every plane a parameter of its own: `&mut` parameters are known
+/// not to overlap (as fields of a struct they are not, and the loop, with its 20 planes, then
+/// stayed scalar). `r`: the colour distances, the feature weights, the centre's and the
+/// neighbour's three channels.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "one plane a parameter: see the doc comment"
+)]
+#[inline]
+fn add_three(
+    inv: f32,
+    r: [&[f32]; 8],
+    w0: &mut [f32],
+    a00: &mut [f32],
+    a01: &mut [f32],
+    a02: &mut [f32],
+    w1: &mut [f32],
+    a10: &mut [f32],
+    a11: &mut [f32],
+    a12: &mut [f32],
+    w2: &mut [f32],
+    a20: &mut [f32],
+    a21: &mut [f32],
+    a22: &mut [f32],
+) {
+    let len = r[0].len();
+    let [dc, ef, p0, p1, p2, q0, q1, q2] = r.map(|x| &x[..len]);
+    let (w0, a00, a01, a02) = (
+        &mut w0[..len],
+        &mut a00[..len],
+        &mut a01[..len],
+        &mut a02[..len],
+    );
+    let (w1, a10, a11, a12) = (
+        &mut w1[..len],
+        &mut a10[..len],
+        &mut a11[..len],
+        &mut a12[..len],
+    );
+    let (w2, a20, a21, a22) = (
+        &mut w2[..len],
+        &mut a20[..len],
+        &mut a21[..len],
+        &mut a22[..len],
+    );
+    for i in 0..len {
+        let x = dc[i] * inv;
+        let e0 = exp_neg(x);
+        let sq = e0 * e0;
+        // 0 from 80 on, as exp_neg (and no subnormals).
+        let e1 = if x < 20.0 { sq * sq } else { 0.0 };
+        let sq = e1 * e1;
+        let e2 = if x < 5.0 { sq * sq } else { 0.0 };
+        let (d0, d1, d2) = (q0[i] - p0[i], q1[i] - p1[i], q2[i] - p2[i]);
+        let f = ef[i];
+        let (t0, t1, t2) = (e0.min(f), e1.min(f), e2.min(f));
+        w0[i] += t0;
+        a00[i] += t0 * d0;
+        a01[i] += t0 * d1;
+        a02[i] += t0 * d2;
+        w1[i] += t1;
+        a10[i] += t1 * d0;
+        a11[i] += t1 * d1;
+        a12[i] += t1 * d2;
+        w2[i] += t2;
+        a20[i] += t2 * d0;
+        a21[i] += t2 * d1;
+        a22[i] += t2 * d2;
+    }
+}
+
+/// The [`Sums`] of one candidate's planes `acc` (per channel) and `w`, over `len` pixels from
+/// `at`.
+fn sums<'a>(acc: &'a mut [Vec<f32>; 3], w: &'a mut [f32], at: usize, len: usize) -> Sums<'a> {
+    let [a0, a1, a2] = acc;
+    Sums {
+        w: &mut w[at..at + len],
+        a: [
+            &mut a0[at..at + len],
+            &mut a1[at..at + len],
+            &mut a2[at..at + len],
+        ],
     }
 }
 
@@ -372,7 +596,8 @@ fn filter_band(
     let mut patch = [vec![0.0f32; n], vec![0.0f32; n]];
     let mut scratch = Vec::new();
     let mut df = vec![0.0f32; w];
-    let mut wt = vec![0.0f32; w];
+    let mut ef = vec![0.0f32; w];
+    let chains = chains(&cand.k);
     let zero = || -> Deltas {
         (0..nk)
             .map(|_| std::array::from_fn(|_| vec![0.0; n]))
@@ -391,17 +616,20 @@ fn filter_band(
             // The colour distance of every pixel the band's patches cover, for each half's
             // guide (the other half).
             for (half, d) in dist.iter_mut().enumerate() {
-                d.fill(0.0);
                 let (c, v) = (&layer.c[1 - half], &layer.v[1 - half]);
                 for y in p0..p1 {
+                    // Zero where the neighbour is outside the image (the patch sums read it).
+                    let full = &mut d[(y - p0) * w..(y - p0 + 1) * w];
                     let qy = y as isize + dy;
                     if qy < 0 || qy >= h as isize {
+                        full.fill(0.0);
                         continue;
                     }
+                    full[..x0].fill(0.0);
+                    full[x1..].fill(0.0);
                     let p_at = y * w + x0;
                     let q_at = (qy as usize * w + x0) as isize + dx;
-                    let row = &mut d[(y - p0) * w + x0..(y - p0) * w + x1];
-                    colour_distance(c, v, p_at, q_at as usize, len, row);
+                    colour_distance(c, v, p_at, q_at as usize, len, &mut full[x0..x1]);
                 }
                 box_rows(d, p0, w, h, f, rows.clone(), &mut scratch, &mut patch[half]);
             }
@@ -414,30 +642,50 @@ fn filter_band(
                 let p_at = y * w + x0;
                 let q_at = ((qy as usize * w + x0) as isize + dx) as usize;
                 let b_at = (y - rows.start) * w + x0;
-                let df = &mut df[..len];
+                let (df, ef) = (&mut df[..len], &mut ef[..len]);
+                // The feature weight exp(−d_f), shared by both halves and every candidate:
+                // exp(−max(a, b)) = min(exp(−a), exp(−b)).
                 match guide {
-                    Some(g) => g.distances(p_at, q_at, steps, df),
-                    None => df.fill(0.0),
+                    Some(g) => {
+                        g.distances(p_at, q_at, steps, df);
+                        for i in 0..len {
+                            ef[i] = exp_neg(df[i]);
+                        }
+                    }
+                    None => ef.fill(1.0),
                 }
                 for half in 0..2 {
-                    let cx = &layer.c[half];
-                    let dc = &patch[half][b_at..b_at + len];
-                    for k in 0..nk {
-                        let (wt, df) = (&mut wt[..len], &df[..len]);
-                        let inv = inv_k2[k];
-                        for i in 0..len {
-                            wt[i] = exp_neg((dc[i] * inv).max(df[i]));
-                        }
-                        let s = &mut wsum[half][k][b_at..b_at + len];
-                        for i in 0..len {
-                            s[i] += wt[i];
-                        }
-                        for ch in 0..3 {
-                            let (cp, cq) = (&cx[ch][p_at..p_at + len], &cx[ch][q_at..q_at + len]);
-                            let a = &mut acc[half][k][ch][b_at..b_at + len];
-                            for i in 0..len {
-                                a[i] += wt[i] * (cq[i] - cp[i]);
+                    let c = &layer.c[half];
+                    let row = Row {
+                        dc: &patch[half][b_at..b_at + len],
+                        ef,
+                        cp: std::array::from_fn(|ch| &c[ch][p_at..p_at + len]),
+                        cq: std::array::from_fn(|ch| &c[ch][q_at..q_at + len]),
+                    };
+                    let (acc, wsum) = (&mut acc[half], &mut wsum[half]);
+                    for chain in &chains {
+                        let (ks, n) = match *chain {
+                            Chain::Three(ks) => {
+                                if let (Ok([a0, a1, a2]), Ok([w0, w1, w2])) =
+                                    (acc.get_disjoint_mut(ks), wsum.get_disjoint_mut(ks))
+                                {
+                                    row.add_three(
+                                        inv_k2[ks[0]],
+                                        [
+                                            sums(a0, w0, b_at, len),
+                                            sums(a1, w1, b_at, len),
+                                            sums(a2, w2, b_at, len),
+                                        ],
+                                    );
+                                    continue;
+                                }
+                                // (Not reached: a chain's candidates are distinct.)
+                                (ks, 3)
                             }
+                            Chain::One(k) => ([k; 3], 1),
+                        };
+                        for &k in &ks[..n] {
+                            row.add_one(inv_k2[k], sums(&mut acc[k], &mut wsum[k], b_at, len));
                         }
                     }
                 }
@@ -455,4 +703,76 @@ fn filter_band(
         }
     }
     acc
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Chain, Row, chains, sums};
+
+    /// Bandwidths in exact ratios of 2 are grouped in threes from the widest; the others
+    /// (and what is left over) stay alone.
+    #[test]
+    fn candidates_are_chained_by_exact_halves() {
+        assert_eq!(chains(&[0.5, 1.0, 2.0]), vec![Chain::Three([2, 1, 0])]);
+        assert_eq!(chains(&[0.35, 0.7, 1.4]), vec![Chain::Three([2, 1, 0])]);
+        assert_eq!(chains(&[0.5]), vec![Chain::One(0)]);
+        assert_eq!(
+            chains(&[0.5, 1.0, 3.0]),
+            vec![Chain::One(2), Chain::One(1), Chain::One(0)]
+        );
+        assert_eq!(
+            chains(&[0.25, 0.5, 1.0, 2.0]),
+            vec![Chain::Three([3, 2, 1]), Chain::One(0)]
+        );
+    }
+
+    /// The three chained weights against the library's exponential in f64:
+    /// `min(exp(−d/k²), e_f)` for each candidate, summed with the weighted differences, over
+    /// distances from negative (weight 1) to far beyond the weights' range (weight 0).
+    #[test]
+    fn chained_weights_match_the_exponential() {
+        let n = 64;
+        let dc: Vec<f32> = (0..n).map(|i| i as f32 * 0.9 - 3.0).collect();
+        let ef: Vec<f32> = (0..n).map(|i| if i % 3 == 0 { 0.2 } else { 1.0 }).collect();
+        let p: Vec<f32> = (0..n).map(|i| (i % 5) as f32 * 0.1).collect();
+        let q: Vec<f32> = (0..n).map(|i| (i % 7) as f32 * 0.3).collect();
+        let row = Row {
+            dc: &dc,
+            ef: &ef,
+            cp: [&p, &p, &p],
+            cq: [&q, &p, &q],
+        };
+        let inv = 1.0 / 12.0;
+        let mut acc: Vec<[Vec<f32>; 3]> = (0..3)
+            .map(|_| std::array::from_fn(|_| vec![0.0; n]))
+            .collect();
+        let mut w = vec![vec![0.0f32; n]; 3];
+        let (a, rest) = acc.split_at_mut(1);
+        let (b, c) = rest.split_at_mut(1);
+        let (wa, wrest) = w.split_at_mut(1);
+        let (wb, wc) = wrest.split_at_mut(1);
+        row.add_three(
+            inv,
+            [
+                sums(&mut a[0], &mut wa[0], 0, n),
+                sums(&mut b[0], &mut wb[0], 0, n),
+                sums(&mut c[0], &mut wc[0], 0, n),
+            ],
+        );
+        for (j, scale) in [1.0f64, 4.0, 16.0].into_iter().enumerate() {
+            for i in 0..n {
+                let x = f64::from(dc[i]) * f64::from(inv) * scale;
+                let want = (-x.max(0.0)).exp().min(f64::from(ef[i]));
+                let got = f64::from(w[j][i]);
+                assert!(
+                    (got - want).abs() <= 5e-4 * want || (want < 2e-35 && got == 0.0),
+                    "candidate {j}, d {}: {got} against {want}",
+                    dc[i]
+                );
+                let d = f64::from(q[i] - p[i]);
+                assert!((f64::from(acc[j][0][i]) - want * d).abs() <= 5e-4 * want * d.abs() + 1e-9);
+                assert_eq!(acc[j][1][i], 0.0);
+            }
+        }
+    }
 }

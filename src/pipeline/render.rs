@@ -37,6 +37,10 @@ use crate::settings::IntegratorKind;
 /// samples per pixel are not stated (they then only cap it).
 pub const BUDGET_SPP_CAP: u32 = 1 << 20;
 
+/// [`RenderRequest::auto_denoise_refusal`]'s reason for an EXR or `.part` output, which stays
+/// the linear estimate by design (nothing to warn about).
+pub const NOT_8_BIT: &str = "the output is not an 8-bit image";
+
 /// Why a render request is refused, or what stopped it; each text names the flag (or scene
 /// field) and what is valid. Converted into [`Error::Usage`] (and [`Error::Interrupted`]).
 #[derive(Debug, thiserror::Error)]
@@ -147,8 +151,11 @@ pub struct RenderRequest {
     pub samples: Option<Range<u32>>,
     /// The layers to write besides the image, each once.
     pub layers: Vec<Layer>,
-    /// Denoise the image (`--denoise`).
+    /// Denoise the image (`--denoise`): asked for, so refused where it cannot apply.
     pub denoise: bool,
+    /// Denoise the image when the render allows it ([`RenderRequest::auto_denoise_refusal`]
+    /// says when not): `caustic render`'s default, off with `--no-denoise`.
+    pub auto_denoise: bool,
     /// Linear exposure for 8-bit images (`--exposure`; `render.exposure`).
     pub exposure: Option<f32>,
     /// Stop once the estimated relMSE is at most this (`--target-error`).
@@ -199,6 +206,11 @@ impl RenderRequest {
             prepared = prepare(&self.scene, &overrides)?;
         }
         let adaptive = prepared.scene.render.with_defaults().adaptive == Some(true);
+        let spp = prepared.render_scene.params.samples_per_pixel;
+        let auto_skipped = (self.auto_denoise && !self.denoise)
+            .then(|| self.auto_denoise_refusal(adaptive, target_error.is_some(), spp))
+            .flatten();
+        let denoise = self.denoise || (self.auto_denoise && auto_skipped.is_none());
         if adaptive
             && let Some(why) = [
                 (is_part(&self.output), "a `.part` output"),
@@ -216,7 +228,47 @@ impl RenderRequest {
             prepared,
             target_error,
             adaptive,
+            denoise,
+            auto_skipped,
         })
+    }
+
+    /// Why the default denoising ([`RenderRequest::auto_denoise`]) does not apply to this render,
+    /// or `None` when it does: only an 8-bit image of the whole frame at a sample count known in
+    /// advance is denoised by default. EXR and `.part` outputs stay the linear estimate (an EXR
+    /// holds both with `--denoise`); a crop keeps the full render's pixels; `--time`, a target
+    /// error and adaptive sampling do not know the samples per pixel in advance (the denoiser's
+    /// two halves need them); a sample range is one part of a render; light layers add up to the
+    /// raw image; checkpoints show the raw passes; fewer than 2 samples per pixel cannot be
+    /// split in halves. `spp` is the render's samples per pixel, `target_error` whether the
+    /// scene or the command line set one.
+    #[must_use]
+    pub fn auto_denoise_refusal(
+        &self,
+        adaptive: bool,
+        target_error: bool,
+        spp: u32,
+    ) -> Option<&'static str> {
+        let png = matches!(OutputFormat::for_path(&self.output), Ok(OutputFormat::Png));
+        [
+            (!png, NOT_8_BIT),
+            (self.region.is_some(), "--region"),
+            (self.time.is_some(), "--time"),
+            (target_error, "a target error"),
+            (adaptive, "adaptive sampling"),
+            (
+                self.shard.is_some() || self.samples.is_some(),
+                "a sample range",
+            ),
+            (
+                self.layers.iter().any(|l| matches!(l, Layer::Part(_))),
+                "light layers",
+            ),
+            (self.checkpoint.is_some(), "--checkpoint"),
+            (spp < 2, "fewer than 2 samples per pixel"),
+        ]
+        .iter()
+        .find_map(|&(skipped, why)| skipped.then_some(why))
     }
 }
 
@@ -228,9 +280,27 @@ pub struct PreparedRender<'q> {
     pub prepared: Prepared,
     target_error: Option<f32>,
     adaptive: bool,
+    /// Whether the image is denoised (asked for, or by default).
+    denoise: bool,
+    /// Why the default denoising does not apply, when it was on and does not.
+    auto_skipped: Option<&'static str>,
 }
 
 impl<'q> PreparedRender<'q> {
+    /// Whether the image will be denoised: `--denoise`, or by default where the render allows it.
+    #[must_use]
+    pub fn denoises(&self) -> bool {
+        self.denoise
+    }
+
+    /// Why the default denoising does not apply to this render
+    /// ([`RenderRequest::auto_denoise_refusal`]); `None` when it applies, was turned off, or
+    /// `--denoise` asked for it.
+    #[must_use]
+    pub fn auto_denoise_skipped(&self) -> Option<&'static str> {
+        self.auto_skipped
+    }
+
     /// Resolves the sample range (of `--samples`, else of the shard), and starts the render job
     /// (photon maps traced or read from the cache); `cancel` is the flag the render polls.
     ///
@@ -269,13 +339,12 @@ impl<'q> PreparedRender<'q> {
             cancel: Some(cancel),
             photon_cache: request.photon_cache.clone(),
             samples: samples.clone(),
-            light_paths: request.denoise
-                || request.layers.iter().any(|l| matches!(l, Layer::Part(_))),
+            light_paths: self.denoise || request.layers.iter().any(|l| matches!(l, Layer::Part(_))),
         };
         let taken = samples.clone().unwrap_or(0..spp);
         // `--denoise`: the samples below `split` are the first half-buffer.
         let split = taken.start + (taken.end - taken.start) / 2;
-        if request.denoise && split == taken.start {
+        if self.denoise && split == taken.start {
             return Err(RenderRefusal::DenoiseTooFewSamples(taken.end - taken.start).into());
         }
         let job = match RenderJob::new(&prepared.render_scene, &options) {
@@ -392,7 +461,7 @@ impl<'p> StartedRender<'p, '_> {
                 .adaptive
                 .then(|| AdaptivePlan::new(self.prepared.target_error.map(f64::from), spp)),
         };
-        let first_half = if request.denoise {
+        let first_half = if self.prepared.denoise {
             match self.job.render_pass(split - taken.start) {
                 Err(RenderError::Cancelled) => {
                     return Err(
@@ -432,7 +501,7 @@ impl<'p> StartedRender<'p, '_> {
         if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
             return Err(interrupted());
         }
-        let trace_features = request.denoise || request.layers.iter().any(|l| l.is_feature());
+        let trace_features = self.prepared.denoise || request.layers.iter().any(|l| l.is_feature());
         let features = if trace_features {
             let started = Instant::now();
             let traced = Features::trace(
@@ -579,6 +648,7 @@ mod tests {
             samples: None,
             layers: Vec::new(),
             denoise: false,
+            auto_denoise: false,
             exposure: None,
             target_error: None,
             adaptive: false,

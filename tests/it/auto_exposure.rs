@@ -85,13 +85,19 @@ fn a_dim_scene_is_brightened_and_still_clips_at_most_one_percent() {
 fn a_stated_exposure_passes_through_exactly() {
     let dir = tempfile::tempdir().expect("tmp");
     let scene = "scenes/cornell.ron";
-    let (flag, stderr) = render(dir.path(), scene, "flag.png", &["--exposure", "0.7"]);
+    // The raw estimate (`--no-denoise`), which the EXR holds.
+    let (flag, stderr) = render(
+        dir.path(),
+        scene,
+        "flag.png",
+        &["--exposure", "0.7", "--no-denoise"],
+    );
     assert!(!stderr.contains("automatic"), "{stderr}");
     let (set, _) = render(
         dir.path(),
         scene,
         "set.png",
-        &["--set", "render.exposure=0.7"],
+        &["--set", "render.exposure=0.7", "--no-denoise"],
     );
     let (exr, _) = render(dir.path(), scene, "linear.exr", &[]);
     let film = caustic::analysis::metrics::read_film(&exr).expect("the EXR");

@@ -178,9 +178,10 @@ fn small_render(dir: &std::path::Path, name: &str, seed: &str) -> String {
         "--seed",
         seed,
         // Exposure 1 with the linear clip: a PNG is then its EXR clamped to [0, 1] (an
-        // automatic exposure would scale it).
+        // automatic exposure would scale it), the raw estimate (not denoised) as the EXR holds.
         "--exposure",
         "1",
+        "--no-denoise",
         "--quiet",
         "-o",
         &path,

@@ -42,6 +42,7 @@ use crate::common;
 /// too slow to render for this test (it does not compare them): the image and its script.
 const SCRIPT_MADE: &[(&str, &str)] = &[
     ("bath_hq.png", "scripts/bath_hq.sh"),
+    ("bath_default.png", "scripts/bath_default.sh"),
     ("bath_steam.png", "scripts/media_images.sh"),
     ("glass_of_water.png", "scripts/media_images.sh"),
     ("foggy_box.png", "scripts/media_images.sh"),

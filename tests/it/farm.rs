@@ -44,7 +44,18 @@ fn refused(out: &Output) -> String {
 
 fn render(extra: &[&str], output: &Path) -> String {
     let o = output.to_str().expect("utf-8 path");
-    let mut args = vec!["render", CORNELL, "--threads", "2", "-q", "-o", o];
+    // The raw estimate in PNGs too: `merge` writes it (a single render's PNG is denoised by
+    // default).
+    let mut args = vec![
+        "render",
+        CORNELL,
+        "--threads",
+        "2",
+        "-q",
+        "--no-denoise",
+        "-o",
+        o,
+    ];
     args.extend_from_slice(&SMALL);
     args.extend_from_slice(extra);
     ok(&caustic(&args))
@@ -349,7 +360,7 @@ fn a_planned_job_run_by_hand_equals_a_single_render() {
 
     for ext in ["exr", "png"] {
         let single = d.join(format!("single.{ext}"));
-        let mut args = vec!["render", CORNELL, "-q", "-o", s(&single)];
+        let mut args = vec!["render", CORNELL, "-q", "--no-denoise", "-o", s(&single)];
         args.extend_from_slice(&flags);
         ok(&caustic(&args));
         assert!(
@@ -436,7 +447,14 @@ fn a_planned_default_estimator_scene_renders_like_the_original() {
             "-o",
             s(&planned),
         ]));
-        let mut b = vec!["render", s(&cornell), "-q", "-o", s(&original)];
+        let mut b = vec![
+            "render",
+            s(&cornell),
+            "-q",
+            "--no-denoise",
+            "-o",
+            s(&original),
+        ];
         b.extend_from_slice(&small);
         b.extend_from_slice(photons);
         ok(&caustic(&b));

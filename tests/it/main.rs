@@ -13,6 +13,7 @@ mod cli;
 mod common;
 mod compare;
 mod converge;
+mod default_denoise;
 mod default_estimator;
 mod determinism;
 mod doc_commands;

@@ -297,12 +297,19 @@ impl Drop for Preview {
     }
 }
 
-/// `caustic render` of `scene` with `flags` into `out`; its stderr.
+/// `caustic render` of `scene` with `flags` into `out`; its stderr. The raw estimate (which the
+/// page shows) unless `flags` ask for `--denoise`: a PNG is denoised by default.
 fn render(scene: &Path, flags: &[&str], out: &Path) -> (bool, String) {
+    let raw: &[&str] = if flags.contains(&"--denoise") {
+        &[]
+    } else {
+        &["--no-denoise"]
+    };
     let o = Command::new(env!("CARGO_BIN_EXE_caustic"))
         .arg("render")
         .arg(scene)
         .args(flags)
+        .args(raw)
         .arg("-q")
         .arg("-o")
         .arg(out)

@@ -1,11 +1,13 @@
 //! Emission from a point of an area light (rectangle, triangle mesh, disc, cylinder): the one
 //! cosine-weighted direction sampling, one- or two-sided, that every area light's `sample_le`
-//! and `pdf_le` share, so photons leave every shape by the same rule.
+//! and `pdf_le` share, so photons leave every shape by the same rule; and the power, the
+//! radiance leaving a side, and the direction towards a point sampled by area, that the shapes
+//! sampled by area (triangle mesh, disc, cylinder) share.
 
 use glam::Vec3;
 use std::f32::consts::PI;
 
-use super::EmissionSample;
+use super::{EmissionSample, LightSample};
 use crate::sampling::warp::cosine_hemisphere;
 
 /// A ray leaving `origin` (a uniformly chosen point, `pdf_pos = 1/area`, `area` in m²) of a
@@ -69,4 +71,59 @@ pub(super) fn pdf_area_li_hit(p: Vec3, point: Vec3, n: Vec3, area: f32, two_side
     }
     let pdf = dist2 / (area * cos_l.abs());
     if pdf.is_finite() { pdf } else { 0.0 }
+}
+
+/// Total flux (W) of an emitter of uniform `radiance` (W/(m²·sr)) and `area` (m²): `π L A`,
+/// twice that when it emits on both sides.
+#[inline]
+#[must_use]
+pub(super) fn area_power(radiance: Vec3, area: f32, two_sided: bool) -> Vec3 {
+    radiance * (PI * area * if two_sided { 2.0 } else { 1.0 })
+}
+
+/// Radiance leaving a point of unit normal `n` in direction `w`: `radiance` on an emitting
+/// side, 0 behind a one-sided emitter.
+#[inline]
+#[must_use]
+pub(super) fn area_le(radiance: Vec3, two_sided: bool, n: Vec3, w: Vec3) -> Vec3 {
+    if two_sided || n.dot(w) > 0.0 {
+        radiance
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// The direction from `p` towards `point` (sampled uniformly by area, unit normal `n`) on an
+/// emitter of uniform `radiance` and `area` (m²), with its solid-angle density
+/// `d²/(A |cos θ_l|)`. `None` behind a one-sided emitter or where the density or the weight is
+/// not finite (`p` on the surface, a grazing point).
+#[inline]
+#[must_use]
+pub(super) fn sample_area_li(
+    p: Vec3,
+    point: Vec3,
+    n: Vec3,
+    radiance: Vec3,
+    area: f32,
+    two_sided: bool,
+) -> Option<LightSample> {
+    let d = point - p;
+    let dist2 = d.length_squared();
+    let distance = dist2.sqrt();
+    let wi = d / distance;
+    let cos_l = -n.dot(wi);
+    if !(two_sided || cos_l > 0.0) {
+        return None;
+    }
+    let pdf = dist2 / (area * cos_l.abs());
+    let weight = radiance / pdf;
+    (pdf.is_finite() && pdf > 0.0 && weight.is_finite()).then_some(LightSample {
+        wi,
+        distance,
+        point,
+        radiance,
+        pdf,
+        delta: false,
+        weight,
+    })
 }

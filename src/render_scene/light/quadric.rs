@@ -10,9 +10,11 @@
 //! Compilation refuses an emissive cylinder that is not round.
 
 use glam::{DAffine3, DMat3, DVec3, Vec3};
-use std::f32::consts::{PI, TAU};
+use std::f32::consts::TAU;
 
-use super::area_emission::{pdf_area_le, sample_area_le};
+use super::area_emission::{
+    area_le, area_power, pdf_area_le, pdf_area_li_hit, sample_area_le, sample_area_li,
+};
 use super::{EmissionSample, LightSample};
 use crate::geometry::quadric::QuadricShape;
 use crate::sampling::warp::concentric_disk;
@@ -70,18 +72,14 @@ impl QuadricLight {
     /// Total flux (W): `π L A`, twice that for a two-sided light.
     #[must_use]
     pub fn power(&self) -> Vec3 {
-        self.radiance * (PI * self.area * if self.two_sided { 2.0 } else { 1.0 })
+        area_power(self.radiance, self.area, self.two_sided)
     }
 
     /// Radiance leaving a point with unit normal `n` (the surface's) in direction `w`.
     #[inline]
     #[must_use]
     pub fn le(&self, n: Vec3, w: Vec3) -> Vec3 {
-        if self.two_sided || n.dot(w) > 0.0 {
-            self.radiance
-        } else {
-            Vec3::ZERO
-        }
+        area_le(self.radiance, self.two_sided, n, w)
     }
 
     /// A uniform point of the surface (from `u ∈ [0, 1)²`) and its unit normal.
@@ -117,25 +115,7 @@ impl QuadricLight {
             return None;
         }
         let (point, n) = self.sample_position(u);
-        let d = point - p;
-        let dist2 = d.length_squared();
-        let distance = dist2.sqrt();
-        let wi = d / distance;
-        let cos_l = -n.dot(wi);
-        if !(self.two_sided || cos_l > 0.0) {
-            return None;
-        }
-        let pdf = dist2 / (self.area * cos_l.abs());
-        let weight = self.radiance / pdf;
-        (pdf.is_finite() && pdf > 0.0 && weight.is_finite()).then_some(LightSample {
-            wi,
-            distance,
-            point,
-            radiance: self.radiance,
-            pdf,
-            delta: false,
-            weight,
-        })
+        sample_area_li(p, point, n, self.radiance, self.area, self.two_sided)
     }
 
     /// [`QuadricLight::sample_li`]'s density of the direction to the surface point `point`
@@ -143,7 +123,7 @@ impl QuadricLight {
     #[inline]
     #[must_use]
     pub fn pdf_li_hit(&self, p: Vec3, point: Vec3, n: Vec3) -> f32 {
-        super::area_emission::pdf_area_li_hit(p, point, n, self.area, self.two_sided)
+        pdf_area_li_hit(p, point, n, self.area, self.two_sided)
     }
 
     /// Density of the direction `wi` from `p`: the sum over every point where the line meets

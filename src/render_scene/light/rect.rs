@@ -12,9 +12,8 @@
 //! A parallelogram whose edges are not perpendicular is always sampled by area.
 
 use glam::{DVec3, Vec3};
-use std::f32::consts::PI;
 
-use super::area_emission::{pdf_area_le, sample_area_le};
+use super::area_emission::{area_le, area_power, pdf_area_le, sample_area_le};
 use super::{EmissionSample, LightSample};
 
 /// Solid angle (sr) below which the rectangle is sampled by area rather than by solid angle
@@ -78,7 +77,7 @@ impl RectLight {
     /// Total emitted flux (W): `π L A`, twice that when two-sided.
     #[must_use]
     pub fn power(&self) -> Vec3 {
-        self.radiance * (PI * self.area * if self.two_sided { 2.0 } else { 1.0 })
+        area_power(self.radiance, self.area, self.two_sided)
     }
 
     /// Radiance leaving the light in the unit direction `w` (pointing away from it): `L` on an
@@ -86,11 +85,7 @@ impl RectLight {
     #[inline]
     #[must_use]
     pub fn le(&self, w: Vec3) -> Vec3 {
-        if self.two_sided || self.normal.dot(w) > 0.0 {
-            self.radiance
-        } else {
-            Vec3::ZERO
-        }
+        area_le(self.radiance, self.two_sided, self.normal, w)
     }
 
     /// True when `p` sees an emitting side (in front of a one-sided light, off the plane of a

@@ -9,9 +9,10 @@
 //! each triangle's mean texture luminance.
 
 use glam::Vec3;
-use std::f32::consts::PI;
 
-use super::area_emission::{pdf_area_le, sample_area_le};
+use super::area_emission::{
+    area_le, area_power, pdf_area_le, pdf_area_li_hit, sample_area_le, sample_area_li,
+};
 use super::{EmissionSample, LightSample};
 use crate::geometry::Ray;
 use crate::geometry::triangle::{TriRay, intersect_triangle};
@@ -99,7 +100,7 @@ impl MeshLight {
     /// Total emitted flux (W): `π L A`, twice that when two-sided.
     #[must_use]
     pub fn power(&self) -> Vec3 {
-        self.radiance * (PI * self.area * if self.two_sided { 2.0 } else { 1.0 })
+        area_power(self.radiance, self.area, self.two_sided)
     }
 
     /// Radiance leaving a point of normal `n` (the triangle's geometric normal) in the unit
@@ -107,11 +108,7 @@ impl MeshLight {
     #[inline]
     #[must_use]
     pub fn le(&self, n: Vec3, w: Vec3) -> Vec3 {
-        if self.two_sided || n.dot(w) > 0.0 {
-            self.radiance
-        } else {
-            Vec3::ZERO
-        }
+        area_le(self.radiance, self.two_sided, n, w)
     }
 
     /// A uniform point on the mesh from `u`: `u.0` picks the triangle (and is remapped), then
@@ -145,27 +142,16 @@ impl MeshLight {
             return None;
         }
         let (i, barycentrics, point) = self.sample_point(u)?;
-        let n = self.normal(i);
-        let d = point - p;
-        let dist2 = d.length_squared();
-        let distance = dist2.sqrt();
-        let wi = d / distance;
-        let cos_l = -n.dot(wi);
-        if !(self.two_sided || cos_l > 0.0) {
-            return None;
-        }
-        let pdf = dist2 / (self.area * cos_l.abs());
-        let weight = self.radiance / pdf;
-        (pdf.is_finite() && pdf > 0.0 && weight.is_finite()).then_some(MeshLightSample {
-            light: LightSample {
-                wi,
-                distance,
-                point,
-                radiance: self.radiance,
-                pdf,
-                delta: false,
-                weight,
-            },
+        let light = sample_area_li(
+            p,
+            point,
+            self.normal(i),
+            self.radiance,
+            self.area,
+            self.two_sided,
+        )?;
+        Some(MeshLightSample {
+            light,
             triangle: i,
             barycentrics,
         })
@@ -177,7 +163,7 @@ impl MeshLight {
     #[inline]
     #[must_use]
     pub fn pdf_li_hit(&self, p: Vec3, point: Vec3, n: Vec3) -> f32 {
-        super::area_emission::pdf_area_li_hit(p, point, n, self.area, self.two_sided)
+        pdf_area_li_hit(p, point, n, self.area, self.two_sided)
     }
 
     /// Solid-angle density of [`MeshLight::sample_li`] for the unit direction `wi` from `p`:

@@ -5,6 +5,7 @@ use super::*;
 use crate::sampling::Rng;
 use crate::sampling::warp::uniform_sphere;
 use glam::DQuat;
+use std::f32::consts::PI;
 
 /// A disc of radius `r` at height `h` above the origin, facing down (−y), radiance `l`.
 fn ceiling_disc(r: f64, h: f64, l: Vec3, two_sided: bool) -> QuadricLight {

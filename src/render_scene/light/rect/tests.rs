@@ -6,6 +6,7 @@ use crate::render_scene::light::test_support::{
 };
 use crate::sampling::Rng;
 use crate::sampling::chi2::{SphereBins, chi2_test, pearson, sidak_alpha};
+use std::f32::consts::PI;
 
 /// A 2 × 1 rectangle in the plane y = 2, facing down, radiance (1, 2, 3).
 fn ceiling(two_sided: bool) -> RectLight {

@@ -7,6 +7,7 @@ use crate::render_scene::light::test_support::{
 };
 use crate::sampling::Rng;
 use crate::sampling::chi2::{SphereBins, chi2_test, pearson, sidak_alpha};
+use std::f32::consts::PI;
 
 /// A fan of `n` triangles inscribed in the disc of radius `r` centred at (0, h, 0), facing −y.
 fn fan(n: usize, r: f32, h: f32) -> MeshLight {
