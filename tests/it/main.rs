@@ -40,6 +40,7 @@ mod passes;
 mod path_tracer;
 mod photon_map;
 mod photon_tools;
+mod potential_walls;
 mod preview;
 mod preview_server;
 mod primitives;

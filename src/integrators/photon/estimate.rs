@@ -242,16 +242,24 @@ impl PhotonMap {
     /// [`PhotonMap::mark_walls`] for estimates of radius up to `radius` (scene units).
     fn mark_walls_within(&mut self, walls: Walls<'_>, radius: f32) {
         use rayon::prelude::*;
+        let bounds = walls.geometry().bvh.bounds;
+        let far = bounds.min.abs().max(bounds.max.abs());
+        self.wall_grid = WallGrid::build(&walls, estimate_reach(far, radius));
+        // A photon whose cell lists no potential wall within the mark's reach needs no mark:
+        // a wall separating it from a query point within `radius` crosses the segment within
+        // that reach of it, so it would be listed there (super::potential_walls).
+        let grid = self.wall_grid.as_ref();
         self.near_wall = self
             .tree
             .items()
             .par_iter()
-            .map(|ph| walls::near_wall(&walls, ph.position(), ph.normal(), radius))
+            .map(|ph| {
+                let p = ph.position();
+                !grid.is_some_and(|g| g.clear_at(p, walls::reach(p, radius)))
+                    && walls::near_wall(&walls, p, ph.normal(), radius)
+            })
             .collect();
         self.wall_radius = radius;
-        let bounds = walls.geometry().bvh.bounds;
-        let far = bounds.min.abs().max(bounds.max.abs());
-        self.wall_grid = WallGrid::build(&walls, estimate_reach(far, radius));
     }
 
     /// Photons marked near a wall ([`PhotonMap::mark_walls`]; all of them before marking).
@@ -626,8 +634,48 @@ impl PhotonMap {
         value: impl Fn(Vec3, Vec3, f32) -> Vec3,
     ) -> Estimate {
         let r = self.shrink * pass.field.radius(p);
+        // Where the query's cell of the wall grid lists no potential wall, no photon can be
+        // hidden (every segment is clear, super::potential_walls): the search runs without
+        // the per-photon wall comparisons.
+        let open = self
+            .wall_grid
+            .as_ref()
+            .is_some_and(|g| g.clear_at(p, estimate_reach(p, r)));
+        let (sum, found, sight) = if open {
+            self.search_within::<false>(pass, p, ng, walls, r, &value)
+        } else {
+            self.search_within::<true>(pass, p, ng, walls, r, &value)
+        };
+        let area = std::f32::consts::PI * r * r * self.kernel.normalisation();
+        Estimate {
+            radiance: if found > 0 { sum / area } else { Vec3::ZERO },
+            found,
+            radius: r,
+            cut: false,
+            rays: sight.rays,
+            listed: sight.listed,
+            hidden: sight.hidden,
+        }
+    }
+}
+
+impl PhotonMap {
+    /// The photons of a progressive pass's disc of radius `r` at `p` ([`PhotonMap::
+    /// gather_within`]), summed with the wall test when `TEST` (without it where the query's
+    /// grid cell lists no potential wall): the sum, the photons found and the wall test's
+    /// counts.
+    #[inline]
+    fn search_within<'g, const TEST: bool>(
+        &'g self,
+        pass: &PassLookup,
+        p: Vec3,
+        ng: Vec3,
+        walls: Walls<'g>,
+        r: f32,
+        value: &impl Fn(Vec3, Vec3, f32) -> Vec3,
+    ) -> (Vec3, usize, Sight<'g>) {
         let q = p.to_array();
-        let mut disc = Disc {
+        let mut disc: Disc<'g, TEST> = Disc {
             sum: Vec3::ZERO,
             found: 0,
             sight: Sight::new(walls, self.wall_grid.as_ref(), p, ng, r),
@@ -646,7 +694,7 @@ impl PhotonMap {
                 GridDisc {
                     disc: &mut disc,
                     photons,
-                    value: &value,
+                    value,
                 },
             );
         } else {
@@ -658,28 +706,16 @@ impl PhotonMap {
                 } else {
                     self.wall_radius
                 };
-                disc.add(&Landing::new(ph, clear), n.dist2, &value);
+                disc.add(&Landing::new(ph, clear), n.dist2, value);
             });
         }
-        let Disc {
-            sum, found, sight, ..
-        } = disc;
-        let area = std::f32::consts::PI * r * r * self.kernel.normalisation();
-        Estimate {
-            radiance: if found > 0 { sum / area } else { Vec3::ZERO },
-            found,
-            radius: r,
-            cut: false,
-            rays: sight.rays,
-            listed: sight.listed,
-            hidden: sight.hidden,
-        }
+        (disc.sum, disc.found, disc.sight)
     }
 }
 
 /// One progressive estimate's running sum over the photons of its disc
 /// ([`PhotonMap::gather_within`]).
-struct Disc<'g> {
+struct Disc<'g, const TEST: bool> {
     sum: Vec3,
     found: usize,
     sight: Sight<'g>,
@@ -688,7 +724,7 @@ struct Disc<'g> {
     kernel: Kernel,
 }
 
-impl Disc<'_> {
+impl<const TEST: bool> Disc<'_, TEST> {
     /// Adds the photon `ph` at squared distance `dist2` from the query point, if the side and
     /// wall tests accept it. Inlined into both searches' loops.
     #[inline(always)]
@@ -696,6 +732,10 @@ impl Disc<'_> {
         self.found += 1;
         if let Some(cos_g) = landing_cosine(ph.normal, ph.wi, self.ng) {
             let (kernel, r) = (self.kernel, self.r);
+            if !TEST {
+                self.sum += value(ph.power, ph.wi, cos_g) * kernel.weight(dist2.sqrt(), r);
+                return;
+            }
             self.sight.add(
                 &mut self.sum,
                 Vec3::from_array(ph.position),
@@ -709,13 +749,15 @@ impl Disc<'_> {
 
 /// [`Disc::add`] for each photon a grid search finds, inlined into the search's loop
 /// ([`crate::spatial::Visit`]).
-struct GridDisc<'a, 'g, F> {
-    disc: &'a mut Disc<'g>,
+struct GridDisc<'a, 'g, F, const TEST: bool> {
+    disc: &'a mut Disc<'g, TEST>,
     photons: &'a [Landing],
     value: &'a F,
 }
 
-impl<F: Fn(Vec3, Vec3, f32) -> Vec3> crate::spatial::Visit for GridDisc<'_, '_, F> {
+impl<F: Fn(Vec3, Vec3, f32) -> Vec3, const TEST: bool> crate::spatial::Visit
+    for GridDisc<'_, '_, F, TEST>
+{
     #[inline(always)]
     fn visit(&mut self, n: crate::spatial::Neighbor) {
         self.disc

@@ -22,6 +22,7 @@ pub mod emit;
 pub mod estimate;
 pub mod maps;
 pub mod passes;
+pub mod potential_walls;
 pub mod radius_field;
 pub mod trace;
 pub mod volume;

@@ -41,6 +41,7 @@
 use glam::{DVec3, Vec3};
 use wide::f32x8;
 
+use super::potential_walls::{Reach, solid_can_separate, triangle_can_separate};
 use super::walls::{self, Walls};
 use crate::geometry::Aabb;
 use crate::render_scene::Geometry;
@@ -58,6 +59,16 @@ pub const MAX_CELLS_PER_AXIS: f32 = 24.0;
 /// Most cell–candidate box tests a grid's build may make (~10 instructions each); a scene that
 /// would need more gets no grid.
 pub const MAX_BUILD_TESTS: usize = 1 << 21;
+
+/// Which opaque surfaces a grid lists.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Listing {
+    /// Only those that can separate a query point from a photon
+    /// ([`super::potential_walls`]): what renders use.
+    PotentialWalls,
+    /// Every opaque surface (the lists before [`super::potential_walls`]; for tests).
+    Every,
+}
 
 /// What a wall candidate is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -93,15 +104,16 @@ pub struct Wall {
 pub struct WallGrid {
     /// Lowest corner of the grid (the scene's bounds' lowest corner).
     origin: Vec3,
-    /// Cell side (scene units).
-    side: f32,
+    /// One over the cell side (1 / scene units).
+    inv_side: f32,
+    /// Cells along x, y, z, as numbers.
+    dims_f: Vec3,
+    /// The rounding tolerance in cells (`slack / side`).
+    slack_cells: f32,
     /// Cells along x, y, z.
     dims: [usize; 3],
     /// The reach the lists hold for (scene units).
     reach: f32,
-    /// How far outside its cell a point may lie and still take its cell's list: the rounding
-    /// tolerance of the scene's coordinates.
-    slack: f32,
     /// Per cell, the range of its candidates' slots (a multiple of [`LANES`] long, the last
     /// lanes padded with empty boxes), or `None` when it has too many.
     cells: Vec<Option<(u32, u32)>>,
@@ -126,6 +138,12 @@ impl WallGrid {
     /// [`MAX_BUILD_TESTS`] box tests.
     #[must_use]
     pub fn build(walls: &Walls<'_>, reach: f32) -> Option<Self> {
+        Self::build_listing(walls, reach, Listing::PotentialWalls)
+    }
+
+    /// [`WallGrid::build`] listing the candidates `listing` says.
+    #[must_use]
+    pub fn build_listing(walls: &Walls<'_>, reach: f32, listing: Listing) -> Option<Self> {
         let geometry = walls.geometry();
         let bounds = geometry.bvh.bounds;
         let extent = bounds.max - bounds.min;
@@ -133,7 +151,8 @@ impl WallGrid {
         {
             return None;
         }
-        let candidates = candidates(walls, geometry);
+        let slack = walls::tolerance(bounds.min.abs().max(bounds.max.abs()));
+        let candidates = candidates(walls, geometry, listing, Reach::new(reach, slack));
         let side = reach.max(extent.max_element() / MAX_CELLS_PER_AXIS);
         let dims = extent
             .to_array()
@@ -142,7 +161,6 @@ impl WallGrid {
         if count.saturating_mul(candidates.len()) > MAX_BUILD_TESTS {
             return None;
         }
-        let slack = walls::tolerance(bounds.min.abs().max(bounds.max.abs()));
         let grow = Vec3::splat(reach + 2.0 * slack);
         let mut cells = Vec::with_capacity(count);
         let mut slot: Vec<u32> = Vec::new();
@@ -187,10 +205,11 @@ impl WallGrid {
         };
         Some(Self {
             origin: bounds.min,
-            side,
+            inv_side: 1.0 / side,
+            dims_f: Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32),
+            slack_cells: slack / side,
             dims,
             reach,
-            slack,
             cells,
             lo: [0, 1, 2].map(|a| axis(a, false)),
             hi: [0, 1, 2].map(|a| axis(a, true)),
@@ -208,6 +227,7 @@ impl WallGrid {
     /// The candidates of the cell holding `q` for an estimate of reach `reach`: `None` when
     /// `reach` exceeds the grid's, `q` lies outside the grid (by more than the rounding
     /// tolerance) or its cell has too many candidates; then a ray decides each segment.
+    #[inline]
     #[must_use]
     pub fn near(&self, q: Vec3, reach: f32) -> Option<CellList<'_>> {
         let index = self.cell_of(q, reach)?;
@@ -219,6 +239,15 @@ impl WallGrid {
         })
     }
 
+    /// True when the cell holding `q` lists no candidate for an estimate of reach `reach`
+    /// ([`WallGrid::near`]): every segment of such an estimate is clear. False when it lists
+    /// some or has no list.
+    #[inline]
+    #[must_use]
+    pub fn clear_at(&self, q: Vec3, reach: f32) -> bool {
+        self.near(q, reach).is_some_and(|c| c.start == c.end)
+    }
+
     /// The index of the cell holding `q` for an estimate of reach `reach`, or `None` (module
     /// docs).
     #[inline]
@@ -226,24 +255,42 @@ impl WallGrid {
         if !(reach <= self.reach) {
             return None;
         }
-        let rel = (q - self.origin) / self.side;
-        let slack = self.slack / self.side;
-        let mut index = 0usize;
-        for axis in (0..3).rev() {
-            let (c, n) = (rel[axis], self.dims[axis]);
-            if !(c >= -slack && c <= n as f32 + slack) {
-                return None;
-            }
-            let i = (c.max(0.0) as usize).min(n - 1);
-            index = index * n + i;
+        // Either cell a point within rounding of a boundary falls in lists every surface
+        // within the reach of it (cells are grown by twice the rounding tolerance).
+        let rel = (q - self.origin) * self.inv_side;
+        let s = self.slack_cells;
+        if !(rel.cmpge(Vec3::splat(-s)) & rel.cmple(self.dims_f + s)).all() {
+            return None;
         }
-        Some(index)
+        let i = rel.max(Vec3::ZERO).min(self.dims_f - 1.0);
+        let (x, y, z) = (i.x as usize, i.y as usize, i.z as usize);
+        Some((z * self.dims[1] + y) * self.dims[0] + x)
     }
 
     /// Number of cells.
     #[must_use]
     pub fn cell_count(&self) -> usize {
         self.cells.len()
+    }
+
+    /// Cells listing no candidate ([`WallGrid::clear_at`]: their estimates test nothing).
+    #[must_use]
+    pub fn clear_cells(&self) -> usize {
+        self.cells
+            .iter()
+            .filter(|c| c.is_some_and(|(start, end)| start == end))
+            .count()
+    }
+
+    /// The candidates listed in some cell: triangles, and surfaces known by their bounds.
+    #[must_use]
+    pub fn candidate_counts(&self) -> (usize, usize) {
+        let triangles = self
+            .walls
+            .iter()
+            .filter(|w| w.kind == WallKind::Triangle)
+            .count();
+        (triangles, self.walls.len() - triangles)
     }
 
     /// Bytes held.
@@ -276,8 +323,11 @@ pub fn estimate_reach(q: Vec3, r: f32) -> f32 {
 }
 
 /// Every opaque surface of `walls`' geometry as a wall candidate (module docs), in the
-/// geometry's order.
-fn candidates(walls: &Walls<'_>, geometry: &Geometry) -> Vec<Wall> {
+/// geometry's order; with [`Listing::PotentialWalls`] only those that can separate a query
+/// point from a photon of an estimate of reach up to `reach.far`'s grid
+/// ([`super::potential_walls`]).
+fn candidates(walls: &Walls<'_>, geometry: &Geometry, listing: Listing, reach: Reach) -> Vec<Wall> {
+    let every = listing == Listing::Every;
     let objects = geometry
         .tri_attrs
         .iter()
@@ -309,15 +359,20 @@ fn candidates(walls: &Walls<'_>, geometry: &Geometry) -> Vec<Wall> {
         if !ng.is_finite() {
             continue;
         }
-        out.push(Wall {
+        let wall = Wall {
             kind: WallKind::Triangle,
             corners: *t,
             ng,
             offset: ng.dot(t[0]),
             bounds,
             body: walls.body_of(a.object),
-        });
+        };
+        if every || triangle_can_separate(geometry, &wall, reach) {
+            out.push(wall);
+        }
     }
+    let solid_near =
+        |bounds: &Aabb, object: u32| every || solid_can_separate(geometry, bounds, object, reach);
     let solid = |bounds: Aabb, object: u32| Wall {
         kind: WallKind::Bounds,
         corners: [Vec3::ZERO; 3],
@@ -334,13 +389,13 @@ fn candidates(walls: &Walls<'_>, geometry: &Geometry) -> Vec<Wall> {
     for s in &geometry.spheres {
         if walls.can_block_any_object(s.object) {
             let r = Vec3::splat(s.radius * (1.0 + 1e-6) + walls::tolerance(s.center));
-            out.push(solid(
-                Aabb {
-                    min: s.center - r,
-                    max: s.center + r,
-                },
-                s.object,
-            ));
+            let b = Aabb {
+                min: s.center - r,
+                max: s.center + r,
+            };
+            if solid_near(&b, s.object) {
+                out.push(solid(b, s.object));
+            }
         }
     }
     for e in &geometry.ellipsoids {
@@ -349,17 +404,17 @@ fn candidates(walls: &Walls<'_>, geometry: &Geometry) -> Vec<Wall> {
             let half = DVec3::new(l.row(0).length(), l.row(1).length(), l.row(2).length());
             let c = e.world_from_object.translation;
             let pad = Vec3::splat(walls::tolerance((c.abs() + half).as_vec3()));
-            out.push(solid(
-                Aabb {
-                    min: (c - half).as_vec3() - pad,
-                    max: (c + half).as_vec3() + pad,
-                },
-                e.object,
-            ));
+            let b = Aabb {
+                min: (c - half).as_vec3() - pad,
+                max: (c + half).as_vec3() + pad,
+            };
+            if solid_near(&b, e.object) {
+                out.push(solid(b, e.object));
+            }
         }
     }
     for q in &geometry.quadrics {
-        if walls.can_block_any_object(q.object) {
+        if walls.can_block_any_object(q.object) && solid_near(&q.bounds(), q.object) {
             out.push(solid(q.bounds(), q.object));
         }
     }

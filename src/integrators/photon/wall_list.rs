@@ -143,7 +143,7 @@ mod tests {
     use glam::Vec2;
 
     use super::*;
-    use crate::integrators::photon::wall_grid::{WallGrid, estimate_reach};
+    use crate::integrators::photon::wall_grid::{Listing, WallGrid, estimate_reach};
     use crate::integrators::photon::walls::{
         Walls, near_wall, reach, segment, separated, tolerance,
     };
@@ -281,9 +281,22 @@ mod tests {
         // and divider; the divider is a wall. x = -0.2 (cell [-1/3, -1/6], grown to
         // [-0.43, -0.07]): the floor alone. x = -0.45 (cell [-1/2, -1/3]): floor and cube, whose
         // four side faces are walls to a floor point (its top lies in the floor's plane).
+        // Listing only the potential walls (super::potential_walls) leaves out the cube's
+        // bottom, which lies on the floor with nothing beyond it: 10 at x = -0.45.
         let g = rooms();
         let walls = Walls::every_surface(&g);
-        let grid = WallGrid::build(&walls, 0.1).expect("grid");
+        let potential = WallGrid::build(&walls, 0.1).expect("grid");
+        let counts: Vec<usize> = [-1.5f32, -0.05, -0.2, -0.45]
+            .iter()
+            .map(|&x| {
+                let list = potential
+                    .near(Vec3::new(x, 0.0, 0.0), 0.05)
+                    .expect("a list");
+                list.walls().count()
+            })
+            .collect();
+        assert_eq!(counts, [2, 4, 2, 10]);
+        let grid = WallGrid::build_listing(&walls, 0.1, Listing::Every).expect("grid");
         for (x, cell, across) in [(-1.5f32, 2, 0), (-0.05, 4, 2), (-0.2, 2, 0), (-0.45, 12, 8)] {
             let q = Vec3::new(x, 0.0, 0.0);
             let list = grid.near(q, 0.05).expect("a list");
