@@ -776,9 +776,11 @@ impl<F: Fn(Vec3, Vec3, f32) -> Vec3, const TEST: bool> crate::spatial::Visit
 /// ([`CellList::crosses`]), or by a ray
 /// ([`walls::separated`]) where the list cannot decide (no grid, a cell with too many
 /// candidates, a mesh or a sphere in the segment's box). An estimate that tests nothing costs
-/// two comparisons per photon beyond the side tests (its mark and its height) and no lookup.
-/// Skipping those where the query's grid cell holds no surface that can be a wall to it (one
-/// lookup per estimate) cost more than it saved on the Cornell box (+2.4 % instructions).
+/// two comparisons per photon beyond the side tests (its mark and its height). A progressive
+/// estimate whose cell lists no potential wall ([`WallGrid::clear_at`]) skips even those (one
+/// lookup per estimate): with every opaque surface listed that skip cost the Cornell box
+/// +2.4 % instructions more than it saved, with only the potential walls listed
+/// ([`super::potential_walls`]) most of its cells are clear.
 struct Sight<'g> {
     walls: Walls<'g>,
     grid: Option<&'g WallGrid>,

@@ -15,7 +15,7 @@
 //! triangle `T` (unit normal `n`, plane `n·x = c`) crossed by `ab` only when `T`'s normal is more
 //! than ~26° from both ends' (`|n·n_q| ≤ 0.9`, `|n·n_p| ≤ 0.9`) and the ends' signed distances
 //! `σ(a), σ(b)` (`σ(x) = n·x − c`) are not both above the margin `m` nor both below `−m`
-//! ([`CellList::crosses`](super::wall_list::CellList::crosses) tests exactly this before the
+//! ([`CellList::crosses`](super::wall_grid::CellList::crosses) tests exactly this before the
 //! watertight test). So some end has `σ ≤ m` and some end has `σ ≥ −m`.
 //!
 //! **Claim 2 (where the ends come from).** The crossing point `x` lies on `T` (within its box

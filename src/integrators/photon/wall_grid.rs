@@ -18,7 +18,10 @@
 //! rounding tolerance of the scene's coordinates): an estimate whose reach is at most `R` and
 //! whose point lies in the grid finds in its cell every surface that could separate it from a
 //! photon. The candidates ([`Wall`]) are the scene's opaque surfaces
-//! ([`Walls`](super::walls::Walls): the surfaces of transmitting materials are no walls):
+//! ([`Walls`](super::walls::Walls): the surfaces of transmitting materials are no walls) that
+//! can separate a query point from a photon at all ([`super::potential_walls`]: a triangle with
+//! surfaces within reach on both sides of its plane; a Cornell box's walls and a room's outer
+//! walls are left out):
 //!
 //! - the triangles of objects of at most [`SMALL_OBJECT`] triangles (quads, cubes, the bath's
 //!   tub and room), each with its unit normal, plane offset and bounds, so that a segment is
@@ -34,6 +37,9 @@
 //! [`MAX_CELLS_PER_AXIS`] a side, and a grid whose build would test more than [`MAX_BUILD_TESTS`]
 //! cell–candidate pairs is not built (every estimate then traces rays): its cost is bounded by a
 //! few milliseconds per map whatever the scene.
+//!
+//! A cell listing nothing ([`WallGrid::clear_at`]) lets a progressive estimate skip the
+//! per-photon wall comparisons, and a photon in it needs no mark.
 //!
 //! The lists depend only on the geometry and the reach, so the decisions do not depend on the
 //! order of estimates or the thread count.
