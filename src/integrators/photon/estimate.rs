@@ -202,7 +202,7 @@ pub struct Estimate {
     /// list could not decide ([`super::wall_list`]).
     pub rays: u32,
     /// Photons whose segment was tested against the estimate's wall list
-    /// ([`super::wall_list::CellList::crosses`]; those it could not decide, a mesh or a sphere
+    /// ([`super::wall_grid::CellList::crosses`]; those it could not decide, a mesh or a sphere
     /// in the segment's box, are counted in `rays` too).
     pub listed: u32,
     /// Accepted photons a wall separates from the query point (left out).

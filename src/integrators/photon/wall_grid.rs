@@ -18,14 +18,14 @@
 //! rounding tolerance of the scene's coordinates): an estimate whose reach is at most `R` and
 //! whose point lies in the grid finds in its cell every surface that could separate it from a
 //! photon. The candidates ([`Wall`]) are the scene's opaque surfaces
-//! ([`Walls`](super::walls::Walls): the surfaces of transmitting materials are no walls) that
+//! ([`Walls`]: the surfaces of transmitting materials are no walls) that
 //! can separate a query point from a photon at all ([`super::potential_walls`]: a triangle with
 //! surfaces within reach on both sides of its plane; a Cornell box's walls and a room's outer
 //! walls are left out):
 //!
 //! - the triangles of objects of at most [`SMALL_OBJECT`] triangles (quads, cubes, the bath's
 //!   tub and room), each with its unit normal, plane offset and bounds, so that a segment is
-//!   tested against it directly ([`super::wall_list::WallList::crosses`]);
+//!   tested against it directly ([`CellList::crosses`]);
 //! - every larger object (a mesh: the duck, the boat, the faucet) and every sphere, ellipsoid
 //!   and quadric as its bounds alone: a segment whose box meets them is decided by a ray
 //!   ([`walls::separated`]), as every segment was before the lists.
@@ -47,7 +47,7 @@
 use glam::{DVec3, Vec3};
 use wide::f32x8;
 
-use super::potential_walls::{Reach, solid_can_separate, triangle_can_separate};
+use super::potential_walls::{Plane, Reach, solid_can_separate, triangle_can_separate};
 use super::walls::{self, Walls};
 use crate::geometry::Aabb;
 use crate::render_scene::Geometry;
@@ -373,7 +373,17 @@ fn candidates(walls: &Walls<'_>, geometry: &Geometry, listing: Listing, reach: R
             bounds,
             body: walls.body_of(a.object),
         };
-        if every || triangle_can_separate(geometry, &wall, reach) {
+        if every
+            || triangle_can_separate(
+                geometry,
+                Plane {
+                    ng,
+                    offset: wall.offset,
+                },
+                &bounds,
+                reach,
+            )
+        {
             out.push(wall);
         }
     }
