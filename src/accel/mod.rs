@@ -2,6 +2,7 @@
 
 pub(crate) mod build;
 pub mod bvh;
+mod query;
 pub mod sphere_bvh;
 mod traverse;
 

@@ -462,6 +462,7 @@ pub(super) fn compile_lights(
                     name: format!("lights[{i}]"),
                     material: None,
                     light: Some(index),
+                    body: None,
                 });
                 builder.spheres.push(SpherePrim { object, ..prim });
                 continue;
@@ -481,6 +482,7 @@ pub(super) fn compile_lights(
                 name: format!("lights[{i}]"),
                 material: None,
                 light: Some(index),
+                body: None,
             });
             out.infinity = Some(InfinityRef {
                 light: index,

@@ -69,6 +69,7 @@ impl Flattener<'_> {
                 name,
                 material,
                 light: None,
+                body: None,
             });
         }
         let first = super::lights::PrimCounts::of(self.builder);
@@ -315,6 +316,8 @@ impl Flattener<'_> {
         let file = g.file.display();
         let names = mesh.names.iter().map(String::as_str);
         let mut ok = true;
+        // Every group object of this mesh is a part of one body, named by the first.
+        let body = Some(self.objects.len() as u32);
         // Per name of the file: the object its faces get if the map has it.
         let mut by_name: Vec<Option<u32>> = vec![None; mesh.names.len()];
         for (key, material) in g.materials {
@@ -345,6 +348,7 @@ impl Flattener<'_> {
                 name: format!("{}: {key}", g.node_name),
                 material: resolved,
                 light: None,
+                body,
             });
         }
         let default = g.default.as_deref().map(|m| {
@@ -368,6 +372,7 @@ impl Flattener<'_> {
                         name: g.node_name.to_string(),
                         material: resolved,
                         light: None,
+                        body,
                     });
                     self.objects.len() as u32 - 1
                 });

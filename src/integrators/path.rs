@@ -7,6 +7,7 @@ use glam::Vec3;
 
 use super::context::{Context, PathObserver};
 use super::light_guide::LightGuide;
+use super::photon::walls::Walls;
 use super::photon::{PhotonMap, SHORT_GATHER, SHORT_GATHER_BOUNCES, VolumeMap};
 use super::shadow::{LightConnection, RayCone, SHADOW_EPSILON, connect_light, shadow_ray};
 use super::trace_log::{RayKind, ShadowRecord};
@@ -598,7 +599,8 @@ impl<'a> PathTracer<'a> {
                         ("global", global, LightPath::Indirect),
                     ] {
                         let Some(map) = map else { continue };
-                        let e = map.estimate(sp.p, wo, &fr, bsdf);
+                        let e =
+                            map.estimate(sp.p, wo, &fr, bsdf, Walls::of(scene, Some(sp.object)));
                         cx.counters.photon_estimates += 1;
                         l.add(kind, beta * e.radiance);
                         if O::ACTIVE {

@@ -239,15 +239,21 @@ impl KeyHash for PhotonParams {
 }
 
 impl KeyHash for ObjectInfo {
-    /// The object's material and light (its name changes no pixel).
+    /// The object's material and light (its name changes no pixel), and its body when it is
+    /// part of one (only then: objects that are whole bodies keep the key they had before
+    /// bodies existed).
     fn key_hash(&self, h: &mut Fnv) {
         let Self {
             name: _,
             material,
             light,
+            body,
         } = self;
         material.key_hash(h);
         light.key_hash(h);
+        if let Some(b) = body {
+            b.key_hash(h);
+        }
     }
 }
 

@@ -141,6 +141,11 @@ pub struct ObjectInfo {
     pub material: Option<u32>,
     /// Index of the light this object emits as, if it is an emitter.
     pub light: Option<u32>,
+    /// The body this object is a part of, when it is not a whole body itself: the material
+    /// groups of one mesh are objects of their own (one material each) but one surface, and
+    /// name the mesh's first group object here. Thin-wall tests take a query point's whole
+    /// body as its receiver ([`RenderScene::body_of`]).
+    pub body: Option<u32>,
 }
 
 /// Everything an integrator needs, resolved to indices.
@@ -179,6 +184,16 @@ pub struct RenderScene {
 }
 
 impl RenderScene {
+    /// The body object `object` is a part of: [`ObjectInfo::body`], or the object itself.
+    #[inline]
+    #[must_use]
+    pub fn body_of(&self, object: u32) -> u32 {
+        self.objects
+            .get(object as usize)
+            .and_then(|o| o.body)
+            .unwrap_or(object)
+    }
+
     /// True if object `object` lets no light through (no transmitting lobe, or an emitter).
     #[inline]
     #[must_use]

@@ -25,6 +25,21 @@ use super::kdtree::HasPosition;
 use super::knn::Neighbor;
 use wide::f32x8;
 
+/// What [`HashGrid::within`] hands each item found to: any `FnMut(Neighbor)` closure, or a
+/// type of the caller's whose `visit` is marked `#[inline(always)]`, so that a large per-item
+/// body is inlined into the search's loop where the compiler would call a closure out of line.
+pub trait Visit {
+    /// Receives one item found (its index into [`HashGrid::items`] and squared distance).
+    fn visit(&mut self, n: Neighbor);
+}
+
+impl<F: FnMut(Neighbor)> Visit for F {
+    #[inline(always)]
+    fn visit(&mut self, n: Neighbor) {
+        self(n);
+    }
+}
+
 /// Why a [`HashGrid`] cannot be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HashGridError {
@@ -284,13 +299,7 @@ impl<T: HasPosition> HashGrid<T> {
     /// testing [`LANES`] items at once. The distance is [`super::distance2`]'s, operation for
     /// operation, so it is the same number.
     #[inline(always)]
-    fn scan(
-        &self,
-        range: std::ops::Range<usize>,
-        q: [f32; 3],
-        r2: f32,
-        visit: &mut impl FnMut(Neighbor),
-    ) {
+    fn scan(&self, range: std::ops::Range<usize>, q: [f32; 3], r2: f32, visit: &mut impl Visit) {
         let [xs, ys, zs] = &self.axes;
         let (qx, qy, qz) = (f32x8::splat(q[0]), f32x8::splat(q[1]), f32x8::splat(q[2]));
         let limit = f32x8::splat(r2);
@@ -312,7 +321,7 @@ impl<T: HasPosition> HashGrid<T> {
                 while hits != 0 {
                     let lane = hits.trailing_zeros() as usize;
                     hits &= hits - 1;
-                    visit(Neighbor {
+                    visit.visit(Neighbor {
                         index: (i + lane) as u32,
                         dist2: d2[lane],
                     });
@@ -326,7 +335,7 @@ impl<T: HasPosition> HashGrid<T> {
     /// depends only on the grid and `q`, `r`. A non-finite `q` or a negative or NaN `r` visits
     /// nothing; an infinite `r` visits every item.
     #[inline]
-    pub fn within(&self, q: [f32; 3], r: f32, mut visit: impl FnMut(Neighbor)) {
+    pub fn within(&self, q: [f32; 3], r: f32, mut visit: impl Visit) {
         if self.items.is_empty() || !(r >= 0.0) || !q.iter().all(|c| c.is_finite()) {
             return;
         }
@@ -371,7 +380,7 @@ mod tests {
 
     fn query(grid: &HashGrid<[f32; 3]>, q: [f32; 3], r: f32) -> Vec<u32> {
         let mut v = Vec::new();
-        grid.within(q, r, |n| {
+        grid.within(q, r, |n: Neighbor| {
             assert!((n.dist2 - distance2(q, grid.items()[n.index as usize])).abs() == 0.0);
             v.push(n.index);
         });
@@ -523,7 +532,7 @@ mod tests {
             .collect();
         let grid = HashGrid::build(pts.clone(), 1.0).expect("grid");
         let mut seen = Vec::new();
-        grid.within([0.5, 0.1, 0.5], 0.7, |n| {
+        grid.within([0.5, 0.1, 0.5], 0.7, |n: Neighbor| {
             seen.push(grid.items()[n.index as usize]);
         });
         let expected: Vec<[f32; 3]> = pts
@@ -534,7 +543,7 @@ mod tests {
             .collect();
         assert_eq!(seen, expected);
         let mut only_first = Vec::new();
-        grid.within([0.1, 0.1, 0.5], 0.5, |n| only_first.push(n.index));
+        grid.within([0.1, 0.1, 0.5], 0.5, |n: Neighbor| only_first.push(n.index));
         assert_eq!(only_first.len(), 21);
     }
 

@@ -27,7 +27,7 @@ pub mod knn;
 pub mod packing;
 pub mod voxel_table;
 
-pub use hash_grid::{CellIndex, HashGrid, HashGridError};
+pub use hash_grid::{CellIndex, HashGrid, HashGridError, Visit};
 pub use kdtree::{BuildOptions, HasPosition, KdTree, KdTreeError, SplitAxis, distance2};
 pub use knn::{KnnHeap, Neighbor};
 pub use packing::Photon;

@@ -19,6 +19,7 @@
 
 use glam::Vec3;
 
+use caustic::integrators::photon::walls::Walls;
 use caustic::integrators::photon::{Kernel, PhotonMap, build_maps};
 use caustic::spatial::KdTree;
 
@@ -53,14 +54,18 @@ fn stripes(caustic: u32, gather: u32) -> String {
 /// the stripes), by the midpoint rule on 400 × 20 points: 80 a period across the stripes, where
 /// the estimate's blurred edges (a few centimetres wide, not symmetric about the edge: photons
 /// at an edge have wider discs) need them; a 40-point grid read the discs 3.4 % high.
-fn window_mean(map: &PhotonMap) -> f64 {
+fn window_mean(map: &PhotonMap, walls: Walls<'_>) -> f64 {
     let (nx, nz) = (400, 20);
     let mut sum = 0.0;
     for i in 0..nx {
         for j in 0..nz {
             let x = -0.5 + (i as f32 + 0.5) / nx as f32;
             let z = -0.5 + (j as f32 + 0.5) / nz as f32;
-            sum += f64::from(map.irradiance(Vec3::new(x, 0.0, z), Vec3::Y).radiance.x);
+            sum += f64::from(
+                map.irradiance(Vec3::new(x, 0.0, z), Vec3::Y, walls)
+                    .radiance
+                    .x,
+            );
         }
     }
     sum / f64::from(nx * nz)
@@ -72,11 +77,13 @@ fn a_striped_caustic_keeps_its_flux_in_the_photon_integrators_estimate() {
     let scene = scene_from_text(&stripes(400_000, 40));
     let maps = build_maps(&scene);
     let map = maps.caustic.as_ref().expect("a caustic map");
-    let ours = window_mean(map);
+    let walls = Walls::of(&scene, None);
+    let ours = window_mean(map, walls);
     // Jensen's k-nearest estimate over the same photons (no discs: what `main` read).
     let tree = KdTree::build(map.photons().to_vec()).expect("finite photons");
-    let knn = PhotonMap::new(tree, 40, map.max_radius(), Kernel::Cone(1.1));
-    let theirs = window_mean(&knn);
+    let mut knn = PhotonMap::new(tree, 40, map.max_radius(), Kernel::Cone(1.1));
+    knn.mark_walls(walls);
+    let theirs = window_mean(&knn, walls);
     // The flux the photons brought into the window (1 m²): what an estimate that keeps flux
     // reads on average there, whatever its blur (the stripes are periodic across the window's
     // edges, so as much blurred light leaves it as enters).

@@ -346,6 +346,7 @@ fn a_quad_lights_irradiance_through_the_global_photon_map_matches_lamberts_polyg
     use caustic::integrators::photon::emit::LightEmitter;
     use caustic::integrators::photon::maps::trace_map;
     use caustic::integrators::photon::trace::{MapKind, TraceSettings};
+    use caustic::integrators::photon::walls::Walls;
     use caustic::integrators::photon::{Kernel, PhotonMap};
     use caustic::shading::{Bsdf, ShadingFrame};
     use caustic::spatial::KdTree;
@@ -397,6 +398,7 @@ fn a_quad_lights_irradiance_through_the_global_photon_map_matches_lamberts_polyg
             Vec3::Y,
             &up,
             &white,
+            Walls::of(&scene, None),
         );
         assert!(!e.cut, "the estimate at {x:?} reached the largest radius");
         let got = f64::from(e.radiance.x) * PI;

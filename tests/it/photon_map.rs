@@ -9,6 +9,7 @@ use caustic::integrators::photon::aim::CausticTargets;
 use caustic::integrators::photon::emit::LightEmitter;
 use caustic::integrators::photon::maps::trace_map;
 use caustic::integrators::photon::trace::{MapKind, TraceCounts, TraceSettings};
+use caustic::integrators::photon::walls::Walls;
 use caustic::integrators::photon::{Kernel, PhotonMap, build_maps};
 use caustic::integrators::{Context, Counters, Integrator, NoTrace};
 use caustic::render::{RenderOptions, render};
@@ -92,7 +93,13 @@ fn point_light_over_a_plane_matches_the_inverse_square_cosine_law() {
         (1.0, 0.35355),
         (2.0, 0.08944),
     ] {
-        let e = map.estimate(Vec3::new(x, 0.0, 0.0), Vec3::Y, &up(), &lambert());
+        let e = map.estimate(
+            Vec3::new(x, 0.0, 0.0),
+            Vec3::Y,
+            &up(),
+            &lambert(),
+            Walls::of(&scene, None),
+        );
         let irradiance = f64::from(e.radiance.x) * PI;
         assert!(
             (irradiance / exact_e - 1.0).abs() < 0.03,
@@ -608,7 +615,13 @@ fn estimates_at_a_planes_edge_and_corner_read_the_boundary_bias() {
     let (photons, _) = direct_photons(&scene, 4_000_000);
     let map = PhotonMap::new(KdTree::build(photons).expect("tree"), 100, 1.0, Kernel::Box);
     let ratio = |x: f32, z: f32| {
-        let e = map.estimate(Vec3::new(x, 0.0, z), Vec3::Y, &up(), &lambert());
+        let e = map.estimate(
+            Vec3::new(x, 0.0, z),
+            Vec3::Y,
+            &up(),
+            &lambert(),
+            Walls::of(&scene, None),
+        );
         let r2 = f64::from(x * x + z * z);
         let exact = 2.0 / (4.0 + r2).powf(1.5);
         f64::from(e.radiance.x) * PI / exact

@@ -12,6 +12,7 @@ use caustic::integrators::photon::aim::CausticTargets;
 use caustic::integrators::photon::emit::LightEmitter;
 use caustic::integrators::photon::maps::trace_map;
 use caustic::integrators::photon::trace::{MapKind, TraceSettings};
+use caustic::integrators::photon::walls::Walls;
 use caustic::integrators::photon::{Kernel, PhotonMap};
 use caustic::pipeline::SceneOverrides;
 use caustic::render::RenderOptions;
@@ -208,7 +209,11 @@ fn photons_on_a_smooth_shaded_low_poly_ball_read_the_shadow_rays_light_per_face(
                 } else {
                     0.0
                 };
-                est += f64::from(map.estimate(sp.p, out, &fr, &white).radiance.x);
+                est += f64::from(
+                    map.estimate(sp.p, out, &fr, &white, Walls::of(&scene, Some(sp.object)))
+                        .radiance
+                        .x,
+                );
                 exact += f64::from(shadow_ray);
                 n += 1;
             }

@@ -6,7 +6,7 @@
 
 use wide::f32x8;
 
-use super::{TriPack4, TriRay};
+use super::{TriPack4, TriRay, near_lanes_f64};
 use crate::geometry::float::gamma;
 
 /// What [`intersect_pack8_k`] found: like [`PackHits`](super::PackHits) for eight lanes, lane
@@ -118,7 +118,14 @@ pub fn intersect_pack8_k<const KZ: usize>(
     let delta_t = splat(3.0)
         * (splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
         * inv_det.abs();
-    let mask = mask & !t.simd_le(delta_t).to_bitmask();
+    let near = mask & t.simd_le(delta_t).to_bitmask();
+    let mask = mask & !near;
+    if near != 0 {
+        // Within the f32 bound of the origin: decided in f64 (see `plane_hit_f64`).
+        let hits = [t.to_array(), t_scaled.to_array(), det.to_array()];
+        let b12 = [(e1 * inv_det).to_array(), (e2 * inv_det).to_array()];
+        return near_pack8_f64(r, [a, b], mask, near, t_max, hits, b12);
+    }
     if mask == 0 {
         return None;
     }
@@ -129,6 +136,33 @@ pub fn intersect_pack8_k<const KZ: usize>(
         det: det.to_array(),
         b1: (e1 * inv_det).to_array(),
         b2: (e2 * inv_det).to_array(),
+    })
+}
+
+/// [`intersect_pack8_k`]'s lanes `near` (positive distance within the f32 error bound) decided
+/// by [`plane_hit_f64`](super::plane_hit_f64), added to the lanes `mask` already hit; `None`
+/// if no lane is hit after all.
+#[cold]
+#[inline(never)]
+fn near_pack8_f64(
+    r: &TriRay,
+    packs: [&TriPack4; 2],
+    mask: u32,
+    near: u32,
+    t_max: f32,
+    mut hits: [[f32; 8]; 3],
+    b12: [[f32; 8]; 2],
+) -> Option<PackHits8> {
+    let mask = mask | near_lanes_f64(r, &packs, near, t_max, &mut hits);
+    let [t, t_scaled, det] = hits;
+    let [b1, b2] = b12;
+    (mask != 0).then_some(PackHits8 {
+        mask,
+        t,
+        t_scaled,
+        det,
+        b1,
+        b2,
     })
 }
 

@@ -33,6 +33,7 @@ use super::maps::{
     precompute_irradiance, use_photon_discs,
 };
 use super::trace::{MapKind, TraceCounts};
+use super::walls::Walls;
 use crate::binfile::{AtomicWrite, Reader, Truncated, fnv1a};
 use crate::render_scene::RenderScene;
 pub use crate::render_scene::hash::{PHOTON_KEY_VERSION as KEY_VERSION, photon_key as cache_key};
@@ -374,7 +375,9 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
         let tree = KdTree::from_tree_order(photons, BuildOptions::default())?;
         memory += tree.memory_bytes();
         *radius = r;
-        Ok(Some(PhotonMap::new(tree, k as usize, r, kernel)))
+        let mut map = PhotonMap::new(tree, k as usize, r, kernel);
+        map.mark_walls(Walls::of(scene, None));
+        Ok(Some(map))
     };
     let caustic_kernel = match p.caustic_cone {
         Some(k) => Kernel::Cone(k),
@@ -397,7 +400,7 @@ pub fn decode(scene: &RenderScene, bytes: &[u8], key: u64) -> Result<PhotonMaps,
     summary.memory = memory;
     summary.trace_time = Duration::ZERO;
     let (mut caustic, mut global) = (caustic, global);
-    use_photon_discs(&mut caustic, &mut global, &mut summary);
+    use_photon_discs(scene, &mut caustic, &mut global, &mut summary);
     summary.build_time = t0.elapsed();
     let irradiance = precompute_irradiance(scene, &caustic, &global, &mut summary, None);
     Ok(PhotonMaps {

@@ -50,6 +50,9 @@ pub struct Disc {
     pub radius: f32,
     /// True when the largest radius cut the photon's k-nearest search short.
     pub capped: bool,
+    /// True when a wall may separate the photon from a query point its disc covers
+    /// ([`super::walls::near_wall`] for the disc's radius): only then does an estimate test it.
+    pub near_wall: bool,
 }
 
 /// How the discs covered a query ([`PhotonDiscs::covering`]).
@@ -83,20 +86,24 @@ pub struct PhotonDiscs {
 
 impl PhotonDiscs {
     /// The discs of a map's photons (`tree`), each of radius `radius_of(its position)` (the
-    /// radius and whether the largest radius capped it). `None` when there is
+    /// radius and whether the largest radius capped it) and wall mark
+    /// `near_wall(its index in tree order, the photon, its radius)`. `None` when there is
     /// no photon or no radius is a positive finite number. Deterministic for any thread count.
     #[must_use]
     pub fn build(
         tree: &KdTree<Photon>,
         radius_of: impl Fn(Vec3) -> (f32, bool) + Sync,
+        near_wall: impl Fn(u32, &Photon, f32) -> bool + Sync,
     ) -> Option<Self> {
         use rayon::prelude::*;
         let photons = tree.items();
         let discs: Vec<Disc> = photons
             .par_iter()
-            .map(|ph| {
+            .enumerate()
+            .map(|(i, ph)| {
                 let (radius, capped) = radius_of(ph.position());
                 Disc {
+                    near_wall: near_wall(i as u32, ph, radius),
                     position: ph.position().to_array(),
                     wi: -ph.direction(),
                     normal: ph.normal(),
@@ -153,16 +160,20 @@ impl PhotonDiscs {
         for (j, grid) in self.levels.iter().enumerate() {
             let Some(grid) = grid else { continue };
             let discs = grid.items();
-            grid.within(q, level_radius(j, self.largest), |n| {
-                let d = &discs[n.index as usize];
-                if n.dist2 >= d.radius * d.radius {
-                    return;
-                }
-                cover.found += 1;
-                cover.reach = cover.reach.max(d.radius);
-                cover.capped |= d.capped;
-                visit(d, n.dist2);
-            });
+            grid.within(
+                q,
+                level_radius(j, self.largest),
+                |n: crate::spatial::Neighbor| {
+                    let d = &discs[n.index as usize];
+                    if n.dist2 >= d.radius * d.radius {
+                        return;
+                    }
+                    cover.found += 1;
+                    cover.reach = cover.reach.max(d.radius);
+                    cover.capped |= d.capped;
+                    visit(d, n.dist2);
+                },
+            );
         }
         cover
     }
@@ -188,7 +199,9 @@ fn level_radius(j: usize, largest: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrators::photon::walls::Walls;
     use crate::integrators::photon::{Kernel, PhotonMap};
+    use crate::render_scene::Geometry;
     use crate::sampling::{Rng, Sampler};
     use crate::settings::SamplerKind;
 
@@ -233,7 +246,11 @@ mod tests {
         let mut sum = 0.0;
         for _ in 0..queries {
             let (u, v) = rng.next_2d();
-            let e = map.irradiance(Vec3::new(u - 0.5, v - 0.5, 0.0), Vec3::Z);
+            let e = map.irradiance(
+                Vec3::new(u - 0.5, v - 0.5, 0.0),
+                Vec3::Z,
+                Walls::every_surface(&Geometry::default()),
+            );
             sum += f64::from(e.radiance.x);
         }
         sum / f64::from(queries) / (n as f64 / 4.0)
@@ -251,7 +268,7 @@ mod tests {
             for kernel in [Kernel::Cone(1.1), Kernel::Box] {
                 let mut map = striped_map(kind, n, 0.95, 40, kernel);
                 let knn = window_ratio(&map, n);
-                map.use_photon_discs();
+                map.use_photon_discs(Walls::every_surface(&Geometry::default()));
                 let discs = window_ratio(&map, n);
                 assert!(
                     (discs - 1.0).abs() < 0.01,
@@ -275,7 +292,7 @@ mod tests {
         for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
             for kernel in [Kernel::Cone(1.1), Kernel::Box] {
                 let mut map = striped_map(kind, n, 0.0, 40, kernel);
-                map.use_photon_discs();
+                map.use_photon_discs(Walls::every_surface(&Geometry::default()));
                 let r = window_ratio(&map, n);
                 assert!((r - 1.0).abs() < 0.01, "{kind:?} {kernel:?}: {r}");
             }
@@ -292,21 +309,33 @@ mod tests {
             .map(|i| Photon::new(Vec3::new(i as f32, 0.0, 0.0), -Vec3::Z, Vec3::Z, Vec3::ONE))
             .collect();
         let mut map = PhotonMap::new(KdTree::build(photons).expect("tree"), 2, 5.0, Kernel::Box);
-        map.use_photon_discs();
-        let e = map.irradiance(Vec3::ZERO, Vec3::Z);
+        map.use_photon_discs(Walls::every_surface(&Geometry::default()));
+        let e = map.irradiance(
+            Vec3::ZERO,
+            Vec3::Z,
+            Walls::every_surface(&Geometry::default()),
+        );
         assert!(
             (e.radiance.x - 1.0 / std::f32::consts::PI).abs() < 1e-4,
             "{e:?}"
         );
         assert_eq!((e.found, e.radius, e.cut), (1, 1.0, false));
         // Between photons 0 and 1 both discs (radius 1) cover the point.
-        let e = map.irradiance(Vec3::new(0.5, 0.0, 0.0), Vec3::Z);
+        let e = map.irradiance(
+            Vec3::new(0.5, 0.0, 0.0),
+            Vec3::Z,
+            Walls::every_surface(&Geometry::default()),
+        );
         assert!(
             (e.radiance.x - 2.0 / std::f32::consts::PI).abs() < 1e-4,
             "{e:?}"
         );
         // Far away: no disc, zero, and marked cut.
-        let e = map.irradiance(Vec3::new(20.0, 0.0, 0.0), Vec3::Z);
+        let e = map.irradiance(
+            Vec3::new(20.0, 0.0, 0.0),
+            Vec3::Z,
+            Walls::every_surface(&Geometry::default()),
+        );
         assert_eq!(e.radiance, Vec3::ZERO);
         assert!(e.cut);
     }

@@ -17,6 +17,7 @@ use super::emit::{LightEmitter, split_by_power};
 use super::estimate::{IrradianceCache, Kernel, PhotonMap};
 use super::trace::{MapKind, TraceCounts, TraceSettings, trace_photon_into};
 use super::volume::{VolumeMap, VolumePhoton};
+use super::walls::Walls;
 use crate::render_scene::RenderScene;
 use crate::sampling::Sampler;
 use crate::sampling::rng::mix64;
@@ -530,6 +531,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
+            pass.is_none().then(|| Walls::of(scene, None)),
             photons,
             MapKind::Caustic,
             p.caustic_gather,
@@ -569,6 +571,7 @@ pub fn build_maps_with(
             return cancelled(summary);
         }
         finish_map(
+            pass.is_none().then(|| Walls::of(scene, None)),
             photons,
             MapKind::Global,
             p.gather,
@@ -586,7 +589,7 @@ pub fn build_maps_with(
     summary.memory = memory;
     let (mut caustic, mut global) = (caustic, global);
     let irradiance = if pass.is_none() {
-        use_photon_discs(&mut caustic, &mut global, &mut summary);
+        use_photon_discs(scene, &mut caustic, &mut global, &mut summary);
         precompute_irradiance(scene, &caustic, &global, &mut summary, cancel)
     } else {
         None
@@ -615,9 +618,11 @@ fn cancelled(mut summary: PhotonSummary) -> PhotonMaps {
 
 /// Gives the photon integrator's maps (not a progressive pass's) their photons' discs
 /// ([`PhotonMap::use_photon_discs`]: the sample-point estimate, which keeps each region's flux),
-/// adding the time to `summary`'s build time and the bytes to its memory. Used by
-/// [`build_maps`] and by the photon-map cache after loading the maps.
+/// adding the time to `summary`'s build time and the bytes to its memory; each disc's wall mark
+/// is made for its own radius against `scene`'s surfaces. Used by [`build_maps`] and by the
+/// photon-map cache after loading the maps.
 pub(super) fn use_photon_discs(
+    scene: &RenderScene,
     caustic: &mut Option<PhotonMap>,
     global: &mut Option<PhotonMap>,
     summary: &mut PhotonSummary,
@@ -625,7 +630,7 @@ pub(super) fn use_photon_discs(
     let t = Instant::now();
     for map in [caustic, global].into_iter().flatten() {
         let before = map.memory_bytes();
-        map.use_photon_discs();
+        map.use_photon_discs(Walls::of(scene, None));
         summary.memory += map.memory_bytes() - before;
     }
     summary.build_time += t.elapsed();
@@ -648,7 +653,7 @@ pub(super) fn precompute_irradiance(
         global
             .as_ref()
             .or(caustic.as_ref())
-            .and_then(|sites| IrradianceCache::build(sites, &maps, cancel))
+            .and_then(|sites| IrradianceCache::build(sites, &maps, Walls::of(scene, None), cancel))
     } else {
         None
     };
@@ -658,9 +663,14 @@ pub(super) fn precompute_irradiance(
     irradiance
 }
 
-/// Builds the kd-tree of one map's photons, or says why there is none.
+/// Builds the kd-tree of one map's photons, or says why there is none; with `walls`, marks its
+/// photons near walls ([`PhotonMap::mark_walls`]). A progressive pass's maps (and the pilot,
+/// which makes no estimate) are marked later, for the pass's own radii
+/// ([`PhotonMap::set_pass_lookup`]): marking them here for the largest radius first cost a
+/// second BVH region query per photon for nothing.
 #[allow(clippy::too_many_arguments)]
 fn finish_map(
+    walls: Option<Walls<'_>>,
     photons: Vec<Photon>,
     kind: MapKind,
     k: u32,
@@ -685,10 +695,14 @@ fn finish_map(
             return None;
         }
     };
-    *build_time += t.elapsed();
     *memory += tree.memory_bytes();
     *radius = r;
-    Some(PhotonMap::new(tree, k as usize, r, kernel))
+    let mut map = PhotonMap::new(tree, k as usize, r, kernel);
+    if let Some(walls) = walls {
+        map.mark_walls(walls);
+    }
+    *build_time += t.elapsed();
+    Some(map)
 }
 
 /// Mean of a flux's channels (W).

@@ -22,9 +22,13 @@ pub mod emit;
 pub mod estimate;
 pub mod maps;
 pub mod passes;
+pub mod potential_walls;
 pub mod radius_field;
 pub mod trace;
 pub mod volume;
+pub mod wall_grid;
+pub mod wall_list;
+pub mod walls;
 
 pub use estimate::{Estimate, IrradianceCache, Kernel, PhotonMap};
 pub use maps::{MapSet, PhotonMaps, PhotonSummary, build_maps};
@@ -43,6 +47,7 @@ use crate::geometry::offset::offset_ray_origin;
 use crate::render_scene::{Interaction, Medium, RenderScene, SurfaceHit, SurfacePoint};
 use crate::sampling::Sampler;
 use crate::shading::{Bsdf, ShadingFrame, TransportMode};
+use walls::Walls;
 
 /// Bounces after which Russian roulette may end a camera path's specular chain.
 const ROULETTE_DEPTH: u32 = 3;
@@ -319,7 +324,17 @@ impl<'a> PhotonMapper<'a> {
     ) -> (Radiance, Option<String>) {
         let (sp, fr, bsdf, wo) = (&v.sp, &v.frame, v.bsdf, v.wo);
         let direct = self.direct(sp, fr, bsdf, wo, sampler, counters);
-        if !full && let Some(l) = cached_radiance(maps, sp, fr, bsdf, wo, counters) {
+        if !full
+            && let Some(l) = cached_radiance(
+                maps,
+                Walls::of(self.scene, Some(sp.object)),
+                sp,
+                fr,
+                bsdf,
+                wo,
+                counters,
+            )
+        {
             let note = describe.then(|| {
                 format!(
                     "direct ({:.4}, {:.4}, {:.4}); caustic + indirect {} ({:.4}, {:.4}, {:.4}) (dim branch)",
@@ -341,10 +356,17 @@ impl<'a> PhotonMapper<'a> {
             r.add(LightPath::Indirect, l);
             return (r, note);
         }
-        let caustic = maps
-            .caustic
-            .as_ref()
-            .map(|m| counted(m, sp.p, wo, fr, bsdf, counters));
+        let caustic = maps.caustic.as_ref().map(|m| {
+            counted(
+                m,
+                Walls::of(self.scene, Some(sp.object)),
+                sp.p,
+                wo,
+                fr,
+                bsdf,
+                counters,
+            )
+        });
         let gather = self.final_gather;
         let (indirect, global) = if gather > 0 {
             (
@@ -352,10 +374,17 @@ impl<'a> PhotonMapper<'a> {
                 None,
             )
         } else {
-            let e = maps
-                .global
-                .as_ref()
-                .map(|m| counted(m, sp.p, wo, fr, bsdf, counters));
+            let e = maps.global.as_ref().map(|m| {
+                counted(
+                    m,
+                    Walls::of(self.scene, Some(sp.object)),
+                    sp.p,
+                    wo,
+                    fr,
+                    bsdf,
+                    counters,
+                )
+            });
             (e.map_or(Vec3::ZERO, |e| e.radiance), e)
         };
         let caustic_l = caustic.map_or(Vec3::ZERO, |e| e.radiance);
@@ -472,23 +501,40 @@ impl<'a> PhotonMapper<'a> {
                 let mut short = false;
                 if g.bsdf.has_local() {
                     let mut lo = self.direct(&gp, &gfr, g.bsdf, gwo, sampler, counters);
-                    let near = maps
-                        .irradiance
-                        .as_ref()
-                        .and_then(|c| c.lookup_with_radius(gp.p, gfr.ng));
+                    let near = maps.irradiance.as_ref().and_then(|c| {
+                        c.lookup_with_radius(gp.p, gfr.ng, Walls::of(scene, Some(gp.object)))
+                    });
                     short = shortcuts < SHORT_GATHER_BOUNCES
                         && near.is_some_and(|(_, r)| g.hit.t < SHORT_GATHER * r);
                     if short {
                         // The caustics here still come from their map; the rest of the light
                         // arriving here is gathered by the bounce below.
                         if let Some(map) = &maps.caustic {
-                            lo += counted(map, gp.p, gwo, &gfr, g.bsdf, counters).radiance;
+                            lo += counted(
+                                map,
+                                Walls::of(scene, Some(gp.object)),
+                                gp.p,
+                                gwo,
+                                &gfr,
+                                g.bsdf,
+                                counters,
+                            )
+                            .radiance;
                         }
                     } else if let Some((e, _)) = near.filter(|_| g.bsdf.is_diffuse_only()) {
                         lo += g.bsdf.eval(gwo, gfr.ns, &gfr, TransportMode::Radiance) * e;
                     } else {
                         for map in [&maps.caustic, &maps.global].into_iter().flatten() {
-                            lo += counted(map, gp.p, gwo, &gfr, g.bsdf, counters).radiance;
+                            lo += counted(
+                                map,
+                                Walls::of(scene, Some(gp.object)),
+                                gp.p,
+                                gwo,
+                                &gfr,
+                                g.bsdf,
+                                counters,
+                            )
+                            .radiance;
                         }
                     }
                     sum += beta * lo;
@@ -538,6 +584,7 @@ impl<'a> PhotonMapper<'a> {
 ///   shininess 1 / 10 / 50 (issue 29, glossy-final-gather).
 fn cached_radiance(
     maps: &PhotonMaps,
+    walls: Walls<'_>,
     sp: &SurfacePoint,
     fr: &ShadingFrame,
     bsdf: &Bsdf,
@@ -546,28 +593,30 @@ fn cached_radiance(
 ) -> Option<Vec3> {
     let cache = maps.irradiance.as_ref()?;
     if bsdf.is_diffuse_only() {
-        let e = cache.lookup(sp.p, fr.ng)?;
+        let e = cache.lookup(sp.p, fr.ng, walls)?;
         return Some(bsdf.eval(wo, fr.ns, fr, TransportMode::Radiance) * e);
     }
     let mut l = Vec3::ZERO;
     for map in [&maps.caustic, &maps.global].into_iter().flatten() {
-        l += counted(map, sp.p, wo, fr, bsdf, counters).radiance;
+        l += counted(map, walls, sp.p, wo, fr, bsdf, counters).radiance;
     }
     Some(l)
 }
 
-/// `map`'s estimate at `p` towards `wo` through `bsdf`, counted in `counters` (estimates
-/// made, and those the largest radius cut short).
+/// `map`'s estimate at `p` towards `wo` through `bsdf` (photons one of `walls`
+/// separates from `p` left out), counted in `counters` (estimates made, and those the largest
+/// radius cut short).
 #[inline]
 fn counted(
     map: &PhotonMap,
+    walls: Walls<'_>,
     p: Vec3,
     wo: Vec3,
     fr: &ShadingFrame,
     bsdf: &Bsdf,
     counters: &mut Counters,
 ) -> Estimate {
-    let e = map.estimate(p, wo, fr, bsdf);
+    let e = map.estimate(p, wo, fr, bsdf, walls);
     counters.photon_estimates += 1;
     counters.photon_radius_cut += u64::from(e.cut);
     e

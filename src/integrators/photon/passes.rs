@@ -24,6 +24,7 @@ use std::time::{Duration, Instant};
 use super::maps::{MapScene, MapSet, PILOT_PASS, PhotonMaps, build_maps_with};
 use super::radius_field::RadiusField;
 use super::volume::{VolumeMap, volume_radius_field};
+use super::walls::Walls;
 use crate::render_scene::RenderScene;
 
 /// Knaus & Zwicker's radius schedule.
@@ -156,10 +157,13 @@ impl<'a> ProgressivePhotons<'a> {
         ] {
             let Some(m) = m else { continue };
             match field {
-                Some(f) => m.set_pass_lookup(shrink, Arc::clone(f)),
+                Some(f) => m.set_pass_lookup(shrink, Arc::clone(f), Walls::of(self.scene, None)),
                 // No pilot photon although this pass stored some (a rare light path): the
-                // pass's own k-nearest radius, shrunk.
-                None => m.set_shrink(shrink),
+                // pass's own k-nearest radius, shrunk (its photons marked for it).
+                None => {
+                    m.mark_walls(Walls::of(self.scene, None));
+                    m.set_shrink(shrink);
+                }
             }
         }
         // The volume photons' spheres: radius `shrink · R(x)` (2-D kernel across the ray, so the
