@@ -41,7 +41,12 @@ mi.set_variant("scalar_rgb")
 
 
 def load(path):
-    a = np.array(mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False))
+    bitmap = mi.Bitmap(path)
+    if bitmap.pixel_format() == mi.Bitmap.PixelFormat.MultiChannel:
+        # caustic's EXR with layers (e.g. `--denoise`: R, G, B denoised and `noisy.R/G/B`):
+        # the image is the root layer.
+        bitmap = dict(bitmap.split())["<root>"]
+    a = np.array(bitmap.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False))
     return a.astype(np.float64)[..., :3]
 
 
