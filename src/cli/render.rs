@@ -12,7 +12,7 @@ use clap::Args;
 
 use caustic::Error;
 pub(super) use caustic::pipeline::render::{BUDGET_SPP_CAP, is_part, output_shard};
-use caustic::pipeline::render::{NOT_8_BIT, RenderNote, RenderRequest};
+use caustic::pipeline::render::{RenderNote, RenderRequest};
 use caustic::render::output::OutputFormat;
 use caustic::render::{Layer, Region};
 
@@ -314,23 +314,14 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         samples: args.samples.clone(),
         layers,
         denoise: args.denoise,
-        // `--compare` scores the raw estimate unless `--denoise` asks for the denoised one.
-        auto_denoise: !args.no_denoise && reference.is_none(),
+        auto_denoise: !args.no_denoise,
+        scored: reference.is_some(),
         exposure: args.exposure,
         target_error: args.target_error,
         adaptive: args.adaptive,
         progress: !args.quiet && std::io::stderr().is_terminal(),
     };
     let prepared = request.prepare()?;
-    let compare_keeps_raw = reference.is_some()
-        && !args.no_denoise
-        && !args.denoise
-        && matches!(
-            OutputFormat::for_path(&request.output),
-            Ok(OutputFormat::Png)
-        )
-        && prepared.auto_denoise_skipped().is_none()
-        && request.region.is_none();
     if !args.quiet {
         print_warnings(&prepared.prepared.warnings);
     }
@@ -342,12 +333,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         super::max_rmse::check_size(reference, p.width, p.height, region)?;
     }
     // Why a PNG was left raw: said with the summary, after the render.
-    let not_denoised = match prepared.auto_denoise_skipped() {
-        Some(why) if why != NOT_8_BIT => Some(why),
-        _ if compare_keeps_raw => Some("--compare (it scores the raw estimate)"),
-        _ => None,
-    }
-    .map(|why| {
+    let not_denoised = prepared.auto_denoise_skipped().map(|why| {
         format!("not denoised: {why} (docs/denoise.md says when a PNG is denoised by default)")
     });
     let started = prepared.start(interrupt.start_rendering())?;

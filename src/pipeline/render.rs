@@ -41,10 +41,6 @@ pub const BUDGET_SPP_CAP: u32 = 1 << 20;
 /// denoiser follow them (on the bath at 800×600 and 8 spp they took 8 % and 9 % of the render).
 pub const DENOISED_PASS_SHARE: f64 = 0.9;
 
-/// [`RenderRequest::auto_denoise_refusal`]'s reason for an EXR or `.part` output, which stays
-/// the linear estimate by design (nothing to warn about).
-pub const NOT_8_BIT: &str = "the output is not an 8-bit image";
-
 /// Why a render request is refused, or what stopped it; each text names the flag (or scene
 /// field) and what is valid. Converted into [`Error::Usage`] (and [`Error::Interrupted`]).
 #[derive(Debug, thiserror::Error)]
@@ -157,9 +153,13 @@ pub struct RenderRequest {
     pub layers: Vec<Layer>,
     /// Denoise the image (`--denoise`): asked for, so refused where it cannot apply.
     pub denoise: bool,
-    /// Denoise the image when the render allows it ([`RenderRequest::auto_denoise_refusal`]
-    /// says when not): `caustic render`'s default, off with `--no-denoise`.
+    /// Denoise a `.png` when the render allows it ([`RenderRequest::auto_denoise_refusal`]
+    /// says when not): `caustic render`'s default, off with `--no-denoise`. EXR and `.part`
+    /// outputs stay the linear estimate (an EXR holds both with `--denoise`).
     pub auto_denoise: bool,
+    /// The image is scored against a reference (`--compare`): the default denoising leaves it
+    /// the raw estimate, which a golden check expects.
+    pub scored: bool,
     /// Linear exposure for 8-bit images (`--exposure`; `render.exposure`).
     pub exposure: Option<f32>,
     /// Stop once the estimated relMSE is at most this (`--target-error`).
@@ -211,10 +211,11 @@ impl RenderRequest {
         }
         let adaptive = prepared.scene.render.with_defaults().adaptive == Some(true);
         let spp = prepared.render_scene.params.samples_per_pixel;
-        let auto_skipped = (self.auto_denoise && !self.denoise)
+        let png = matches!(OutputFormat::for_path(&self.output), Ok(OutputFormat::Png));
+        let auto_skipped = (self.auto_denoise && !self.denoise && png)
             .then(|| self.auto_denoise_refusal(adaptive, spp))
             .flatten();
-        let denoise = self.denoise || (self.auto_denoise && auto_skipped.is_none());
+        let denoise = self.denoise || (self.auto_denoise && png && auto_skipped.is_none());
         if adaptive
             && let Some(why) = [
                 (is_part(&self.output), "a `.part` output"),
@@ -237,21 +238,19 @@ impl RenderRequest {
         })
     }
 
-    /// Why the default denoising ([`RenderRequest::auto_denoise`]) does not apply to this render,
-    /// or `None` when it does: only an 8-bit image of the whole frame at a sample count known in
-    /// advance is denoised by default. EXR and `.part` outputs stay the linear estimate (an EXR
-    /// holds both with `--denoise`); a crop keeps the full render's pixels; adaptive sampling
+    /// Why the default denoising ([`RenderRequest::auto_denoise`]) does not apply to this `.png`
+    /// render, or `None` when it does: only the whole frame with every pixel taking the same
+    /// samples is denoised by default. A crop keeps the full render's pixels; adaptive sampling
     /// gives its pixels different samples (the denoiser's two halves need the same split for
     /// all); a sample range is one part of a render; light layers add up to the raw image;
-    /// checkpoints show the raw passes; fewer than 2 samples per pixel cannot be split in
+    /// checkpoints show the raw passes; `--compare` scores the raw estimate (see
+    /// [`RenderRequest::scored`]); fewer than 2 samples per pixel cannot be split in
     /// halves (a render under `--time` or a target error is denoised when it reaches 2:
     /// [`crate::render::passes::PassPlan::halves`]). `spp` is the render's samples per pixel
     /// (the cap of an open-ended render).
     #[must_use]
     pub fn auto_denoise_refusal(&self, adaptive: bool, spp: u32) -> Option<&'static str> {
-        let png = matches!(OutputFormat::for_path(&self.output), Ok(OutputFormat::Png));
         [
-            (!png, NOT_8_BIT),
             (self.region.is_some(), "--region"),
             (adaptive, "adaptive sampling"),
             (
@@ -263,6 +262,7 @@ impl RenderRequest {
                 "light layers",
             ),
             (self.checkpoint.is_some(), "--checkpoint"),
+            (self.scored, "--compare (it scores the raw estimate)"),
             (spp < 2, "fewer than 2 samples per pixel"),
         ]
         .iter()
@@ -297,9 +297,9 @@ impl<'q> PreparedRender<'q> {
         self.denoise
     }
 
-    /// Why the default denoising does not apply to this render
-    /// ([`RenderRequest::auto_denoise_refusal`]); `None` when it applies, was turned off, or
-    /// `--denoise` asked for it.
+    /// Why the default denoising does not apply to this `.png` render
+    /// ([`RenderRequest::auto_denoise_refusal`]); `None` when it applies, was turned off, was
+    /// asked for by `--denoise`, or the output is not a `.png`.
     #[must_use]
     pub fn auto_denoise_skipped(&self) -> Option<&'static str> {
         self.auto_skipped
@@ -689,6 +689,7 @@ mod tests {
             layers: Vec::new(),
             denoise: false,
             auto_denoise: false,
+            scored: false,
             exposure: None,
             target_error: None,
             adaptive: false,

@@ -142,6 +142,23 @@ fn renders_the_denoiser_cannot_serve_stay_raw_say_why_and_are_not_refused() {
             None => assert!(!err.contains("not denoised"), "{flags:?}: {err}"),
         }
     }
+    // `--compare` scores the raw estimate, and says so.
+    let reference = dir.path().join("3.exr");
+    let (out, _) = render(
+        dir.path(),
+        "scored.png",
+        &[
+            "--spp",
+            "4",
+            "--exposure",
+            "1",
+            "--compare",
+            reference.to_str().expect("utf-8"),
+        ],
+    );
+    let err = stderr(&out);
+    assert!(err.contains("not denoised: --compare"), "{err}");
+    assert!(!err.contains("denoised in"), "{err}");
 }
 
 /// Open-ended renders are denoised: `--time` and a target error keep a first half at a pass

@@ -139,7 +139,7 @@ impl<'a> CellList<'a> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use glam::Vec2;
 
     use super::*;
@@ -153,8 +153,9 @@ mod tests {
     use crate::sampling::Rng;
     use crate::spatial::{KdTree, Photon};
 
-    /// Adds quad `c` (corners in order) as two triangles of object `object`.
-    fn quad(b: &mut GeometryBuilder, c: [Vec3; 4], object: u32) {
+    /// Adds quad `c` (corners in order) as two triangles of object `object` (also the potential
+    /// walls' tests' builder).
+    pub(in crate::integrators::photon) fn quad(b: &mut GeometryBuilder, c: [Vec3; 4], object: u32) {
         for t in [[c[0], c[1], c[2]], [c[0], c[2], c[3]]] {
             b.triangles.push(t);
             b.tri_attrs.push(TriAttrs {

@@ -1,25 +1,14 @@
 //! Tests of the potential-wall criterion (super) against full lists and hand counts.
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 use crate::integrators::photon::wall_grid::{Listing, WallGrid, WallKind, estimate_reach};
 use crate::integrators::photon::wall_list::Crossing;
+use crate::integrators::photon::wall_list::tests::quad;
 use crate::integrators::photon::walls::{Walls, segment, separated, tolerance};
 use crate::render_scene::Geometry;
-use crate::render_scene::geometry::{GeometryBuilder, SpherePrim, TriAttrs};
+use crate::render_scene::geometry::{GeometryBuilder, SpherePrim};
 use crate::sampling::Rng;
-
-/// Adds quad `c` (corners in order) as two triangles of object `object`.
-fn quad(b: &mut GeometryBuilder, c: [Vec3; 4], object: u32) {
-    for t in [[c[0], c[1], c[2]], [c[0], c[2], c[3]]] {
-        b.triangles.push(t);
-        b.tri_attrs.push(TriAttrs {
-            object,
-            normals: None,
-            uvs: [Vec2::ZERO; 3],
-        });
-    }
-}
 
 /// The six faces of the box `lo`–`hi` (object `object`), each as a quad; with `open`, no
 /// face at `z = hi.z` (a Cornell box's open front).
